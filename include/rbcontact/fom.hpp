@@ -1,0 +1,60 @@
+// rbcontact/fom.hpp: the full-order model of a scene: mesh, elasticity, the factored stiffness
+// (KSP prefix fom_, default MUMPS Cholesky, reused for every solve of the same parameter) and
+// the solution. Contact (contact.hpp, kacanov.hpp) builds on the factored operator held here.
+#pragma once
+#include <petscksp.h>
+#include <memory>
+#include "rbcontact/elasticity.hpp"
+#include "rbcontact/report.hpp"
+#include "rbcontact/scene.hpp"
+
+namespace rbc {
+
+struct FomTimes {
+  PetscLogDouble assembly = 0, factorization = 0, contact = 0, solve = 0, total = 0;
+};
+
+class ElasticFOM {
+public:
+  ElasticFOM() = default;
+  ElasticFOM(const ElasticFOM &) = delete;
+  ElasticFOM &operator=(const ElasticFOM &) = delete;
+  ~ElasticFOM();
+
+  // Loads the mesh of the scene and sets up the discretization.
+  PetscErrorCode Create(MPI_Comm comm, const SceneSpec &scene);
+  // Sets up on an existing DM (tests, manufactured solutions); takes a reference.
+  PetscErrorCode CreateOnDM(DM dm, const SceneSpec &scene);
+  // Assembles A and f and factors A (KSPSetUp); times go to times.
+  PetscErrorCode AssembleAndFactor();
+  // u = A^{-1} rhs with the factored operator.
+  PetscErrorCode ApplyInverse(Vec rhs, Vec x);
+  // Plain elastic solve u = A^{-1} f.
+  PetscErrorCode SolveElastic();
+  // Writes displacement (vertex field), von Mises (cell field) to HDF5 and an XDMF beside it.
+  PetscErrorCode WriteOutput(const std::string &h5file, Vec extraVertexField = nullptr);
+  // Fills ndofs, nranks, energy, time_s.
+  PetscErrorCode FillReport(Report *rep);
+  PetscInt GlobalSize() const;
+
+  SceneSpec  scene;
+  Elasticity elas;
+  DM         dm  = nullptr;
+  Mat        A   = nullptr;
+  Vec        f   = nullptr;
+  Vec        u   = nullptr;
+  KSP        ksp = nullptr;
+  FomTimes   times;
+};
+
+// One attribute of an XDMF grid: display name, HDF5 dataset path, components, node or cell centred.
+struct XdmfAttribute {
+  std::string name, dataset;
+  PetscInt    ncomp = 1;
+  bool        cell  = false;
+};
+// Writes <h5file without .h5>.xmf describing the mesh (/geometry/vertices, /viz/topology/cells)
+// and the attributes of an HDF5 file in PETSc's VIZ layout.
+PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs);
+
+} // namespace rbc

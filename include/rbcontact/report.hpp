@@ -1,0 +1,70 @@
+// rbcontact/report.hpp: the machine-readable run summary written by every stage (-report file.json).
+// Owns a small ordered JSON tree (objects, arrays, numbers, strings, booleans) and its atomic
+// write (temp file + rename, rank 0 only). The key names each issue lists are a contract.
+#pragma once
+#include <petscsys.h>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rbc {
+
+class JsonValue {
+public:
+  enum class Kind { Null, Number, Integer, String, Bool, Array, Object };
+  JsonValue() = default;
+  static JsonValue Number(double v);
+  static JsonValue Integer(long long v);
+  static JsonValue String(const std::string &s);
+  static JsonValue Bool(bool b);
+  static JsonValue Array();
+  static JsonValue Object();
+
+  // Object access: creates the key (in insertion order) if missing; turns a Null into an Object.
+  JsonValue &operator[](const std::string &key);
+  // Array append; turns a Null into an Array.
+  JsonValue &Push(const JsonValue &v);
+  JsonValue &operator=(double v);
+  JsonValue &operator=(int v);
+  JsonValue &operator=(long v);
+  JsonValue &operator=(long long v);
+  JsonValue &operator=(bool v);
+  JsonValue &operator=(const char *s);
+  JsonValue &operator=(const std::string &s);
+  JsonValue &operator=(const std::vector<double> &v);
+
+  bool Has(const std::string &key) const;
+  const JsonValue *Get(const std::string &key) const;
+  double AsNumber() const;
+  const std::string &AsString() const { return str_; }
+  Kind kind() const { return kind_; }
+  std::string Dump(int indent = 0) const;
+
+private:
+  Kind kind_ = Kind::Null;
+  double num_ = 0;
+  long long int_ = 0;
+  bool bool_ = false;
+  std::string str_;
+  std::vector<std::pair<std::string, std::unique_ptr<JsonValue>>> obj_;
+  std::vector<JsonValue> arr_;
+
+public:
+  JsonValue(const JsonValue &o);
+  JsonValue &operator=(const JsonValue &o);
+  JsonValue(JsonValue &&) = default;
+  JsonValue &operator=(JsonValue &&) = default;
+};
+
+// Writes text to path atomically (path.tmp.<pid> then rename) on rank 0 of comm; errors name the file.
+PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text);
+
+// The report of one stage run: filled by the stage, written by Write() if -report was given.
+class Report {
+public:
+  JsonValue root = JsonValue::Object();
+  PetscErrorCode Write(MPI_Comm comm, const std::string &path) const;
+};
+
+} // namespace rbc

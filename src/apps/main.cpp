@@ -1,0 +1,40 @@
+// src/apps/main.cpp: the rbcontact executable. The first argument is the stage word (fom, offline,
+// online, validate, dualbasis); PETSc options follow it. Each stage writes -report <file.json>.
+#include <petscsys.h>
+#include <slepcsys.h>
+#include <cstring>
+#include <string>
+#include "stages.hpp"
+
+static const char help[] = "rbcontact: reduced-basis model reduction of frictionless contact.\n"
+                           "Usage: rbcontact <stage> [PETSc options]\n"
+                           "Stages:\n"
+                           "  fom       solve the full-order model of a scene (-options_file runs/<scene>.opts)\n"
+                           "See docs/options.md for the options of each stage.\n";
+
+int main(int argc, char **argv)
+{
+  if (argc < 2 || argv[1][0] == '-') {
+    std::fprintf(stderr, "%s\nerror: the first argument must be a stage word (fom, ...)\n", help);
+    return 1;
+  }
+  const std::string stage = argv[1];
+  // Drop the stage word: PETSc sees the options only.
+  for (int i = 1; i < argc - 1; ++i) argv[i] = argv[i + 1];
+  --argc;
+
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
+  PetscErrorCode ierr = 0;
+  if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
+  else {
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom)\n", stage.c_str()));
+    ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
+  }
+  if (ierr) {
+    // The error message was printed by PETSc's handler; exit non-zero.
+    (void)SlepcFinalize();
+    return (int)ierr;
+  }
+  PetscCall(SlepcFinalize());
+  return 0;
+}

@@ -1,0 +1,7 @@
+// src/apps/stages.hpp: one function per stage of the rbcontact executable.
+#pragma once
+#include <petscsys.h>
+
+namespace rbc {
+PetscErrorCode StageFom(MPI_Comm comm);
+} // namespace rbc

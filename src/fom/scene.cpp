@@ -1,0 +1,152 @@
+// src/fom/scene.cpp: parses a scene from the options database and checks its values.
+#include "rbcontact/scene.hpp"
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace rbc {
+
+std::vector<std::string> SplitList(const std::string &s, char sep)
+{
+  std::vector<std::string> out;
+  std::stringstream        ss(s);
+  std::string              item;
+  while (std::getline(ss, item, sep)) {
+    const auto b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    if (b != std::string::npos) out.push_back(item.substr(b, e - b + 1));
+  }
+  return out;
+}
+
+void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G)
+{
+  *L = E * nu / ((1 + nu) * (1 - 2 * nu));
+  *G = E / (2 * (1 + nu));
+}
+
+static PetscErrorCode GetString(const char *name, std::string *value, PetscBool *set)
+{
+  char      buf[PETSC_MAX_PATH_LEN];
+  PetscBool flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, name, buf, sizeof buf, &flg));
+  if (flg) *value = buf;
+  if (set) *set = flg;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode GetRealArray(const char *name, std::vector<PetscReal> *v, PetscBool *set)
+{
+  PetscReal buf[64];
+  PetscInt  n = 64;
+  PetscBool flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetRealArray(NULL, NULL, name, buf, &n, &flg));
+  if (flg) v->assign(buf, buf + n);
+  if (set) *set = flg;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode GetIntArray(const char *name, std::vector<PetscInt> *v, PetscBool *set)
+{
+  PetscInt  buf[64];
+  PetscInt  n = 64;
+  PetscBool flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetIntArray(NULL, NULL, name, buf, &n, &flg));
+  if (flg) v->assign(buf, buf + n);
+  if (set) *set = flg;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
+{
+  std::string s;
+  PetscBool   flg;
+  PetscInt    refine = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetString("-scene", &scene->name, NULL));
+  PetscCall(GetString("-mesh_file", &scene->mesh.file, &flg));
+  PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)");
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-mesh_clscale", &scene->mesh.clscale, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-mesh_refine", &refine, NULL));
+  PetscCheck(scene->mesh.clscale > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_clscale %g must be > 0", (double)scene->mesh.clscale);
+  PetscCheck(refine >= 0 && refine <= 8, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_refine %" PetscInt_FMT " out of range [0, 8]", refine);
+  scene->mesh.clscale *= std::pow(0.5, (double)refine);
+  if (const char *env = std::getenv("RBC_MESH_CACHE")) scene->mesh.cacheDir = env;
+  PetscCall(GetString("-mesh_cache_dir", &scene->mesh.cacheDir, NULL));
+  if (scene->mesh.cacheDir.empty()) scene->mesh.cacheDir = "meshcache";
+  s.clear();
+  PetscCall(GetString("-mesh_geo_set", &s, &flg));
+  for (const auto &kv : SplitList(s)) {
+    const auto eq = kv.find('=');
+    PetscCheck(eq != std::string::npos, comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: item '%s' is not NAME=VALUE", kv.c_str());
+    char     *end;
+    const std::string val = kv.substr(eq + 1);
+    double    x           = std::strtod(val.c_str(), &end);
+    PetscCheck(end != val.c_str() && *end == 0, comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: value '%s' of '%s' is not a number", val.c_str(), kv.substr(0, eq).c_str());
+    scene->mesh.geoNumbers.emplace_back(kv.substr(0, eq), x);
+  }
+
+  // Bodies and materials
+  s.clear();
+  PetscCall(GetString("-bodies", &s, NULL));
+  std::vector<std::string> names = SplitList(s);
+  if (names.empty()) names.push_back("all");
+  std::vector<PetscReal> E, nu;
+  PetscCall(GetRealArray("-body_E", &E, NULL));
+  PetscCall(GetRealArray("-body_nu", &nu, NULL));
+  if (E.empty()) E.push_back(1.0);
+  if (nu.empty()) nu.push_back(0.3);
+  PetscCheck(E.size() == 1 || E.size() == names.size(), comm, PETSC_ERR_USER_INPUT, "-body_E has %zu values for %zu bodies (give one, or one per body of -bodies)", E.size(), names.size());
+  PetscCheck(nu.size() == 1 || nu.size() == names.size(), comm, PETSC_ERR_USER_INPUT, "-body_nu has %zu values for %zu bodies (give one, or one per body of -bodies)", nu.size(), names.size());
+  scene->bodies.clear();
+  for (size_t b = 0; b < names.size(); ++b) {
+    BodySpec body;
+    body.name = names[b];
+    body.E    = E.size() == 1 ? E[0] : E[b];
+    body.nu   = nu.size() == 1 ? nu[0] : nu[b];
+    PetscCheck(body.E > 0 && std::isfinite(body.E), comm, PETSC_ERR_ARG_OUTOFRANGE, "-body_E: Young's modulus %g of body '%s' must be > 0", (double)body.E, body.name.c_str());
+    PetscCheck(body.nu > -1 && body.nu < 0.5, comm, PETSC_ERR_ARG_OUTOFRANGE, "-body_nu: Poisson ratio %g of body '%s' must lie in (-1, 0.5)", (double)body.nu, body.name.c_str());
+    scene->bodies.push_back(body);
+  }
+
+  // Dirichlet boundaries: -bc_dirichlet a,b with -bc_a_u ux,uy[,uz] and optional -bc_a_comps 0,1
+  s.clear();
+  PetscCall(GetString("-bc_dirichlet", &s, NULL));
+  scene->dirichlet.clear();
+  for (const auto &name : SplitList(s)) {
+    DirichletSpec bc;
+    bc.label = name;
+    PetscCall(GetRealArray(("-bc_" + name + "_u").c_str(), &bc.values, NULL));
+    PetscCall(GetIntArray(("-bc_" + name + "_comps").c_str(), &bc.comps, NULL));
+    for (PetscInt c : bc.comps) PetscCheck(c >= 0 && c < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "-bc_%s_comps: component %" PetscInt_FMT " out of range [0, 2]", name.c_str(), c);
+    scene->dirichlet.push_back(bc);
+  }
+  s.clear();
+  PetscCall(GetString("-bc_traction", &s, NULL));
+  scene->tractions.clear();
+  for (const auto &name : SplitList(s)) {
+    TractionSpec t;
+    t.label = name;
+    PetscCall(GetRealArray(("-bc_" + name + "_t").c_str(), &t.traction, &flg));
+    PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "-bc_traction names '%s' but -bc_%s_t (the traction vector) is missing", name.c_str(), name.c_str());
+    scene->tractions.push_back(t);
+  }
+  PetscCall(GetRealArray("-body_force", &scene->bodyForce, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-fem_degree", &scene->degree, NULL));
+  PetscCheck(scene->degree == 1 || scene->degree == 2, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fem_degree %" PetscInt_FMT " is not supported (1 or 2)", scene->degree);
+
+  PetscCall(GetString("-contact_slave", &scene->slave, NULL));
+  PetscCall(GetString("-contact_master", &scene->master, NULL));
+  scene->contact = (!scene->slave.empty() || !scene->master.empty()) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-contact", &scene->contact, NULL));
+  if (scene->contact) PetscCheck(!scene->slave.empty() && !scene->master.empty(), comm, PETSC_ERR_USER_INPUT, "-contact 1 needs -contact_slave NAME and -contact_master NAME");
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

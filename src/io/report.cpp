@@ -1,0 +1,144 @@
+// src/io/report.cpp: JSON tree for the -report summaries and atomic file writing.
+#include "rbcontact/report.hpp"
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace rbc {
+
+JsonValue JsonValue::Number(double v) { JsonValue j; j.kind_ = Kind::Number; j.num_ = v; return j; }
+JsonValue JsonValue::Integer(long long v) { JsonValue j; j.kind_ = Kind::Integer; j.int_ = v; return j; }
+JsonValue JsonValue::String(const std::string &s) { JsonValue j; j.kind_ = Kind::String; j.str_ = s; return j; }
+JsonValue JsonValue::Bool(bool b) { JsonValue j; j.kind_ = Kind::Bool; j.bool_ = b; return j; }
+JsonValue JsonValue::Array() { JsonValue j; j.kind_ = Kind::Array; return j; }
+JsonValue JsonValue::Object() { JsonValue j; j.kind_ = Kind::Object; return j; }
+
+JsonValue::JsonValue(const JsonValue &o) { *this = o; }
+JsonValue &JsonValue::operator=(const JsonValue &o)
+{
+  if (this == &o) return *this;
+  kind_ = o.kind_; num_ = o.num_; int_ = o.int_; bool_ = o.bool_; str_ = o.str_; arr_ = o.arr_;
+  obj_.clear();
+  for (const auto &kv : o.obj_) obj_.emplace_back(kv.first, std::make_unique<JsonValue>(*kv.second));
+  return *this;
+}
+
+JsonValue &JsonValue::operator[](const std::string &key)
+{
+  if (kind_ == Kind::Null) kind_ = Kind::Object;
+  for (auto &kv : obj_) if (kv.first == key) return *kv.second;
+  obj_.emplace_back(key, std::make_unique<JsonValue>());
+  return *obj_.back().second;
+}
+JsonValue &JsonValue::Push(const JsonValue &v)
+{
+  if (kind_ == Kind::Null) kind_ = Kind::Array;
+  arr_.push_back(v);
+  return arr_.back();
+}
+JsonValue &JsonValue::operator=(double v) { return *this = Number(v); }
+JsonValue &JsonValue::operator=(int v) { return *this = Integer(v); }
+JsonValue &JsonValue::operator=(long v) { return *this = Integer(v); }
+JsonValue &JsonValue::operator=(long long v) { return *this = Integer(v); }
+JsonValue &JsonValue::operator=(bool v) { return *this = Bool(v); }
+JsonValue &JsonValue::operator=(const char *s) { return *this = String(s); }
+JsonValue &JsonValue::operator=(const std::string &s) { return *this = String(s); }
+JsonValue &JsonValue::operator=(const std::vector<double> &v)
+{
+  JsonValue a = Array();
+  for (double x : v) a.Push(Number(x));
+  return *this = a;
+}
+
+bool JsonValue::Has(const std::string &key) const { return Get(key) != nullptr; }
+const JsonValue *JsonValue::Get(const std::string &key) const
+{
+  for (const auto &kv : obj_) if (kv.first == key) return kv.second.get();
+  return nullptr;
+}
+double JsonValue::AsNumber() const { return kind_ == Kind::Integer ? (double)int_ : num_; }
+
+static std::string Escape(const std::string &s)
+{
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+    case '"': o += "\\\""; break;
+    case '\\': o += "\\\\"; break;
+    case '\n': o += "\\n"; break;
+    case '\t': o += "\\t"; break;
+    default:
+      if ((unsigned char)c < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); o += b; }
+      else o += c;
+    }
+  }
+  return o;
+}
+
+std::string JsonValue::Dump(int indent) const
+{
+  std::ostringstream os;
+  const std::string pad(indent + 2, ' '), padEnd(indent, ' ');
+  switch (kind_) {
+  case Kind::Null: os << "null"; break;
+  case Kind::Number:
+    if (std::isfinite(num_)) { char b[40]; std::snprintf(b, sizeof b, "%.17g", num_); os << b; }
+    else os << "null"; // JSON has no NaN/Inf: a non-finite number is reported as null
+    break;
+  case Kind::Integer: os << int_; break;
+  case Kind::String: os << '"' << Escape(str_) << '"'; break;
+  case Kind::Bool: os << (bool_ ? "true" : "false"); break;
+  case Kind::Array: {
+    bool scalars = true;
+    for (const auto &v : arr_) if (v.kind_ == Kind::Array || v.kind_ == Kind::Object) scalars = false;
+    os << '[';
+    for (size_t i = 0; i < arr_.size(); ++i) {
+      if (scalars) os << (i ? ", " : "") << arr_[i].Dump(indent + 2);
+      else os << (i ? ",\n" : "\n") << pad << arr_[i].Dump(indent + 2);
+    }
+    if (!scalars && !arr_.empty()) os << '\n' << padEnd;
+    os << ']';
+  } break;
+  case Kind::Object:
+    os << '{';
+    for (size_t i = 0; i < obj_.size(); ++i) os << (i ? ",\n" : "\n") << pad << '"' << Escape(obj_[i].first) << "\": " << obj_[i].second->Dump(indent + 2);
+    if (!obj_.empty()) os << '\n' << padEnd;
+    os << '}';
+    break;
+  }
+  return os.str();
+}
+
+PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text)
+{
+  PetscMPIInt rank;
+  int         ok = 1;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+    std::ofstream     f(tmp);
+    if (!f) ok = 0;
+    else {
+      f << text;
+      f.close();
+      if (!f || std::rename(tmp.c_str(), path.c_str()) != 0) { ok = 0; std::remove(tmp.c_str()); }
+    }
+  }
+  PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
+  PetscCheck(ok, comm, PETSC_ERR_FILE_OPEN, "Cannot write file '%s' (directory missing or not writable?)", path.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Report::Write(MPI_Comm comm, const std::string &path) const
+{
+  PetscFunctionBeginUser;
+  if (path.empty()) PetscFunctionReturn(0);
+  PetscCall(WriteFileAtomic(comm, path, root.Dump() + "\n"));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,198 @@
+// src/mesh/mesh_loader.cpp: gmsh .geo -> .msh generation (cached, atomic), DMPlex reading with
+// physical names as labels, label checks, and distribution.
+#include "rbcontact/mesh.hpp"
+#include "rbcontact/partition.hpp"
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#ifndef RBC_GMSH_EXECUTABLE
+  #define RBC_GMSH_EXECUTABLE "gmsh"
+#endif
+#ifndef RBC_SOURCE_DIR
+  #define RBC_SOURCE_DIR "."
+#endif
+
+namespace rbc {
+
+static PetscLogEvent MESH_Generate = 0, MESH_Load = 0;
+
+unsigned long long Fnv1a(const std::string &s, unsigned long long h)
+{
+  for (unsigned char c : s) { h ^= c; h *= 1099511628211ULL; }
+  return h;
+}
+
+static bool FileExists(const std::string &p)
+{
+  struct stat st;
+  return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+PetscErrorCode ResolveDataFile(MPI_Comm comm, const std::string &file, std::string *path)
+{
+  PetscFunctionBeginUser;
+  if (FileExists(file)) *path = file;
+  else if (file.size() && file[0] != '/' && FileExists(std::string(RBC_SOURCE_DIR) + "/" + file)) *path = std::string(RBC_SOURCE_DIR) + "/" + file;
+  else SETERRQ(comm, PETSC_ERR_FILE_OPEN, "Mesh file '%s' not found (given by -mesh_file; looked in the working directory and in %s)", file.c_str(), RBC_SOURCE_DIR);
+  PetscFunctionReturn(0);
+}
+
+static bool EndsWith(const std::string &s, const std::string &suf) { return s.size() >= suf.size() && s.compare(s.size() - suf.size(), suf.size(), suf) == 0; }
+
+PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *mshPath)
+{
+  PetscMPIInt rank;
+  std::string src;
+  int         ok = 1;
+  char        msg[1024] = "";
+
+  PetscFunctionBeginUser;
+  if (!MESH_Generate) PetscCall(PetscLogEventRegister("RBCMeshGenerate", DM_CLASSID, &MESH_Generate));
+  PetscCall(ResolveDataFile(comm, spec.file, &src));
+  if (!EndsWith(src, ".geo")) {
+    *mshPath = src;
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscLogEventBegin(MESH_Generate, 0, 0, 0, 0));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  // Cache key: geo text + numbers + clscale + gmsh version string.
+  std::ostringstream key;
+  {
+    std::ifstream f(src);
+    key << f.rdbuf();
+  }
+  char scale[64];
+  std::snprintf(scale, sizeof scale, "%.12g", (double)spec.clscale);
+  key << "|clscale=" << scale;
+  std::string setnum;
+  for (const auto &kv : spec.geoNumbers) {
+    char v[64];
+    std::snprintf(v, sizeof v, "%.17g", (double)kv.second);
+    key << "|" << kv.first << "=" << v;
+    setnum += " -setnumber " + kv.first + " " + v;
+  }
+  std::string base = src.substr(src.find_last_of('/') == std::string::npos ? 0 : src.find_last_of('/') + 1);
+  base             = base.substr(0, base.size() - 4);
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", Fnv1a(key.str()));
+  *mshPath = spec.cacheDir + "/" + base + "-" + hash + ".msh";
+  if (rank == 0 && !FileExists(*mshPath)) {
+    std::string mk = "mkdir -p '" + spec.cacheDir + "'";
+    if (std::system(mk.c_str()) != 0) {
+      ok = 0;
+      std::snprintf(msg, sizeof msg, "cannot create mesh cache directory '%s' (-mesh_cache_dir or RBC_MESH_CACHE)", spec.cacheDir.c_str());
+    } else {
+      const std::string tmp = *mshPath + ".tmp." + std::to_string((long)getpid()) + ".msh";
+      const std::string log = *mshPath + ".log";
+      const std::string cmd = std::string(RBC_GMSH_EXECUTABLE) + " -3 '" + src + "' -clscale " + scale + setnum + " -format msh22 -v 2 -o '" + tmp + "' > '" + log + "' 2>&1";
+      const int         rc  = std::system(cmd.c_str());
+      if (rc != 0 || !FileExists(tmp)) {
+        ok = 0;
+        std::remove(tmp.c_str());
+        std::snprintf(msg, sizeof msg, "gmsh failed on '%s' (exit %d); command: %s; see %s", src.c_str(), rc, cmd.c_str(), log.c_str());
+      } else if (std::rename(tmp.c_str(), mshPath->c_str()) != 0) {
+        ok = 0;
+        std::snprintf(msg, sizeof msg, "cannot move generated mesh to '%s'", mshPath->c_str());
+      }
+    }
+  }
+  PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
+  PetscCallMPI(MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, comm));
+  PetscCheck(ok, comm, PETSC_ERR_FILE_UNEXPECTED, "%s", msg);
+  PetscCall(PetscLogEventEnd(MESH_Generate, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MeshPhysicalNames(DM dm, std::vector<std::string> *names)
+{
+  PetscInt n;
+
+  PetscFunctionBeginUser;
+  names->clear();
+  PetscCall(DMGetNumLabels(dm, &n));
+  for (PetscInt l = 0; l < n; ++l) {
+    const char *name;
+    PetscCall(DMGetLabelName(dm, l, &name));
+    const std::string s(name);
+    if (s == "depth" || s == "celltype" || s == "Cell Sets" || s == "Face Sets" || s == "Vertex Sets" || s == "Edge Sets" || s == "marker") continue;
+    names->push_back(s);
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MeshCheckLabel(DM dm, const std::string &name, const char *option, const std::string &file)
+{
+  DMLabel  label;
+  PetscInt n = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLabel(dm, name.c_str(), &label));
+  if (label) {
+    IS is;
+    PetscCall(DMLabelGetValueIS(label, &is));
+    PetscCall(ISGetSize(is, &n));
+    PetscCall(ISDestroy(&is));
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &n, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+  if (!n) {
+    std::vector<std::string> names;
+    std::string              all;
+    PetscCall(MeshPhysicalNames(dm, &names));
+    for (const auto &s : names) all += (all.empty() ? "" : ", ") + s;
+    SETERRQ(PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "Physical name '%s' (option %s) does not exist in mesh '%s'; it has: %s", name.c_str(), option, file.c_str(), all.c_str());
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
+{
+  std::string msh;
+  PetscBool   set;
+
+  PetscFunctionBeginUser;
+  if (!MESH_Load) PetscCall(PetscLogEventRegister("RBCMeshLoad", DM_CLASSID, &MESH_Load));
+  PetscCall(MeshGenerate(comm, scene.mesh, &msh));
+  PetscCall(PetscLogEventBegin(MESH_Load, 0, 0, 0, 0));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-dm_plex_gmsh_use_regions", &set));
+  if (!set) PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_gmsh_use_regions", "true"));
+  {
+    PetscErrorCode ierr;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = DMPlexCreateFromFile(comm, msh.c_str(), "rbcontact", PETSC_TRUE, dm);
+    PetscCall(PetscPopErrorHandler());
+    PetscCheck(!ierr, comm, PETSC_ERR_FILE_UNEXPECTED, "Cannot read mesh '%s' (from -mesh_file %s): not a valid gmsh file? (PETSc error %d)", msh.c_str(), scene.mesh.file.c_str(), (int)ierr);
+  }
+  PetscCall(PetscObjectSetName((PetscObject)*dm, scene.name.c_str()));
+  // Every physical name the scene uses must exist.
+  for (const auto &b : scene.bodies)
+    if (b.name != "all") PetscCall(MeshCheckLabel(*dm, b.name, "-bodies", scene.mesh.file));
+  for (const auto &bc : scene.dirichlet) PetscCall(MeshCheckLabel(*dm, bc.label, "-bc_dirichlet", scene.mesh.file));
+  for (const auto &t : scene.tractions) PetscCall(MeshCheckLabel(*dm, t.label, "-bc_traction", scene.mesh.file));
+  if (scene.contact) {
+    PetscCall(MeshCheckLabel(*dm, scene.slave, "-contact_slave", scene.mesh.file));
+    PetscCall(MeshCheckLabel(*dm, scene.master, "-contact_master", scene.mesh.file));
+  }
+  // Boundary labels must hold the closure (vertices, edges) for essential conditions and contact.
+  {
+    std::vector<std::string> bnames;
+    for (const auto &bc : scene.dirichlet) bnames.push_back(bc.label);
+    if (scene.contact) { bnames.push_back(scene.slave); bnames.push_back(scene.master); }
+    for (const auto &n : bnames) {
+      DMLabel l;
+      PetscCall(DMCreateLabel(*dm, n.c_str())); // ranks without cells before distribution lack it
+      PetscCall(DMGetLabel(*dm, n.c_str(), &l));
+      PetscCall(DMPlexLabelComplete(*dm, l));
+    }
+  }
+  PetscCall(DistributeMesh(dm));
+  PetscCall(DMSetFromOptions(*dm));
+  PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
+  PetscCall(PetscLogEventEnd(MESH_Load, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
