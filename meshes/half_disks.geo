@@ -69,7 +69,8 @@ Circle(102) = {103, 101, 104};  // master
 Circle(103) = {104, 101, 105};  // master
 Circle(104) = {105, 101, 106};
 Line(105)   = {106, 102};       // lower_bottom
-Curve Loop(101) = {101, 102, 103, 104, 105};
+// counter-clockwise loop (reversed curves) so that the triangles are positively oriented
+Curve Loop(101) = {-105, -104, -103, -102, -101};
 Plane Surface(101) = {101};
 
 // ---------------- physical groups ----------------

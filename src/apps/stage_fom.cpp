@@ -1,8 +1,21 @@
-// src/apps/stage_fom.cpp: `rbcontact fom`: solve the full-order model of one scene and report.
+// src/apps/stage_fom.cpp: `rbcontact fom`: solve the full-order model of one scene (elastic, or with
+// contact by Kacanov iterations) and write the report and the fields.
 #include "stages.hpp"
 #include "rbcontact/fom.hpp"
+#include "rbcontact/kacanov.hpp"
+#include <cmath>
 
 namespace rbc {
+
+// Hertz line contact of a cylinder (radius Rc) on a half-space, plane strain, per unit thickness.
+static void HertzReference(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0)
+{
+  PetscReal inv = 0;
+  for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
+  const PetscReal Estar = 1.0 / inv;
+  *a                    = std::sqrt(4 * P * Rc / (PETSC_PI * Estar));
+  *p0                   = 2 * P / (PETSC_PI * *a);
+}
 
 PetscErrorCode StageFom(MPI_Comm comm)
 {
@@ -10,21 +23,64 @@ PetscErrorCode StageFom(MPI_Comm comm)
   Report         rep;
   char           reportPath[PETSC_MAX_PATH_LEN] = "", outPath[PETSC_MAX_PATH_LEN] = "";
   PetscLogDouble t0, t1;
+  PetscReal      hertzRadius = 0;
+  PetscBool      hertz = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-fom_output", outPath, sizeof outPath, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-hertz_radius", &hertzRadius, &hertz));
   PetscCall(SceneSpecFromOptions(comm, &scene));
-  ElasticFOM fom;
+  ElasticFOM    fom;
+  ContactMap    map;
+  KacanovSolver kacanov;
   PetscCall(fom.Create(comm, scene));
+  if (scene.contact) {
+    PetscCall(kacanov.SetFromOptions(comm));
+    PetscCall(map.Setup(fom.elas, scene.slave, scene.master));
+  }
   PetscCall(fom.AssembleAndFactor());
-  PetscCall(fom.SolveElastic());
+  if (scene.contact) PetscCall(kacanov.Solve(fom, map));
+  else PetscCall(fom.SolveElastic());
   PetscCall(PetscTime(&t1));
   fom.times.total = t1 - t0;
   PetscCall(fom.FillReport(&rep));
   rep.root["stage"]   = "fom";
-  rep.root["contact"] = false;
+  rep.root["contact"] = (bool)scene.contact;
+  if (scene.contact) {
+    ContactSummary cs;
+    PetscCall(SummarizeContact(kacanov.sys, kacanov.lambda, fom.elas.dim, &cs));
+    rep.root["converged"]          = (bool)kacanov.converged;
+    rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
+    rep.root["ncontact"]           = (long long)cs.R;
+    rep.root["nactive"]            = (long long)cs.nactive;
+    rep.root["contact_force"]      = (double)cs.force;
+    rep.root["max_pressure"]       = (double)cs.maxPressure;
+    rep.root["contact_halfwidth"]  = (double)cs.halfwidth;
+    rep.root["pressure_spread"]    = (double)cs.pressureSpread;
+    JsonValue &k                   = rep.root["kkt"];
+    k["primal_infeas"]             = (double)kacanov.kkt.primal;
+    k["dual_infeas"]               = (double)kacanov.kkt.dual;
+    k["complementarity"]           = (double)kacanov.kkt.complementarity;
+    k["stationarity"]              = (double)kacanov.kkt.stationarity;
+    JsonValue &h                   = rep.root["kacanov_history"];
+    h["du"]                        = kacanov.history.du;
+    std::vector<double> dl(kacanov.history.dl.begin(), kacanov.history.dl.end()), na(kacanov.history.nactive.begin(), kacanov.history.nactive.end());
+    h["dlambda"] = dl;
+    h["nactive"] = na;
+    if (hertz) {
+      PetscReal a, p0;
+      HertzReference(scene, hertzRadius, cs.force, &a, &p0);
+      JsonValue &hz  = rep.root["hertz"];
+      hz["a"]        = (double)cs.halfwidthMoment; // from the pressure's second moment (docs/contact.md)
+      hz["a_nodes"]  = (double)cs.halfwidth;       // half the extent of the active nodes
+      hz["a_exact"]  = (double)a;
+      hz["p0"]       = (double)cs.maxPressure;
+      hz["p0_exact"] = (double)p0;
+      hz["P"]        = (double)cs.force;
+    }
+  }
   if (outPath[0]) {
     PetscCall(fom.WriteOutput(outPath));
     rep.root["output"] = outPath;

@@ -167,6 +167,17 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     PetscCheck(!ierr, comm, PETSC_ERR_FILE_UNEXPECTED, "Cannot read mesh '%s' (from -mesh_file %s): not a valid gmsh file? (PETSc error %d)", msh.c_str(), scene.mesh.file.c_str(), (int)ierr);
   }
   PetscCall(PetscObjectSetName((PetscObject)*dm, scene.name.c_str()));
+  {
+    // Inverted cells (a gmsh surface meshed clockwise) give an indefinite stiffness: refuse them.
+    PetscErrorCode ierr;
+    PetscInt       bad;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = DMPlexCheckGeometry(*dm);
+    PetscCall(PetscPopErrorHandler());
+    bad = ierr ? 1 : 0;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
+    PetscCheck(!bad, comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has inverted (negatively oriented) cells: orient every gmsh surface counter-clockwise (reverse its Curve Loop) and regenerate", msh.c_str(), scene.mesh.file.c_str());
+  }
   // Every physical name the scene uses must exist.
   for (const auto &b : scene.bodies)
     if (b.name != "all") PetscCall(MeshCheckLabel(*dm, b.name, "-bodies", scene.mesh.file));

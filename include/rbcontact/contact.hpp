@@ -1,0 +1,109 @@
+// rbcontact/contact.hpp: the discrete non-penetration constraint K(u) v <= g(u) between a slave and a
+// master surface of one DMPlex (non-matching meshes). Owns the surface extraction (facets, their
+// closure dofs, outward normals), the gathering of the master surface on every rank, the closest-point
+// search on the deformed master (uniform bins), and the assembly of K (R x ndofs, MPIAIJ) and g by
+// Gauss quadrature on the slave facets (mortar-like) or by nodal collocation. Dimension-generic:
+// 2D segments now, 3D triangles through the same code paths. See docs/contact.md for the formulas.
+#pragma once
+#include <petscdmplex.h>
+#include <petscmat.h>
+#include <array>
+#include <string>
+#include <vector>
+#include "rbcontact/elasticity.hpp"
+
+namespace rbc {
+
+// One surface facet with its displacement nodes (P1: vertices; P2: vertices + edge midpoints).
+struct SurfaceFacet {
+  PetscInt                     nv = 0;       // geometric vertices (dim)
+  std::array<PetscReal, 9>     X{};          // vertex coordinates (reference), nv x dim
+  std::array<PetscInt, 3>      vglobal{};    // global vertex numbers (for nodal normals, multiplier rows)
+  PetscInt                     nnodes = 0;   // displacement nodes (<= 6)
+  std::array<PetscReal, 18>    U{};          // node displacements, nnodes x dim (current iterate)
+  std::array<PetscInt, 18>     dof{};        // node global dofs, nnodes x dim; < 0: constrained
+  std::array<PetscReal, 18>    Ubc{};        // Dirichlet values of constrained dofs
+  std::array<PetscInt, 6>      nodeKind{};   // node i: vertex k (0..2) or edge (3 + e, e = edge (0,1),(1,2),(0,2))
+  PetscReal                    outward = 1;  // sign making the facet normal point out of its body
+};
+
+// Lagrange basis of the facet nodes at barycentric coordinates b (size nv).
+void FacetBasis(const SurfaceFacet &f, const PetscReal b[], PetscReal N[]);
+
+// The slave or master surface: the local facets of a labelled boundary.
+class ContactSurface {
+public:
+  PetscErrorCode Build(const Elasticity &elas, const std::string &label);
+  // Refreshes U (current displacement, full local field with Dirichlet values) of every facet.
+  PetscErrorCode Update(const Elasticity &elas, Vec uloc);
+  // All ranks' facets (for the master).
+  PetscErrorCode Gather(MPI_Comm comm, std::vector<SurfaceFacet> *all) const;
+  std::vector<SurfaceFacet> facets;
+  std::vector<PetscInt>     points; // DMPlex facet points, aligned with facets
+  PetscInt                  dim = 0;
+};
+
+// Closest-point search on a deformed facet soup (uniform bins over facet bounding boxes).
+class ClosestPoint {
+public:
+  // deformed = true: vertices at X + U (vertex dofs); false: reference X.
+  PetscErrorCode Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed);
+  // Closest point of p: facet index, barycentric coordinates, distance.
+  void Find(const PetscReal p[], PetscInt *facet, PetscReal b[], PetscReal *dist) const;
+  // Deformed vertex positions of facet f.
+  const PetscReal *Vertices(PetscInt f) const { return &xdef_[9 * f]; }
+  PetscInt NumFacets() const { return (PetscInt)(xdef_.size() / 9); }
+
+private:
+  void                  Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const;
+  PetscReal             DistToFacet(PetscInt f, const PetscReal p[], PetscReal b[]) const;
+  PetscInt              dim_ = 2, nv_ = 2;
+  std::vector<PetscReal> xdef_;
+  PetscReal             lo_[3] = {0, 0, 0}, h_[3] = {1, 1, 1};
+  PetscInt              nb_[3] = {1, 1, 1};
+  std::vector<PetscInt> binStart_, binFacets_;
+  mutable std::vector<PetscInt> stamp_;
+  mutable PetscInt      stampId_ = 0;
+};
+
+// What one assembly produces.
+struct ContactSystem {
+  Mat       K = nullptr;       // R x ndofs (rows: slave vertices, owned where the vertex is owned)
+  Vec       g = nullptr;       // R, gap (Dirichlet lifting included)
+  Vec       weight = nullptr;  // R, int psi_i over the slave surface (pressure = lambda_i / weight_i)
+  Vec       normal[3] = {nullptr, nullptr, nullptr}; // R, mean master normal of row i (int psi_i n2 / weight_i)
+  Vec       coord[3]  = {nullptr, nullptr, nullptr}; // R, reference coordinates of slave vertex i
+  PetscInt  R = 0;
+  ~ContactSystem();
+  PetscErrorCode Destroy();
+};
+
+enum class ContactQuadrature { Gauss, Nodal };
+
+// The contact map: slave/master surfaces of a scene and the assembly of K(u), g(u).
+class ContactMap {
+public:
+  // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet.
+  PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
+  // Assembles K(u), g(u) at the full local field uloc (Dirichlet values included).
+  PetscErrorCode Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys);
+  PetscInt NumMultipliers() const { return R_; }
+  // The free global dofs the constraint rows can touch (slave and master facet closures), sorted,
+  // the same on every rank.
+  PetscErrorCode SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const;
+  ContactQuadrature quadrature = ContactQuadrature::Gauss;
+  PetscInt          nquad      = 4;
+  bool              smoothNormal = true;
+
+private:
+  PetscErrorCode NumberMultipliers(const Elasticity &elas);
+  void           SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const;
+  ContactSurface        slave_, master_;
+  std::vector<PetscInt> vertexRow_;  // local vertex point - vStart -> multiplier row (-1: not a slave vertex)
+  PetscInt              R_ = 0, rStart_ = 0, rEnd_ = 0;
+  PetscInt              vStart_ = 0;
+  std::vector<PetscReal> quadPoints_, quadWeights_; // reference facet rule (barycentric, nv per point)
+  std::vector<SurfaceFacet> masterAll_;
+};
+
+} // namespace rbc

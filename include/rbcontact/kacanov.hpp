@@ -1,0 +1,64 @@
+// rbcontact/kacanov.hpp: the contact full-order solve. KacanovSolver runs the fixed-point iterations of
+// the seed: iterate k solves the QP  min 1/2 v'Av - f'v  s.t.  K(u^{k-1}) v <= g(u^{k-1})  through its
+// dual  min_{lambda >= 0} 1/2 lambda'S lambda - lambda'(K u0 - g),  S = K A^{-1} K^T, u0 = A^{-1} f,
+// with A factored once (ElasticFOM) and reused for every back-solve; then u = u0 - A^{-1} K^T lambda.
+// Stops on the relative changes of u and lambda; non-convergence is an error with the history.
+// Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
+// -kacanov_monitor; the dual QP takes the fom_ prefix (-fom_tao_type, -fom_qp_polish); -fom_kkt_tol.
+#pragma once
+#include "rbcontact/bound_qp.hpp"
+#include "rbcontact/compliance.hpp"
+#include "rbcontact/contact.hpp"
+#include "rbcontact/fom.hpp"
+
+namespace rbc {
+
+struct KKTResiduals {
+  PetscReal primal = 0, dual = 0, complementarity = 0, stationarity = 0;
+  PetscReal Max() const { return std::max(std::max(primal, dual), std::max(complementarity, stationarity)); }
+};
+
+struct KacanovHistory {
+  std::vector<PetscReal> du, dl;
+  std::vector<PetscInt>  nactive;
+};
+
+class KacanovSolver {
+public:
+  KacanovSolver() = default;
+  KacanovSolver(const KacanovSolver &) = delete;
+  KacanovSolver &operator=(const KacanovSolver &) = delete;
+  ~KacanovSolver();
+
+  PetscErrorCode SetFromOptions(MPI_Comm comm);
+  // Solves the contact problem of fom (assembled and factored). On return fom.u is the displacement,
+  // lambda (R, distributed like the rows of K) the multipliers, sys the constraint at the last iterate.
+  PetscErrorCode Solve(ElasticFOM &fom, ContactMap &map);
+
+  Vec            lambda = nullptr;
+  ContactSystem  sys;
+  KacanovHistory history;
+  KKTResiduals   kkt;
+  PetscInt       iterations = 0;
+  PetscBool      converged  = PETSC_FALSE;
+  PetscInt       maxIt = 30;
+  PetscReal      rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
+  PetscBool      monitor = PETSC_FALSE;
+  DualQPInfo     lastQP;
+  SurfaceCompliance compliance;
+
+private:
+  PetscErrorCode ComputeKKT(ElasticFOM &fom);
+  DualQPSolver qp_;
+};
+
+// Contact quantities for reports: resultant normal force, max pressure, active count, half-width (2D).
+struct ContactSummary {
+  PetscInt  R = 0, nactive = 0;
+  PetscReal force = 0, forceVec[3] = {0, 0, 0}, maxPressure = 0, halfwidth = 0;
+  PetscReal halfwidthMoment = 0; // 2D: 2 sqrt(int p x^2 / int p), x from the pressure centroid (= a for a Hertz profile)
+  PetscReal pressureSpread = 0; // 2D: max/min - 1 of the nodal pressure over the active nodes but the two ends
+};
+PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s);
+
+} // namespace rbc

@@ -1,0 +1,181 @@
+// src/contact/closest_point.cpp: closest point on a (deformed) facet soup, with a uniform bin grid over
+// the facets' bounding boxes and an expanding search box (exact: a facet at distance d from p has a
+// bounding box that meets the box [p - d, p + d]).
+#include "rbcontact/contact.hpp"
+#include <algorithm>
+#include <cmath>
+
+namespace rbc {
+
+PetscErrorCode ClosestPoint::Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
+{
+  PetscFunctionBeginUser;
+  dim_ = dim;
+  nv_  = dim;
+  const PetscInt nf = (PetscInt)facets.size();
+  xdef_.assign(9 * nf, 0.0);
+  PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL}, hsum = 0;
+  for (PetscInt f = 0; f < nf; ++f) {
+    const SurfaceFacet &F = facets[f];
+    for (PetscInt k = 0; k < nv_; ++k) {
+      // vertex node i with nodeKind k
+      PetscInt node = -1;
+      for (PetscInt i = 0; i < F.nnodes; ++i) if (F.nodeKind[i] == k) node = i;
+      for (PetscInt d = 0; d < dim; ++d) {
+        const PetscReal x = F.X[k * dim + d] + (deformed && node >= 0 ? F.U[node * dim + d] : 0.0);
+        xdef_[9 * f + k * dim + d] = x;
+        lo[d] = std::min(lo[d], x);
+        hi[d] = std::max(hi[d], x);
+      }
+    }
+    PetscReal len = 0;
+    for (PetscInt d = 0; d < dim; ++d) len += PetscSqr(xdef_[9 * f + dim + d] - xdef_[9 * f + d]);
+    hsum += std::sqrt(len);
+  }
+  const PetscReal h = nf ? std::max(hsum / nf, 1e-12) : 1.0;
+  PetscInt        nbins = 1;
+  for (PetscInt d = 0; d < 3; ++d) {
+    if (d < dim && nf) {
+      lo_[d] = lo[d];
+      // about one facet per bin along the surface; cap the total bin count
+      nb_[d] = std::max<PetscInt>(1, std::min<PetscInt>((PetscInt)std::ceil((hi[d] - lo[d]) / h), dim == 2 ? 4096 : 256));
+      h_[d]  = std::max((hi[d] - lo[d]) / nb_[d], 1e-300);
+    } else {
+      lo_[d] = 0;
+      nb_[d] = 1;
+      h_[d]  = 1;
+    }
+    nbins *= nb_[d];
+  }
+  // CSR bins -> facets
+  std::vector<std::vector<PetscInt>> lists(nbins);
+  for (PetscInt f = 0; f < nf; ++f) {
+    PetscInt blo[3] = {0, 0, 0}, bhi[3] = {0, 0, 0};
+    for (PetscInt d = 0; d < dim; ++d) {
+      PetscReal mn = PETSC_MAX_REAL, mx = PETSC_MIN_REAL;
+      for (PetscInt k = 0; k < nv_; ++k) { mn = std::min(mn, xdef_[9 * f + k * dim + d]); mx = std::max(mx, xdef_[9 * f + k * dim + d]); }
+      blo[d] = std::min(nb_[d] - 1, std::max<PetscInt>(0, (PetscInt)std::floor((mn - lo_[d]) / h_[d])));
+      bhi[d] = std::min(nb_[d] - 1, std::max<PetscInt>(0, (PetscInt)std::floor((mx - lo_[d]) / h_[d])));
+    }
+    for (PetscInt i = blo[0]; i <= bhi[0]; ++i)
+      for (PetscInt j = blo[1]; j <= bhi[1]; ++j)
+        for (PetscInt k = blo[2]; k <= bhi[2]; ++k) lists[(i * nb_[1] + j) * nb_[2] + k].push_back(f);
+  }
+  binStart_.assign(nbins + 1, 0);
+  binFacets_.clear();
+  for (PetscInt b = 0; b < nbins; ++b) {
+    binFacets_.insert(binFacets_.end(), lists[b].begin(), lists[b].end());
+    binStart_[b + 1] = (PetscInt)binFacets_.size();
+  }
+  stamp_.assign(nf, -1);
+  stampId_ = 0;
+  PetscFunctionReturn(0);
+}
+
+void ClosestPoint::Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const
+{
+  PetscInt blo[3] = {0, 0, 0}, bhi[3] = {0, 0, 0};
+  for (PetscInt d = 0; d < dim_; ++d) {
+    blo[d] = std::min(nb_[d] - 1, std::max<PetscInt>(0, (PetscInt)std::floor((lo[d] - lo_[d]) / h_[d])));
+    bhi[d] = std::min(nb_[d] - 1, std::max<PetscInt>(0, (PetscInt)std::floor((hi[d] - lo_[d]) / h_[d])));
+  }
+  ++stampId_;
+  c->clear();
+  for (PetscInt i = blo[0]; i <= bhi[0]; ++i)
+    for (PetscInt j = blo[1]; j <= bhi[1]; ++j)
+      for (PetscInt k = blo[2]; k <= bhi[2]; ++k) {
+        const PetscInt b = (i * nb_[1] + j) * nb_[2] + k;
+        for (PetscInt q = binStart_[b]; q < binStart_[b + 1]; ++q) {
+          const PetscInt f = binFacets_[q];
+          if (stamp_[f] != stampId_) { stamp_[f] = stampId_; c->push_back(f); }
+        }
+      }
+}
+
+// Closest point of a segment or triangle; b = barycentric coordinates of the closest point.
+PetscReal ClosestPoint::DistToFacet(PetscInt f, const PetscReal p[], PetscReal b[]) const
+{
+  const PetscReal *x = &xdef_[9 * f];
+  if (dim_ == 2) {
+    const PetscReal t[2] = {x[2] - x[0], x[3] - x[1]};
+    const PetscReal tt   = t[0] * t[0] + t[1] * t[1];
+    PetscReal       s    = tt > 0 ? ((p[0] - x[0]) * t[0] + (p[1] - x[1]) * t[1]) / tt : 0;
+    s                    = std::min(1.0, std::max(0.0, s));
+    b[0] = 1 - s;
+    b[1] = s;
+    const PetscReal q[2] = {x[0] + s * t[0] - p[0], x[1] + s * t[1] - p[1]};
+    return std::sqrt(q[0] * q[0] + q[1] * q[1]);
+  }
+  // Triangle (Ericson, Real-Time Collision Detection, 5.1.5)
+  const PetscReal *a = x, *bb = x + 3, *c = x + 6;
+  auto sub = [](const PetscReal *u, const PetscReal *v, PetscReal *w) { for (int i = 0; i < 3; ++i) w[i] = u[i] - v[i]; };
+  auto dot = [](const PetscReal *u, const PetscReal *v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  PetscReal ab[3], ac[3], ap[3], bp[3], cp[3];
+  sub(bb, a, ab); sub(c, a, ac); sub(p, a, ap);
+  PetscReal d1 = dot(ab, ap), d2 = dot(ac, ap), v, w;
+  if (d1 <= 0 && d2 <= 0) { b[0] = 1; b[1] = 0; b[2] = 0; }
+  else {
+    sub(p, bb, bp);
+    PetscReal d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) { b[0] = 0; b[1] = 1; b[2] = 0; }
+    else {
+      PetscReal vc = d1 * d4 - d3 * d2;
+      if (vc <= 0 && d1 >= 0 && d3 <= 0) { v = d1 / (d1 - d3); b[0] = 1 - v; b[1] = v; b[2] = 0; }
+      else {
+        sub(p, c, cp);
+        PetscReal d5 = dot(ab, cp), d6 = dot(ac, cp);
+        if (d6 >= 0 && d5 <= d6) { b[0] = 0; b[1] = 0; b[2] = 1; }
+        else {
+          PetscReal vb = d5 * d2 - d1 * d6;
+          if (vb <= 0 && d2 >= 0 && d6 <= 0) { w = d2 / (d2 - d6); b[0] = 1 - w; b[1] = 0; b[2] = w; }
+          else {
+            PetscReal va = d3 * d6 - d5 * d4;
+            if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) { w = (d4 - d3) / ((d4 - d3) + (d5 - d6)); b[0] = 0; b[1] = 1 - w; b[2] = w; }
+            else {
+              PetscReal den = 1 / (va + vb + vc);
+              v = vb * den; w = vc * den;
+              b[0] = 1 - v - w; b[1] = v; b[2] = w;
+            }
+          }
+        }
+      }
+    }
+  }
+  PetscReal q2 = 0;
+  for (int i = 0; i < 3; ++i) {
+    const PetscReal qi = b[0] * a[i] + b[1] * bb[i] + b[2] * c[i] - p[i];
+    q2 += qi * qi;
+  }
+  return std::sqrt(q2);
+}
+
+void ClosestPoint::Find(const PetscReal p[], PetscInt *facet, PetscReal b[], PetscReal *dist) const
+{
+  *facet = -1;
+  *dist  = PETSC_MAX_REAL;
+  const PetscInt nf = NumFacets();
+  if (!nf) return;
+  PetscReal r = 0;
+  for (PetscInt d = 0; d < dim_; ++d) r = std::max(r, h_[d]);
+  std::vector<PetscInt> cand;
+  PetscReal             span = 0;
+  for (PetscInt d = 0; d < dim_; ++d) span = std::max(span, h_[d] * nb_[d] + std::abs(p[d] - lo_[d]) + std::abs(p[d] - (lo_[d] + h_[d] * nb_[d])));
+  for (;;) {
+    PetscReal lo[3], hi[3];
+    for (PetscInt d = 0; d < dim_; ++d) { lo[d] = p[d] - r; hi[d] = p[d] + r; }
+    Candidates(lo, hi, &cand);
+    for (PetscInt f : cand) {
+      PetscReal bb[3];
+      const PetscReal dd = DistToFacet(f, p, bb);
+      if (dd < *dist || (dd == *dist && f < *facet)) {
+        *dist  = dd;
+        *facet = f;
+        for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
+      }
+    }
+    if (*dist <= r || r > span) break;
+    r *= 2;
+  }
+}
+
+} // namespace rbc

@@ -1,0 +1,130 @@
+// src/contact/compliance.cpp: G = (A^{-1})_{DD} by a MUMPS Schur complement (serial) or by
+// back-solves with unit right-hand sides (parallel).
+#include "rbcontact/compliance.hpp"
+#include <petscblaslapack.h>
+#include <cstring>
+
+namespace rbc {
+
+static PetscLogEvent CMP_Compute = 0;
+
+static PetscErrorCode ComplianceBySchur(ElasticFOM &fom, const std::vector<PetscInt> &D, std::vector<PetscReal> *G)
+{
+  Mat                  F, S;
+  IS                   is;
+  MatFactorInfo        info;
+  MatFactorSchurStatus status;
+  const PetscBLASInt   n = (PetscBLASInt)D.size();
+
+  PetscFunctionBeginUser;
+  PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)D.size(), D.data(), PETSC_COPY_VALUES, &is));
+  PetscCall(MatGetFactor(fom.A, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F));
+  PetscCall(MatFactorSetSchurIS(F, is));
+  PetscCall(MatFactorInfoInitialize(&info));
+  PetscCall(MatCholeskyFactorSymbolic(F, fom.A, NULL, &info));
+  PetscCall(MatCholeskyFactorNumeric(F, fom.A, &info));
+  PetscCall(MatFactorCreateSchurComplement(F, &S, &status));
+  // S_A = A_DD - A_DI A_II^{-1} A_ID; (A^{-1})_DD = S_A^{-1} (SPD: Cholesky inverse)
+  const PetscScalar *s;
+  PetscInt           lda;
+  PetscCall(MatDenseGetLDA(S, &lda));
+  PetscCall(MatDenseGetArrayRead(S, &s));
+  G->assign((size_t)n * n, 0.0);
+  for (PetscBLASInt j = 0; j < n; ++j)
+    for (PetscBLASInt i = 0; i < n; ++i) (*G)[i + (size_t)j * n] = PetscRealPart(s[i + j * lda]);
+  PetscCall(MatDenseRestoreArrayRead(S, &s));
+  PetscBLASInt linfo = 0;
+  LAPACKpotrf_("L", &n, G->data(), &n, &linfo);
+  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_MAT_CH_ZRPVT, "Contact compliance: Schur complement on the contact dofs is not SPD (LAPACK potrf info %d)", (int)linfo);
+  LAPACKpotri_("L", &n, G->data(), &n, &linfo);
+  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_LIB, "Contact compliance: LAPACK potri info %d", (int)linfo);
+  for (PetscBLASInt j = 0; j < n; ++j)
+    for (PetscBLASInt i = 0; i < j; ++i) (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n];
+  PetscCall(MatDestroy(&S));
+  PetscCall(MatDestroy(&F));
+  PetscCall(ISDestroy(&is));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ComplianceBySolves(ElasticFOM &fom, const std::vector<PetscInt> &D, std::vector<PetscReal> *G)
+{
+  Vec                e, x, xall;
+  VecScatter         sc;
+  IS                 isD;
+  const PetscInt     n = (PetscInt)D.size();
+  PetscInt           lo, hi;
+  MPI_Comm           comm = PetscObjectComm((PetscObject)fom.A);
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(fom.f, &e));
+  PetscCall(VecDuplicate(fom.f, &x));
+  PetscCall(VecGetOwnershipRange(e, &lo, &hi));
+  PetscCall(ISCreateGeneral(PETSC_COMM_SELF, n, D.data(), PETSC_COPY_VALUES, &isD));
+  PetscCall(VecCreateSeq(PETSC_COMM_SELF, n, &xall));
+  PetscCall(VecScatterCreate(x, isD, xall, NULL, &sc));
+  G->assign((size_t)n * n, 0.0);
+  for (PetscInt j = 0; j < n; ++j) {
+    PetscCall(VecSet(e, 0.0));
+    if (D[j] >= lo && D[j] < hi) PetscCall(VecSetValue(e, D[j], 1.0, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(e));
+    PetscCall(VecAssemblyEnd(e));
+    PetscCall(fom.ApplyInverse(e, x));
+    PetscCall(VecScatterBegin(sc, x, xall, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecScatterEnd(sc, x, xall, INSERT_VALUES, SCATTER_FORWARD));
+    const PetscScalar *a;
+    PetscCall(VecGetArrayRead(xall, &a));
+    for (PetscInt i = 0; i < n; ++i) (*G)[i + (size_t)j * n] = PetscRealPart(a[i]);
+    PetscCall(VecRestoreArrayRead(xall, &a));
+  }
+  // Symmetrize (the factor is symmetric up to rounding)
+  for (PetscInt j = 0; j < n; ++j)
+    for (PetscInt i = 0; i < j; ++i) {
+      const PetscReal m = 0.5 * ((*G)[i + (size_t)j * n] + (*G)[j + (size_t)i * n]);
+      (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n] = m;
+    }
+  PetscCall(VecScatterDestroy(&sc));
+  PetscCall(ISDestroy(&isD));
+  PetscCall(VecDestroy(&xall));
+  PetscCall(VecDestroy(&e));
+  PetscCall(VecDestroy(&x));
+  (void)comm;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<PetscInt> &Din)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)fom.A);
+  PetscMPIInt    size;
+  char           m[32] = "auto";
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  if (!CMP_Compute) PetscCall(PetscLogEventRegister("RBCCompliance", MAT_CLASSID, &CMP_Compute));
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscLogEventBegin(CMP_Compute, 0, 0, 0, 0));
+  D = Din;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_compliance", m, sizeof m, NULL));
+  PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur or solves)", m);
+  PetscBool mumps = PETSC_FALSE;
+  {
+    PC          pc;
+    MatSolverType st = NULL;
+    PetscBool   isChol;
+    PetscCall(KSPGetPC(fom.ksp, &pc));
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCCHOLESKY, &isChol));
+    if (isChol) PetscCall(PCFactorGetMatSolverType(pc, &st));
+    mumps = (st && !strcmp(st, MATSOLVERMUMPS)) ? PETSC_TRUE : PETSC_FALSE;
+  }
+  if (!strcmp(m, "auto")) method = (size == 1 && mumps) ? "schur" : "solves";
+  else method = m;
+  PetscCheck(method != "schur" || size == 1, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank (PETSc 3.18 has no parallel MUMPS Schur complement); use solves");
+  if (method == "schur") PetscCall(ComplianceBySchur(fom, D, &G));
+  else PetscCall(ComplianceBySolves(fom, D, &G));
+  PetscCall(PetscLogEventEnd(CMP_Compute, 0, 0, 0, 0));
+  PetscCall(PetscTime(&t1));
+  seconds = t1 - t0;
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

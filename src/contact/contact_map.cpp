@@ -1,0 +1,381 @@
+// src/contact/contact_map.cpp: multiplier numbering on the slave vertices and the assembly of the
+// linearized non-penetration constraint K(u) v <= g(u) (see docs/contact.md):
+//   K_ij = - int_{Gamma_1^c} (phi_j|_1(z) - phi_j|_2(rho(z))) . n2(z) psi_i(z) dz,
+//   g_i  =   int_{Gamma_1^c} (z - rho(z)) . n2(z) psi_i(z) dz  -  sum_{j constrained} K_ij u_D,j,
+// rho(z) the closest point of the deformed master surface to the deformed slave point z + u_1(z),
+// n2 the master's outward unit normal there (facet normal or interpolated nodal normals).
+#include "rbcontact/contact.hpp"
+#include <petscsf.h>
+#include <petscdt.h>
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace rbc {
+
+ContactSystem::~ContactSystem() { (void)Destroy(); }
+
+PetscErrorCode ContactSystem::Destroy()
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&K));
+  PetscCall(VecDestroy(&g));
+  PetscCall(VecDestroy(&weight));
+  for (int d = 0; d < 3; ++d) {
+    PetscCall(VecDestroy(&normal[d]));
+    PetscCall(VecDestroy(&coord[d]));
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ContactMap::NumberMultipliers(const Elasticity &elas)
+{
+  DM       dm = elas.dm;
+  PetscInt pStart, pEnd, vStart, vEnd;
+  PetscSF  sf;
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  vStart_ = vStart;
+  std::vector<PetscInt> flag(pEnd - pStart, 0), row(pEnd - pStart, -1);
+  for (PetscInt p : slave_.points) {
+    PetscInt *closure = NULL, ncl;
+    PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &closure));
+    for (PetscInt c = 0; c < ncl; ++c)
+      if (closure[2 * c] >= vStart && closure[2 * c] < vEnd) flag[closure[2 * c] - pStart] = 1;
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &closure));
+  }
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscInt        nroots, nleaves;
+  const PetscInt *ilocal;
+  PetscCall(PetscSFGetGraph(sf, &nroots, &nleaves, &ilocal, NULL));
+  std::vector<char> isLeaf(pEnd - pStart, 0);
+  if (nroots >= 0) {
+    for (PetscInt l = 0; l < nleaves; ++l) isLeaf[(ilocal ? ilocal[l] : l) - pStart] = 1;
+    PetscCall(PetscSFReduceBegin(sf, MPIU_INT, flag.data(), flag.data(), MPI_MAX));
+    PetscCall(PetscSFReduceEnd(sf, MPIU_INT, flag.data(), flag.data(), MPI_MAX));
+  }
+  // Owned slave vertices, ordered by global vertex number
+  IS              vnumIS;
+  const PetscInt *vnum;
+  PetscCall(DMPlexGetVertexNumbering(dm, &vnumIS));
+  PetscCall(ISGetIndices(vnumIS, &vnum));
+  std::vector<std::pair<PetscInt, PetscInt>> owned;
+  for (PetscInt v = vStart; v < vEnd; ++v)
+    if (flag[v - pStart] && !isLeaf[v - pStart]) owned.emplace_back(vnum[v - vStart], v);
+  PetscCall(ISRestoreIndices(vnumIS, &vnum));
+  std::sort(owned.begin(), owned.end());
+  PetscInt nown = (PetscInt)owned.size();
+  PetscCallMPI(MPI_Scan(&nown, &rEnd_, 1, MPIU_INT, MPI_SUM, comm));
+  rStart_ = rEnd_ - nown;
+  PetscCallMPI(MPI_Allreduce(&nown, &R_, 1, MPIU_INT, MPI_SUM, comm));
+  for (PetscInt i = 0; i < nown; ++i) row[owned[i].second - pStart] = rStart_ + i;
+  if (nroots >= 0) {
+    PetscCall(PetscSFBcastBegin(sf, MPIU_INT, row.data(), row.data(), MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, MPIU_INT, row.data(), row.data(), MPI_REPLACE));
+  }
+  vertexRow_.assign(vEnd - vStart, -1);
+  for (PetscInt v = vStart; v < vEnd; ++v) vertexRow_[v - vStart] = row[v - pStart];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slave, const std::string &master)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)elas.dm);
+  char      quad[64] = "gauss", nrm[64] = "smooth";
+  PetscBool flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_quadrature", quad, sizeof quad, NULL));
+  if (!strcmp(quad, "gauss")) quadrature = ContactQuadrature::Gauss;
+  else if (!strcmp(quad, "nodal")) quadrature = ContactQuadrature::Nodal;
+  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_quadrature: unknown value '%s' (gauss or nodal)", quad);
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-contact_quadrature_points", &nquad, &flg));
+  PetscCheck(nquad >= 1 && nquad <= 12, comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_quadrature_points %" PetscInt_FMT " out of range [1, 12]", nquad);
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_normal", nrm, sizeof nrm, NULL));
+  if (!strcmp(nrm, "smooth")) smoothNormal = true;
+  else if (!strcmp(nrm, "facet")) smoothNormal = false;
+  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_normal: unknown value '%s' (smooth or facet)", nrm);
+
+  PetscCall(slave_.Build(elas, slave));
+  PetscCall(master_.Build(elas, master));
+  PetscCall(NumberMultipliers(elas));
+  PetscCheck(R_ > 0, comm, PETSC_ERR_USER_INPUT, "Contact slave surface '%s' (-contact_slave) has no facets", slave.c_str());
+  {
+    PetscInt nm = (PetscInt)master_.facets.size();
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nm, 1, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(nm > 0, comm, PETSC_ERR_USER_INPUT, "Contact master surface '%s' (-contact_master) has no facets", master.c_str());
+  }
+  // Reference facet rule in barycentric coordinates, weights normalized to sum 1.
+  const PetscInt  fdim = elas.dim - 1;
+  PetscQuadrature q;
+  PetscInt        npts;
+  const PetscReal *pts, *wts;
+  PetscCall(PetscDTStroudConicalQuadrature(fdim, 1, nquad, -1.0, 1.0, &q));
+  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &npts, &pts, &wts));
+  quadPoints_.clear();
+  quadWeights_.clear();
+  PetscReal wsum = 0;
+  for (PetscInt i = 0; i < npts; ++i) wsum += wts[i];
+  for (PetscInt i = 0; i < npts; ++i) {
+    PetscReal b[3] = {0, 0, 0};
+    if (fdim == 1) { b[1] = 0.5 * (pts[i] + 1); b[0] = 1 - b[1]; }
+    else { b[1] = 0.5 * (pts[2 * i] + 1); b[2] = 0.5 * (pts[2 * i + 1] + 1); b[0] = 1 - b[1] - b[2]; }
+    for (PetscInt k = 0; k <= fdim; ++k) quadPoints_.push_back(b[k]);
+    quadWeights_.push_back(wts[i] / wsum);
+  }
+  PetscCall(PetscQuadratureDestroy(&q));
+  PetscFunctionReturn(0);
+}
+
+static PetscReal FacetMeasure(const PetscReal *x, PetscInt dim)
+{
+  if (dim == 2) return std::hypot(x[2] - x[0], x[3] - x[1]);
+  const PetscReal a[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, b[3] = {x[6] - x[0], x[7] - x[1], x[8] - x[2]};
+  const PetscReal c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  return 0.5 * std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+}
+
+// Unnormalized outward normal of a facet with vertices x (length / area weighted).
+static void FacetNormal(const PetscReal *x, PetscInt dim, PetscReal outward, PetscReal n[])
+{
+  if (dim == 2) {
+    n[0] = outward * (x[3] - x[1]);
+    n[1] = -outward * (x[2] - x[0]);
+    n[2] = 0;
+  } else {
+    const PetscReal a[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, b[3] = {x[6] - x[0], x[7] - x[1], x[8] - x[2]};
+    n[0] = outward * 0.5 * (a[1] * b[2] - a[2] * b[1]);
+    n[1] = outward * 0.5 * (a[2] * b[0] - a[0] * b[2]);
+    n[2] = outward * 0.5 * (a[0] * b[1] - a[1] * b[0]);
+  }
+}
+
+PetscErrorCode ContactMap::SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const
+{
+  std::vector<PetscInt> mine;
+  PetscMPIInt           size;
+
+  PetscFunctionBeginUser;
+  for (const auto *surf : {&slave_, &master_})
+    for (const auto &F : surf->facets)
+      for (PetscInt i = 0; i < F.nnodes * surf->dim; ++i)
+        if (F.dof[i] >= 0) mine.push_back(F.dof[i]);
+  std::sort(mine.begin(), mine.end());
+  mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<int> counts(size), displs(size, 0);
+  int              c = (int)mine.size();
+  PetscCallMPI(MPI_Allgather(&c, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (int r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  D->resize(displs[size - 1] + counts[size - 1]);
+  PetscCallMPI(MPI_Allgatherv(mine.data(), c, MPIU_INT, D->data(), counts.data(), displs.data(), MPIU_INT, comm));
+  std::sort(D->begin(), D->end());
+  D->erase(std::unique(D->begin(), D->end()), D->end());
+  PetscFunctionReturn(0);
+}
+
+// Deformed position of the slave point at barycentric b.
+static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[], PetscReal zdef[])
+{
+  PetscReal Ns[6];
+  FacetBasis(F, b, Ns);
+  for (PetscInt d = 0; d < dim; ++d) {
+    zdef[d] = 0;
+    for (PetscInt k = 0; k < F.nv; ++k) zdef[d] += b[k] * F.X[k * dim + d];
+    for (PetscInt a = 0; a < F.nnodes; ++a) zdef[d] += Ns[a] * F.U[a * dim + d];
+  }
+}
+
+// 2D: pieces [s0, s1] of the slave segment (parameter t, b = (1 - t, t)) on which the closest master
+// facet does not change; the switch points are located by bisection to 1e-13.
+void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const
+{
+  auto facetAt = [&](PetscReal t) {
+    const PetscReal b[3] = {1 - t, t, 0};
+    PetscReal       z[3], bm[3], dist;
+    PetscInt        m;
+    SlavePoint(F, 2, b, z);
+    cp.Find(z, &m, bm, &dist);
+    return m;
+  };
+  segs->clear();
+  std::vector<std::array<PetscReal, 4>> stack = {{0.0, 1.0, (PetscReal)facetAt(0.0), (PetscReal)facetAt(1.0)}};
+  std::vector<PetscReal>                cuts  = {0.0, 1.0};
+  while (!stack.empty()) {
+    const auto iv = stack.back();
+    stack.pop_back();
+    if (iv[2] == iv[3] || iv[1] - iv[0] < 1e-13) {
+      if (iv[2] != iv[3]) cuts.push_back(0.5 * (iv[0] + iv[1]));
+      continue;
+    }
+    const PetscReal tm = 0.5 * (iv[0] + iv[1]);
+    const PetscReal mm = (PetscReal)facetAt(tm);
+    stack.push_back({iv[0], tm, iv[2], mm});
+    stack.push_back({tm, iv[1], mm, iv[3]});
+  }
+  std::sort(cuts.begin(), cuts.end());
+  for (size_t i = 0; i + 1 < cuts.size(); ++i)
+    if (cuts[i + 1] > cuts[i]) segs->emplace_back(cuts[i], cuts[i + 1]);
+}
+
+PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)elas.dm);
+  const PetscInt dim  = elas.dim, nv = dim;
+  PetscInt       nlocal, N;
+
+  PetscFunctionBeginUser;
+  PetscCall(sys->Destroy());
+  sys->R = R_;
+  {
+    Vec gv;
+    PetscCall(DMGetGlobalVector(elas.dm, &gv));
+    PetscCall(VecGetLocalSize(gv, &nlocal));
+    PetscCall(VecGetSize(gv, &N));
+    PetscCall(DMRestoreGlobalVector(elas.dm, &gv));
+  }
+  PetscCall(MatCreateAIJ(comm, rEnd_ - rStart_, nlocal, R_, N, 48, NULL, 48, NULL, &sys->K));
+  PetscCall(MatSetOption(sys->K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+  PetscCall(VecCreateMPI(comm, rEnd_ - rStart_, R_, &sys->g));
+  PetscCall(VecDuplicate(sys->g, &sys->weight));
+  for (PetscInt d = 0; d < dim; ++d) {
+    PetscCall(VecDuplicate(sys->g, &sys->normal[d]));
+    PetscCall(VecDuplicate(sys->g, &sys->coord[d]));
+  }
+  PetscCall(VecSet(sys->g, 0.0));
+  PetscCall(VecSet(sys->weight, 0.0));
+
+  // Current displacement on both surfaces; the master is gathered on every rank.
+  PetscCall(slave_.Update(elas, uloc));
+  PetscCall(master_.Update(elas, uloc));
+  PetscCall(master_.Gather(comm, &masterAll_));
+  ClosestPoint cp;
+  PetscCall(cp.Build(masterAll_, dim, true));
+  // Nodal normals of the deformed master (area-weighted facet normals)
+  std::unordered_map<PetscInt, std::array<PetscReal, 3>> vnormal;
+  if (smoothNormal) {
+    for (PetscInt m = 0; m < (PetscInt)masterAll_.size(); ++m) {
+      PetscReal n[3];
+      FacetNormal(cp.Vertices(m), dim, masterAll_[m].outward, n);
+      for (PetscInt k = 0; k < nv; ++k) {
+        auto &a = vnormal[masterAll_[m].vglobal[k]];
+        for (PetscInt d = 0; d < 3; ++d) a[d] += n[d];
+      }
+    }
+  }
+
+  std::vector<PetscInt>    cols;
+  std::vector<PetscScalar> vals;
+  const PetscInt           nq = (PetscInt)quadWeights_.size();
+  for (size_t s = 0; s < slave_.facets.size(); ++s) {
+    const SurfaceFacet &F    = slave_.facets[s];
+    const PetscReal     meas = FacetMeasure(F.X.data(), dim);
+    PetscInt            rows[3];
+    {
+      const PetscInt *cone = NULL;
+      PetscInt       *closure = NULL, ncl, k = 0;
+      PetscCall(DMPlexGetTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
+      for (PetscInt c = 0; c < ncl; ++c) {
+        const PetscInt pt = closure[2 * c];
+        if (pt >= vStart_ && pt < vStart_ + (PetscInt)vertexRow_.size() && k < nv) rows[k++] = vertexRow_[pt - vStart_];
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
+      (void)cone;
+    }
+    // Integration points of this slave facet (barycentric b, weight w)
+    std::vector<std::array<PetscReal, 4>> ipts;
+    if (quadrature == ContactQuadrature::Nodal) {
+      for (PetscInt k = 0; k < nv; ++k) {
+        std::array<PetscReal, 4> q = {0, 0, 0, meas / nv}; // weight: int psi_k over this facet
+        q[k] = 1.0;
+        ipts.push_back(q);
+      }
+    } else if (dim == 2) {
+      // Segment-based (mortar) integration: split [0, 1] where the projection changes master facet,
+      // so that every piece sees one smooth master facet; Gauss on each piece.
+      std::vector<std::pair<PetscReal, PetscReal>> segs;
+      SegmentFacet(F, cp, &segs);
+      for (const auto &sg : segs)
+        for (PetscInt qp = 0; qp < (PetscInt)quadWeights_.size(); ++qp) {
+          const PetscReal t = sg.first + (sg.second - sg.first) * quadPoints_[qp * nv + 1];
+          ipts.push_back({1 - t, t, 0, quadWeights_[qp] * meas * (sg.second - sg.first)});
+        }
+    } else {
+      for (PetscInt qp = 0; qp < nq; ++qp) ipts.push_back({quadPoints_[qp * nv], quadPoints_[qp * nv + 1], quadPoints_[qp * nv + 2], quadWeights_[qp] * meas});
+    }
+    for (const auto &ip : ipts) {
+      const PetscReal b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
+      PetscReal Ns[6], z[3] = {0, 0, 0}, zdef[3];
+      FacetBasis(F, b, Ns);
+      for (PetscInt k = 0; k < nv; ++k)
+        for (PetscInt d = 0; d < dim; ++d) z[d] += b[k] * F.X[k * dim + d];
+      for (PetscInt d = 0; d < dim; ++d) {
+        zdef[d] = z[d];
+        for (PetscInt a = 0; a < F.nnodes; ++a) zdef[d] += Ns[a] * F.U[a * dim + d];
+      }
+      PetscInt  m;
+      PetscReal bm[3] = {0, 0, 0}, dist;
+      cp.Find(zdef, &m, bm, &dist);
+      const SurfaceFacet &M = masterAll_[m];
+      PetscReal           Nm[6], rho[3] = {0, 0, 0}, n2[3] = {0, 0, 0};
+      FacetBasis(M, bm, Nm);
+      for (PetscInt k = 0; k < nv; ++k)
+        for (PetscInt d = 0; d < dim; ++d) rho[d] += bm[k] * M.X[k * dim + d];
+      if (smoothNormal) {
+        for (PetscInt k = 0; k < nv; ++k) {
+          const auto &a = vnormal[M.vglobal[k]];
+          const PetscReal an = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+          for (PetscInt d = 0; d < dim; ++d) n2[d] += bm[k] * a[d] / an;
+        }
+      } else FacetNormal(cp.Vertices(m), dim, M.outward, n2);
+      PetscReal nn = 0;
+      for (PetscInt d = 0; d < dim; ++d) nn += n2[d] * n2[d];
+      nn = std::sqrt(nn);
+      for (PetscInt d = 0; d < dim; ++d) n2[d] /= nn;
+      PetscReal gap = 0;
+      for (PetscInt d = 0; d < dim; ++d) gap += (z[d] - rho[d]) * n2[d];
+
+      for (PetscInt k = 0; k < nv; ++k) {
+        const PetscReal psi = b[k];
+        if (psi == 0.0) continue;
+        const PetscInt r = rows[k];
+        PetscScalar    gk = w * psi * gap;
+        cols.clear();
+        vals.clear();
+        for (PetscInt a = 0; a < F.nnodes; ++a)
+          for (PetscInt d = 0; d < dim; ++d) {
+            const PetscReal coef = -w * psi * Ns[a] * n2[d];
+            if (F.dof[a * dim + d] >= 0) { cols.push_back(F.dof[a * dim + d]); vals.push_back(coef); }
+            else gk -= coef * F.Ubc[a * dim + d];
+          }
+        for (PetscInt a = 0; a < M.nnodes; ++a)
+          for (PetscInt d = 0; d < dim; ++d) {
+            const PetscReal coef = w * psi * Nm[a] * n2[d];
+            if (M.dof[a * dim + d] >= 0) { cols.push_back(M.dof[a * dim + d]); vals.push_back(coef); }
+            else gk -= coef * M.Ubc[a * dim + d];
+          }
+        PetscCall(MatSetValues(sys->K, 1, &r, (PetscInt)cols.size(), cols.data(), vals.data(), ADD_VALUES));
+        PetscCall(VecSetValue(sys->g, r, gk, ADD_VALUES));
+        PetscCall(VecSetValue(sys->weight, r, w * psi, ADD_VALUES));
+        for (PetscInt d = 0; d < dim; ++d) PetscCall(VecSetValue(sys->normal[d], r, w * psi * n2[d], ADD_VALUES));
+      }
+    }
+    for (PetscInt k = 0; k < nv; ++k)
+      for (PetscInt d = 0; d < dim; ++d) PetscCall(VecSetValue(sys->coord[d], rows[k], F.X[k * dim + d], INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(sys->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(sys->K, MAT_FINAL_ASSEMBLY));
+  Vec all[8] = {sys->g, sys->weight, sys->normal[0], sys->normal[1], sys->normal[2], sys->coord[0], sys->coord[1], sys->coord[2]};
+  for (Vec v : all)
+    if (v) {
+      PetscCall(VecAssemblyBegin(v));
+      PetscCall(VecAssemblyEnd(v));
+    }
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(VecPointwiseDivide(sys->normal[d], sys->normal[d], sys->weight));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

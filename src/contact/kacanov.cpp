@@ -1,0 +1,380 @@
+// src/contact/kacanov.cpp: Kacanov fixed-point iterations with the TAO dual solve, KKT checks and
+// the contact summary (force, pressure, active zone).
+#include "rbcontact/kacanov.hpp"
+#include <petscblaslapack.h>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace rbc {
+
+static PetscLogEvent KAC_Assemble = 0, KAC_Schur = 0, KAC_QP = 0;
+
+KacanovSolver::~KacanovSolver() { (void)VecDestroy(&lambda); }
+
+PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
+{
+  PetscFunctionBeginUser;
+  if (!KAC_Assemble) {
+    PetscCall(PetscLogEventRegister("RBCContactAsm", MAT_CLASSID, &KAC_Assemble));
+    PetscCall(PetscLogEventRegister("RBCContactSchur", MAT_CLASSID, &KAC_Schur));
+    PetscCall(PetscLogEventRegister("RBCContactQP", MAT_CLASSID, &KAC_QP));
+  }
+  PetscOptionsBegin(comm, "kacanov_", "Kacanov iterations", "KacanovSolver");
+  PetscCall(PetscOptionsInt("-max_it", "Maximum Kacanov iterations (1: linearized model)", NULL, maxIt, &maxIt, NULL));
+  PetscCall(PetscOptionsReal("-rtol_primal", "Relative change of u to stop", NULL, rtolPrimal, &rtolPrimal, NULL));
+  PetscCall(PetscOptionsReal("-rtol_dual", "Relative change of lambda to stop", NULL, rtolDual, &rtolDual, NULL));
+  PetscCall(PetscOptionsReal("-relaxation", "Under-relaxation factor in (0, 1]", NULL, relaxation, &relaxation, NULL));
+  PetscCall(PetscOptionsBool("-monitor", "Print the changes and the active-set size per iteration", NULL, monitor, &monitor, NULL));
+  PetscOptionsEnd();
+  PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
+  PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
+  PetscOptionsEnd();
+  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
+  PetscCheck(rtolPrimal > 0 && rtolDual > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_rtol_primal and -kacanov_rtol_dual must be > 0");
+  PetscCheck(relaxation > 0 && relaxation <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
+  PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCall(qp_.Setup("fom_"));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full)
+{
+  VecScatter         sc;
+  Vec                all;
+  const PetscScalar *a;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecScatterCreateToAll(v, &sc, &all));
+  PetscCall(VecScatterBegin(sc, v, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(sc, v, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetSize(all, &n));
+  PetscCall(VecGetArrayRead(all, &a));
+  full->resize(n);
+  for (PetscInt i = 0; i < n; ++i) (*full)[i] = PetscRealPart(a[i]);
+  PetscCall(VecRestoreArrayRead(all, &a));
+  PetscCall(VecScatterDestroy(&sc));
+  PetscCall(VecDestroy(&all));
+  PetscFunctionReturn(0);
+}
+
+static const PetscReal kInf = std::numeric_limits<PetscReal>::infinity(); // reported as null in JSON
+
+static PetscReal RelChange(PetscReal diff, PetscReal prev, PetscReal cur)
+{
+  if (prev > 0) return diff / prev;
+  return cur == 0 ? 0.0 : kInf;
+}
+
+PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
+{
+  Vec       r, Ku, res;
+  PetscReal nKu, ng, nl, nl1, lmin, rmax, comp, nf;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(sys.g, &r));
+  PetscCall(VecDuplicate(sys.g, &Ku));
+  PetscCall(MatMult(sys.K, fom.u, Ku));
+  PetscCall(VecWAXPY(r, -1.0, sys.g, Ku)); // K u - g
+  PetscCall(VecNorm(Ku, NORM_INFINITY, &nKu));
+  PetscCall(VecNorm(sys.g, NORM_INFINITY, &ng));
+  PetscCall(VecNorm(lambda, NORM_INFINITY, &nl));
+  PetscCall(VecNorm(lambda, NORM_1, &nl1));
+  PetscCall(VecMin(lambda, NULL, &lmin));
+  PetscCall(VecMax(r, NULL, &rmax));
+  {
+    PetscScalar c;
+    PetscCall(VecDot(lambda, r, &c));
+    comp = std::abs(PetscRealPart(c));
+  }
+  {
+    PetscBool view = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-fom_kkt_view", &view, NULL));
+    if (view) {
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)r), "KKT view: lambda, K u - g, g per multiplier\n"));
+      PetscCall(VecView(lambda, PETSC_VIEWER_STDOUT_(PetscObjectComm((PetscObject)r))));
+      PetscCall(VecView(r, PETSC_VIEWER_STDOUT_(PetscObjectComm((PetscObject)r))));
+      PetscCall(VecView(sys.g, PETSC_VIEWER_STDOUT_(PetscObjectComm((PetscObject)r))));
+    }
+  }
+  // Scale of the constraint terms: |K|_inf |u|_inf + |g|_inf (K u - g itself vanishes on a closed gap)
+  PetscReal nK, nuinf;
+  PetscCall(MatNorm(sys.K, NORM_INFINITY, &nK));
+  PetscCall(VecNorm(fom.u, NORM_INFINITY, &nuinf));
+  const PetscReal scaleG = std::max(std::max(nK * nuinf, nKu) + ng, PETSC_SMALL * PETSC_SMALL);
+  kkt.primal             = std::max(0.0, (double)rmax) / scaleG;
+  kkt.dual               = nl > 0 ? std::max(0.0, -(double)lmin) / nl : 0.0;
+  kkt.complementarity    = nl1 > 0 ? comp / (nl1 * scaleG) : 0.0;
+  // Stationarity A u - f + K^T lambda = 0
+  PetscCall(VecDuplicate(fom.u, &res));
+  PetscCall(MatMult(fom.A, fom.u, res));
+  PetscCall(VecAXPY(res, -1.0, fom.f));
+  PetscCall(MatMultTransposeAdd(sys.K, lambda, res, res));
+  PetscReal nres;
+  PetscCall(VecNorm(res, NORM_2, &nres));
+  PetscCall(VecNorm(fom.f, NORM_2, &nf));
+  {
+    Vec       KtL;
+    PetscReal nktl;
+    PetscCall(VecDuplicate(fom.u, &KtL));
+    PetscCall(MatMultTranspose(sys.K, lambda, KtL));
+    PetscCall(VecNorm(KtL, NORM_2, &nktl));
+    kkt.stationarity = nres / std::max(nf + nktl, PETSC_SMALL * PETSC_SMALL);
+    PetscCall(VecDestroy(&KtL));
+  }
+  PetscCall(VecDestroy(&res));
+  PetscCall(VecDestroy(&r));
+  PetscCall(VecDestroy(&Ku));
+  PetscFunctionReturn(0);
+}
+
+// Rows of K restricted to the columns D, dense R x nD column-major, on every rank.
+static PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD)
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)K);
+  PetscInt    R, rstart, rend;
+  PetscMPIInt size;
+  const PetscInt nD = (PetscInt)D.size();
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(MatGetSize(K, &R, NULL));
+  PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
+  std::vector<PetscReal> mine((size_t)(rend - rstart) * nD, 0.0);
+  for (PetscInt r = rstart; r < rend; ++r) {
+    PetscInt           nc;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscCall(MatGetRow(K, r, &nc, &cols, &vals));
+    for (PetscInt k = 0; k < nc; ++k) {
+      const auto it = std::lower_bound(D.begin(), D.end(), cols[k]);
+      PetscCheck(it != D.end() && *it == cols[k], PETSC_COMM_SELF, PETSC_ERR_PLIB, "Constraint column %" PetscInt_FMT " outside the contact dofs", cols[k]);
+      mine[(size_t)(r - rstart) * nD + (it - D.begin())] += PetscRealPart(vals[k]);
+    }
+    PetscCall(MatRestoreRow(K, r, &nc, &cols, &vals));
+  }
+  std::vector<int> counts(size), displs(size, 0);
+  int              c = (int)mine.size();
+  PetscCallMPI(MPI_Allgather(&c, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (int q = 1; q < size; ++q) displs[q] = displs[q - 1] + counts[q - 1];
+  std::vector<PetscReal> rows((size_t)R * nD);
+  PetscCallMPI(MPI_Allgatherv(mine.data(), c, MPIU_REAL, rows.data(), counts.data(), displs.data(), MPIU_REAL, comm));
+  KD->assign((size_t)R * nD, 0.0);
+  for (PetscInt i = 0; i < R; ++i)
+    for (PetscInt j = 0; j < nD; ++j) (*KD)[i + (size_t)j * R] = rows[(size_t)i * nD + j];
+  PetscFunctionReturn(0);
+}
+
+// Values of a global vector at the global indices D, on every rank.
+static PetscErrorCode GatherAt(Vec v, const std::vector<PetscInt> &D, std::vector<PetscReal> *out)
+{
+  IS         is;
+  Vec        loc;
+  VecScatter sc;
+
+  PetscFunctionBeginUser;
+  PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)D.size(), D.data(), PETSC_COPY_VALUES, &is));
+  PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)D.size(), &loc));
+  PetscCall(VecScatterCreate(v, is, loc, NULL, &sc));
+  PetscCall(VecScatterBegin(sc, v, loc, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(sc, v, loc, INSERT_VALUES, SCATTER_FORWARD));
+  const PetscScalar *a;
+  PetscCall(VecGetArrayRead(loc, &a));
+  out->assign(D.size(), 0.0);
+  for (size_t i = 0; i < D.size(); ++i) (*out)[i] = PetscRealPart(a[i]);
+  PetscCall(VecRestoreArrayRead(loc, &a));
+  PetscCall(VecScatterDestroy(&sc));
+  PetscCall(VecDestroy(&loc));
+  PetscCall(ISDestroy(&is));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)fom.dm);
+  Vec            u0, uprev, uloc, lamPrev = nullptr, tmp, rhs;
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  history = KacanovHistory();
+  converged = PETSC_FALSE;
+  // Elastic solution u0 = A^{-1} f (solve time)
+  PetscCall(PetscTime(&t0));
+  PetscCall(VecDuplicate(fom.f, &u0));
+  PetscCall(fom.ApplyInverse(fom.f, u0));
+  PetscCall(PetscTime(&t1));
+  fom.times.solve += t1 - t0;
+  PetscCall(VecDuplicate(u0, &uprev));
+  PetscCall(VecDuplicate(u0, &tmp));
+  PetscCall(VecDuplicate(u0, &rhs));
+  PetscCall(VecSet(uprev, 0.0));
+  PetscCall(DMCreateLocalVector(fom.dm, &uloc));
+  PetscCall(VecSet(uloc, 0.0)); // u^0 = 0: the reference configuration
+  // Compliance of the contact dofs, once per parameter: S = K_D G K_D^T costs dense operations only.
+  PetscCall(PetscTime(&t0));
+  std::vector<PetscInt> D;
+  std::vector<PetscReal> u0D;
+  PetscCall(map.SurfaceDofs(comm, &D));
+  PetscCall(compliance.Compute(fom, D));
+  PetscCall(GatherAt(u0, D, &u0D));
+  PetscCall(PetscTime(&t1));
+  fom.times.contact += t1 - t0;
+  const PetscBLASInt nD = (PetscBLASInt)D.size();
+  if (monitor) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %d contact dofs, compliance by %s in %.3f s\n", map.NumMultipliers(), (int)nD, compliance.method.c_str(), (double)compliance.seconds));
+
+  for (PetscInt k = 1; k <= maxIt; ++k) {
+    std::vector<PetscReal> KD, T, Sfull, gfull, bfull, lam;
+    PetscCall(PetscTime(&t0));
+    PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
+    PetscCall(map.Assemble(fom.elas, uloc, &sys));
+    PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
+    // S = K_D G K_D^T, b = K_D u0_D - g
+    PetscCall(PetscLogEventBegin(KAC_Schur, 0, 0, 0, 0));
+    const PetscBLASInt R = (PetscBLASInt)sys.R;
+    PetscCall(GatherRowsOnDofs(sys.K, D, &KD));
+    PetscCall(GatherVec(sys.g, &gfull));
+    T.assign((size_t)nD * R, 0.0);
+    Sfull.assign((size_t)R * R, 0.0);
+    {
+      const PetscScalar one = 1.0, zero = 0.0;
+      if (nD && R) {
+        BLASgemm_("N", "T", &nD, &R, &nD, &one, compliance.G.data(), &nD, KD.data(), &R, &zero, T.data(), &nD); // T = G K_D^T
+        BLASgemm_("N", "N", &R, &R, &nD, &one, KD.data(), &R, T.data(), &nD, &zero, Sfull.data(), &R);          // S = K_D T
+      }
+    }
+    for (PetscInt i = 0; i < R; ++i)
+      for (PetscInt j = 0; j < R; ++j)
+        if (j > i) Sfull[i + (size_t)j * R] = Sfull[j + (size_t)i * R] = 0.5 * (Sfull[i + (size_t)j * R] + Sfull[j + (size_t)i * R]);
+    bfull.assign(R, 0.0);
+    for (PetscInt i = 0; i < R; ++i) {
+      PetscReal v = -gfull[i];
+      for (PetscInt j = 0; j < nD; ++j) v += KD[i + (size_t)j * R] * u0D[j];
+      bfull[i] = v;
+    }
+    PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
+    PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
+    PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP));
+    PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
+    if (!lambda) {
+      PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
+      PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
+    }
+    {
+      PetscInt     lo, hi;
+      PetscScalar *la;
+      PetscCall(VecGetOwnershipRange(lambda, &lo, &hi));
+      PetscCall(VecGetArray(lambda, &la));
+      for (PetscInt i = lo; i < hi; ++i) la[i - lo] = lam[i];
+      PetscCall(VecRestoreArray(lambda, &la));
+    }
+    PetscCall(PetscTime(&t1));
+    fom.times.contact += t1 - t0;
+    // u = A^{-1} (f - K^T lambda): one back-solve with the factored A
+    PetscCall(MatMultTranspose(sys.K, lambda, rhs));
+    PetscCall(VecAYPX(rhs, -1.0, fom.f));
+    PetscCall(fom.ApplyInverse(rhs, fom.u));
+    PetscCall(PetscTime(&t0));
+    fom.times.solve += t0 - t1;
+    if (relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - relaxation, relaxation, uprev));
+
+    // Relative changes
+    PetscReal nu, nup, ndu, nl, nlp = 0, ndl;
+    PetscCall(VecNorm(fom.u, NORM_2, &nu));
+    PetscCall(VecNorm(uprev, NORM_2, &nup));
+    PetscCall(VecWAXPY(tmp, -1.0, uprev, fom.u));
+    PetscCall(VecNorm(tmp, NORM_2, &ndu));
+    PetscCall(VecNorm(lambda, NORM_2, &nl));
+    if (lamPrev) {
+      PetscCall(VecNorm(lamPrev, NORM_2, &nlp));
+      PetscCall(VecAXPY(lamPrev, -1.0, lambda));
+      PetscCall(VecNorm(lamPrev, NORM_2, &ndl));
+    } else ndl = nl;
+    const PetscReal du = RelChange(ndu, nup, nu), dl = lamPrev ? RelChange(ndl, nlp, nl) : (nl == 0 ? 0.0 : kInf);
+    PetscInt        nact = 0;
+    for (PetscReal l : lam) if (l > 0) ++nact;
+    history.du.push_back(du);
+    history.dl.push_back(dl);
+    history.nactive.push_back(nact);
+    iterations = k;
+    if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
+    if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
+    PetscCall(VecCopy(lambda, lamPrev));
+    PetscCall(VecCopy(fom.u, uprev));
+    if (maxIt == 1 || (du <= rtolPrimal && dl <= rtolDual)) {
+      converged = PETSC_TRUE;
+      break;
+    }
+    PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+  }
+  PetscCall(VecDestroy(&u0));
+  PetscCall(VecDestroy(&rhs));
+  PetscCall(VecDestroy(&uprev));
+  PetscCall(VecDestroy(&tmp));
+  PetscCall(VecDestroy(&uloc));
+  PetscCall(VecDestroy(&lamPrev));
+  if (!converged) {
+    std::ostringstream h;
+    for (size_t i = 0; i < history.du.size(); ++i) h << "\n  it " << i + 1 << ": du " << history.du[i] << ", dlambda " << history.dl[i] << ", active " << history.nactive[i];
+    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "Kacanov iterations did not converge in %" PetscInt_FMT " iterations (-kacanov_max_it; tolerances -kacanov_rtol_primal %g, -kacanov_rtol_dual %g; try -kacanov_relaxation 0.5). History:%s", maxIt, (double)rtolPrimal, (double)rtolDual, h.str().c_str());
+  }
+  PetscCall(ComputeKKT(fom));
+  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s)
+{
+  std::vector<PetscReal> lam, w, n[3], x[3];
+
+  PetscFunctionBeginUser;
+  PetscCall(GatherVec(lambda, &lam));
+  PetscCall(GatherVec(sys.weight, &w));
+  for (PetscInt d = 0; d < dim; ++d) {
+    PetscCall(GatherVec(sys.normal[d], &n[d]));
+    PetscCall(GatherVec(sys.coord[d], &x[d]));
+  }
+  *s   = ContactSummary();
+  s->R = (PetscInt)lam.size();
+  PetscReal lmax = 0;
+  for (PetscReal l : lam) lmax = std::max(lmax, l);
+  for (size_t i = 0; i < lam.size(); ++i) {
+    // lambda_i is the coefficient of the pressure field in the hat basis psi_i (docs/contact.md):
+    // nodal pressure lambda_i, resultant int p n2 = sum_i lambda_i int psi_i n2.
+    if (lam[i] > 0) ++s->nactive;
+    for (PetscInt d = 0; d < dim; ++d) s->forceVec[d] += lam[i] * w[i] * n[d][i];
+    s->maxPressure = std::max(s->maxPressure, lam[i]);
+  }
+  for (PetscInt d = 0; d < dim; ++d) s->force += s->forceVec[d] * s->forceVec[d];
+  s->force = std::sqrt(s->force);
+  // 2D half-width: extent of the active nodes along the tangent of the mean normal, half of it.
+  if (dim == 2 && s->nactive && s->force > 0) {
+    const PetscReal t[2] = {-s->forceVec[1] / s->force, s->forceVec[0] / s->force};
+    std::vector<std::pair<PetscReal, PetscReal>> active; // (tangent coordinate, nodal pressure)
+    for (size_t i = 0; i < lam.size(); ++i)
+      if (lam[i] > 0) active.emplace_back(x[0][i] * t[0] + x[1][i] * t[1], lam[i]);
+    std::sort(active.begin(), active.end());
+    {
+      // second moment of the pressure along the tangent (exact a for p0 sqrt(1 - x^2/a^2))
+      PetscReal m0 = 0, m1 = 0, m2 = 0;
+      for (size_t i = 0; i < lam.size(); ++i) {
+        const PetscReal st = x[0][i] * t[0] + x[1][i] * t[1], f = lam[i] * w[i];
+        m0 += f; m1 += f * st; m2 += f * st * st;
+      }
+      if (m0 > 0) s->halfwidthMoment = 2 * std::sqrt(std::max(0.0, m2 / m0 - (m1 / m0) * (m1 / m0)));
+    }
+    s->halfwidth = 0.5 * (active.back().first - active.front().first);
+    if (active.size() >= 3) {
+      PetscReal pmin = PETSC_MAX_REAL, pmax = 0;
+      for (size_t i = 1; i + 1 < active.size(); ++i) {
+        pmin = std::min(pmin, active[i].second);
+        pmax = std::max(pmax, active[i].second);
+      }
+      s->pressureSpread = pmin > 0 ? pmax / pmin - 1 : PETSC_INFINITY;
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,7 @@
+# tests/elasticity.cmake -- registers the tests of the elastic full-order model (WIP)
+rbc_test_exe(test_mms)
+rbc_add_mpi_test(NAME mms RANKS 1 2 COMMAND $<TARGET_FILE:test_mms> LABELS elasticity)
+rbc_test_exe(test_vonmises)
+rbc_add_mpi_test(NAME vonmises RANKS 1 2 COMMAND $<TARGET_FILE:test_vonmises> -out_dir ${CMAKE_CURRENT_BINARY_DIR} LABELS elasticity)
+rbc_test_exe(test_two_bodies)
+rbc_add_mpi_test(NAME two_bodies RANKS 1 2 COMMAND $<TARGET_FILE:test_two_bodies> LABELS elasticity)
