@@ -31,8 +31,9 @@ public:
   PetscErrorCode ApplyInverse(Vec rhs, Vec x);
   // Plain elastic solve u = A^{-1} f.
   PetscErrorCode SolveElastic();
-  // Writes displacement (vertex field), von Mises (cell field) to HDF5 and an XDMF beside it.
-  PetscErrorCode WriteOutput(const std::string &h5file, Vec extraVertexField = nullptr);
+  // Writes displacement (vertex field), von Mises (cell field) to HDF5 and an XDMF beside it; the
+  // named vectors of `contact` (multipliers, slave coordinates, ...) go to the group /contact.
+  PetscErrorCode WriteOutput(const std::string &h5file, const std::vector<Vec> &contact = {});
   // Fills ndofs, nranks, energy, time_s.
   PetscErrorCode FillReport(Report *rep);
   PetscInt GlobalSize() const;

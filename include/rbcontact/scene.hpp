@@ -37,6 +37,14 @@ struct MeshSpec {
   std::string                                   cacheDir;    // where generated .msh files go
 };
 
+// A scene parameter with its box; geometry parameters set a gmsh constant of the .geo (the mesh is
+// generated at that value; the reference-configuration map of the next stage replaces this).
+struct ParamSpec {
+  std::string name;
+  PetscReal   min = 0, max = 0, value = 0;
+  std::string geoName; // gmsh constant (-mu_geo_set), empty if not a geometry parameter
+};
+
 struct SceneSpec {
   std::string                name = "unnamed";
   MeshSpec                   mesh;
@@ -47,7 +55,8 @@ struct SceneSpec {
   // C++ API: a pointwise residual term f0 replacing the constant body force (manufactured solutions).
   void (*bodyForceF0)(PetscInt, PetscInt, PetscInt, const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], PetscReal, const PetscReal[], PetscInt, const PetscScalar[], PetscScalar[]) = nullptr;
   PetscInt                   degree = 1; // Lagrange degree of the displacement (1 or 2)
-  // Contact pair (the contact issue): slave and master physical names.
+  std::vector<ParamSpec>     params; // -mu_names, -mu_min, -mu_max, -mu_default, -mu_geo_set, -mu
+  // Contact pair: slave and master physical names.
   PetscBool   contact = PETSC_FALSE;
   std::string slave, master;
 };

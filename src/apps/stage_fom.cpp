@@ -81,8 +81,26 @@ PetscErrorCode StageFom(MPI_Comm comm)
       hz["P"]        = (double)cs.force;
     }
   }
+  if (!scene.params.empty()) {
+    JsonValue &m = rep.root["mu"];
+    for (const auto &p : scene.params) m[p.name] = (double)p.value;
+  }
   if (outPath[0]) {
-    PetscCall(fom.WriteOutput(outPath));
+    std::vector<Vec> cv;
+    if (scene.contact) {
+      // multipliers (nodal pressures), int psi_i, slave vertex coordinates, mean master normal
+      const char *names[] = {"x", "y", "z"}, *nn[] = {"normal_x", "normal_y", "normal_z"};
+      PetscCall(PetscObjectSetName((PetscObject)kacanov.lambda, "lambda"));
+      PetscCall(PetscObjectSetName((PetscObject)kacanov.sys.weight, "weight"));
+      cv = {kacanov.lambda, kacanov.sys.weight};
+      for (PetscInt d = 0; d < fom.elas.dim; ++d) {
+        PetscCall(PetscObjectSetName((PetscObject)kacanov.sys.coord[d], names[d]));
+        PetscCall(PetscObjectSetName((PetscObject)kacanov.sys.normal[d], nn[d]));
+        cv.push_back(kacanov.sys.coord[d]);
+        cv.push_back(kacanov.sys.normal[d]);
+      }
+    }
+    PetscCall(fom.WriteOutput(outPath, cv));
     rep.root["output"] = outPath;
   }
   PetscCall(PetscPrintf(comm, "rbcontact fom: scene %s, %" PetscInt_FMT " dofs, energy %.10e, total %.3f s\n", scene.name.c_str(), fom.GlobalSize(), rep.root["energy"].AsNumber(), (double)fom.times.total));

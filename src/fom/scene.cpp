@@ -92,6 +92,40 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     scene->mesh.geoNumbers.emplace_back(kv.substr(0, eq), x);
   }
 
+  // Parameters: names, boxes, defaults, the gmsh constant each one sets, and the values (-mu)
+  s.clear();
+  PetscCall(GetString("-mu_names", &s, NULL));
+  const std::vector<std::string> pnames = SplitList(s);
+  if (!pnames.empty()) {
+    std::vector<PetscReal> lo, hi, def, val;
+    PetscCall(GetRealArray("-mu_min", &lo, NULL));
+    PetscCall(GetRealArray("-mu_max", &hi, NULL));
+    PetscCall(GetRealArray("-mu_default", &def, NULL));
+    PetscCall(GetRealArray("-mu", &val, &flg));
+    s.clear();
+    PetscCall(GetString("-mu_geo_set", &s, NULL));
+    const std::vector<std::string> geo = SplitList(s);
+    const size_t np = pnames.size();
+    PetscCheck(lo.size() == np && hi.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu_min and -mu_max need one value per parameter of -mu_names (%zu)", np);
+    PetscCheck(def.empty() || def.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu_default needs one value per parameter (%zu)", np);
+    PetscCheck(!flg || val.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu has %zu values; the scene has %zu parameters (%s)", val.size(), np, s.c_str());
+    for (size_t i = 0; i < np; ++i) {
+      ParamSpec p;
+      p.name  = pnames[i];
+      p.min   = lo[i];
+      p.max   = hi[i];
+      p.value = flg ? val[i] : (def.empty() ? 0.5 * (lo[i] + hi[i]) : def[i]);
+      PetscCheck(lo[i] <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu_min %g > -mu_max %g for parameter '%s'", (double)lo[i], (double)hi[i], p.name.c_str());
+      PetscCheck(p.value >= lo[i] && p.value <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' = %g is outside its box [%g, %g]", p.name.c_str(), (double)p.value, (double)lo[i], (double)hi[i]);
+      if (i < geo.size() && geo[i] != "-") p.geoName = geo[i];
+      if (!p.geoName.empty()) scene->mesh.geoNumbers.emplace_back(p.geoName, p.value);
+      scene->params.push_back(p);
+    }
+  } else {
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-mu", &flg));
+    PetscCheck(!flg, comm, PETSC_ERR_USER_INPUT, "-mu given but the scene declares no parameters (-mu_names)");
+  }
+
   // Bodies and materials
   s.clear();
   PetscCall(GetString("-bodies", &s, NULL));

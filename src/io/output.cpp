@@ -45,7 +45,7 @@ PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim,
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, Vec extra)
+PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vector<Vec> &contact)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   PetscViewer v;
@@ -67,8 +67,12 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, Vec extra)
   PetscCall(DMView(dm, v));
   PetscCall(VecView(u, v));
   PetscCall(VecView(vm, v));
-  if (extra) PetscCall(VecView(extra, v));
   PetscCall(PetscViewerPopFormat(v));
+  if (!contact.empty()) {
+    PetscCall(PetscViewerHDF5PushGroup(v, "/contact"));
+    for (Vec c : contact) PetscCall(VecView(c, v));
+    PetscCall(PetscViewerHDF5PopGroup(v));
+  }
   PetscCall(PetscViewerDestroy(&v));
   PetscCall(VecDestroy(&vm));
   if (rank == 0) PetscCheck(std::rename(tmp.c_str(), h5file.c_str()) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot move '%s' to '%s' (-fom_output)", tmp.c_str(), h5file.c_str());

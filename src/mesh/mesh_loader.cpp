@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #ifndef RBC_GMSH_EXECUTABLE
@@ -93,7 +94,17 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
       if (rc != 0 || !FileExists(tmp)) {
         ok = 0;
         std::remove(tmp.c_str());
-        std::snprintf(msg, sizeof msg, "gmsh failed on '%s' (exit %d); command: %s; see %s", src.c_str(), rc, cmd.c_str(), log.c_str());
+        // std::system returns a wait status: report gmsh's exit code, and its first error line
+        // (e.g. "Error : 'x.geo', line 2: syntax error") so the user need not open the log.
+        const int   code = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : rc;
+        std::string first;
+        {
+          std::ifstream lf(log);
+          std::string   line;
+          while (first.empty() && std::getline(lf, line))
+            if (line.find("Error") != std::string::npos) first = line.substr(0, 300);
+        }
+        std::snprintf(msg, sizeof msg, "gmsh failed on '%s' (exit code %d)%s%s; command: %s; see %s", src.c_str(), code, first.empty() ? "" : ": ", first.c_str(), cmd.c_str(), log.c_str());
       } else if (std::rename(tmp.c_str(), mshPath->c_str()) != 0) {
         ok = 0;
         std::snprintf(msg, sizeof msg, "cannot move generated mesh to '%s'", mshPath->c_str());

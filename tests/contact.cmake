@@ -1,0 +1,20 @@
+# tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test, no-contact gap,
+# ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers.
+find_program(RBC_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+set(RBC_CC ${RBC_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/contact_checks.py)
+foreach(np 1 2)
+  add_test(NAME contact_hertz_np${np} COMMAND ${RBC_CC} hertz --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  add_test(NAME contact_flat_punch_np${np} COMMAND ${RBC_CC} flat_punch --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  add_test(NAME contact_no_contact_np${np} COMMAND ${RBC_CC} no_contact --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  add_test(NAME contact_kkt_all_np${np} COMMAND ${RBC_CC} kkt_all --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np}
+    PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
+endforeach()
+# runs both rank counts itself and compares them
+add_test(NAME contact_ring_np1_np2 COMMAND ${RBC_CC} ring --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(contact_ring_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
+
+rbc_test_exe(test_bound_qp)
+rbc_add_mpi_test(NAME bound_qp RANKS 1 COMMAND $<TARGET_FILE:test_bound_qp> LABELS contact)
+rbc_test_exe(test_closest_point)
+rbc_add_mpi_test(NAME closest_point RANKS 1 COMMAND $<TARGET_FILE:test_closest_point> LABELS contact)

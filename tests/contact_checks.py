@@ -1,0 +1,167 @@
+#!/usr/bin/python3
+"""Checks of the contact full-order model, run by ctest (tests/contact.cmake).
+
+Each subcommand runs `rbcontact fom` (under mpirun -n NP) on a scene of runs/ and asserts on its
+-report JSON (and -fom_output HDF5 where fields are compared). Exit 0 = pass; a failure prints what
+was measured and the bound it broke. References: Hertz's analytic line contact, the flat-punch patch
+test (uniform pressure), the elastic solution (a gap larger than any motion), KKT residuals,
+1 vs 2 ranks.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+FAILED = []
+
+
+def check(cond, msg):
+    print(("  ok    " if cond else "  FAIL  ") + msg)
+    if not cond:
+        FAILED.append(msg)
+
+
+def run(args, np_, opts, extra, tag):
+    out = tempfile.mkdtemp(prefix="rbc_contact_")
+    rep = os.path.join(out, tag + ".json")
+    h5 = os.path.join(out, tag + ".h5")
+    cmd = ["mpirun", "-n", str(np_), args.exe, "fom", "-options_file", opts] + extra + ["-report", rep, "-fom_output", h5]
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        print(p.stdout[-4000:])
+        sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(cmd)))
+    with open(rep) as f:
+        return json.load(f), h5
+
+
+def check_kkt(r, tol=1e-8):
+    k = r["kkt"]
+    check(max(k["primal_infeas"], k["dual_infeas"], k["complementarity"], k["stationarity"]) <= tol,
+          "KKT residuals %.2e %.2e %.2e %.2e <= %g" % (k["primal_infeas"], k["dual_infeas"], k["complementarity"], k["stationarity"], tol))
+
+
+def contact_fields(h5):
+    with h5py.File(h5, "r") as f:
+        c = f["contact"]
+        lam = np.array(c["lambda"])
+        xy = np.stack([np.array(c["x"]), np.array(c["y"])], axis=1)
+    order = np.lexsort((xy[:, 1], xy[:, 0]))
+    return lam[order], xy[order]
+
+
+def vertex_field(h5):
+    """Displacement at the vertices, sorted by vertex coordinates (independent of the partition)."""
+    with h5py.File(h5, "r") as f:
+        x = np.array(f["geometry/vertices"])
+        u = np.array(f["vertex_fields/displacement_displacement"])
+    return u[np.lexsort(x.T[::-1])]
+
+
+def hertz(args):
+    print("Hertz: cylinder on a block; errors of a and p0 over refinements (clscale %s)" % args.clscale)
+    ea, ep = [], []
+    for cl in args.clscale:
+        r, _ = run(args, args.np, "runs/hertz.opts", ["-mesh_clscale", str(cl)] + args.extra, "hertz%g" % cl)
+        h = r["hertz"]
+        ea.append(abs(h["a"] - h["a_exact"]) / h["a_exact"])
+        ep.append(abs(h["p0"] - h["p0_exact"]) / h["p0_exact"])
+        print("  clscale %-5g ndofs %7d R %4d active %3d  P %.5f  a %.5f (exact %.5f, err %.2f%%)  p0 %.4f (exact %.4f, err %.2f%%)  a_nodes %.5f"
+              % (cl, r["ndofs"], r["ncontact"], r["nactive"], h["P"], h["a"], h["a_exact"], 100 * ea[-1], h["p0"], h["p0_exact"], 100 * ep[-1], h["a_nodes"]))
+        check_kkt(r)
+        check(r["converged"] and r["kacanov_iterations"] <= 15, "Kacanov converged in %d <= 15 iterations" % r["kacanov_iterations"])
+    check(ea[-1] <= 0.03, "finest mesh: relative error of a %.3f%% <= 3%%" % (100 * ea[-1]))
+    check(ep[-1] <= 0.05, "finest mesh: relative error of p0 %.3f%% <= 5%%" % (100 * ep[-1]))
+    check(all(ea[i + 1] < ea[i] for i in range(len(ea) - 1)), "error of a decreases: %s" % ["%.2e" % e for e in ea])
+    check(all(ep[i + 1] < ep[i] for i in range(len(ep) - 1)), "error of p0 decreases: %s" % ["%.2e" % e for e in ep])
+
+
+def flat_punch(args):
+    print("Flat punch patch test: uniform pressure across a non-matching interface")
+    r, h5 = run(args, args.np, "runs/flat_punch.opts", args.extra, "punch_gauss")
+    rn, _ = run(args, args.np, "runs/flat_punch.opts", ["-contact_quadrature", "nodal"] + args.extra, "punch_nodal")
+    print("  pressure_spread: gauss %.3e, nodal %.3e (nodal collocation is reported, not asserted)" % (r["pressure_spread"], rn["pressure_spread"]))
+    check(r["nactive"] == r["ncontact"], "all %d slave nodes active (%d)" % (r["ncontact"], r["nactive"]))
+    check(r["pressure_spread"] <= 1e-2, "gauss pressure_spread %.3e <= 1e-2" % r["pressure_spread"])
+    # The segment-based integration is exact for this patch: expect round-off, assert far below 1e-2.
+    check(r["pressure_spread"] <= 1e-9, "gauss pressure_spread %.3e <= 1e-9 (exact mortar integration)" % r["pressure_spread"])
+    # Reference: the stacked blocks (same material, height H) in plane strain with free right edges:
+    # sigma_xx = 0, eps_zz = 0, so p = -sigma_yy = E / (1 - nu^2) * d / H.
+    E, nu, d, H = 100.0, 0.3, 0.01, 1.0
+    p_exact = E / (1 - nu * nu) * d / H
+    lam, _ = contact_fields(h5)
+    err = np.max(np.abs(lam - p_exact)) / p_exact
+    print("  nodal pressure %.10f .. %.10f, exact E d / ((1 - nu^2) H) = %.10f" % (lam.min(), lam.max(), p_exact))
+    check(err <= 1e-9, "pressure equals the analytic uniaxial-strain value to %.2e <= 1e-9" % err)
+    check_kkt(r)
+    check_kkt(rn)
+
+
+def no_contact(args):
+    print("Gap larger than any motion: lambda = 0 exactly and u = the elastic solution")
+    # the ring hangs from its top ends under a body force, 0.3 above the block: both bodies deform
+    extra = ["-mesh_geo_set", "g0=0.3", "-body_force", "0,-0.5"] + args.extra
+    r, h5 = run(args, args.np, "runs/ring_on_block.opts", extra, "gap")
+    re, h5e = run(args, args.np, "runs/ring_on_block.opts", extra + ["-contact", "0"], "gap_elastic")
+    lam, _ = contact_fields(h5)
+    check(np.all(lam == 0.0), "every multiplier is exactly 0 (max %.3e)" % np.max(np.abs(lam)))
+    check(r["nactive"] == 0 and r["contact_force"] == 0.0, "nactive %d, contact_force %g" % (r["nactive"], r["contact_force"]))
+    u, ue = vertex_field(h5), vertex_field(h5e)
+    check(r["energy"] > 1e-6, "the bodies are strained (energy %.3e)" % r["energy"])
+    du = np.max(np.abs(u - ue)) / np.max(np.abs(ue))
+    check(du <= 1e-12, "max |u - u_elastic| / max |u_elastic| = %.2e <= 1e-12" % du)
+    de = abs(r["energy"] - re["energy"]) / re["energy"]
+    check(de <= 1e-12, "energy %.12e vs elastic %.12e (rel %.1e <= 1e-12)" % (r["energy"], re["energy"], de))
+
+
+def ring(args):
+    print("Ring on block at mu = %s: convergence and 1 vs 2 ranks" % args.mu)
+    for mu in args.mu:
+        res = {}
+        for np_ in (1, 2):
+            r, h5 = run(args, np_, "runs/ring_on_block.opts", ["-mu", str(mu)] + args.extra, "ring%g_np%d" % (mu, np_))
+            res[np_] = (r, contact_fields(h5))
+            print("  mu %.3f np %d: ndofs %d R %d active %d Kacanov its %d force %.10f energy %.12e"
+                  % (mu, np_, r["ndofs"], r["ncontact"], r["nactive"], r["kacanov_iterations"], r["contact_force"], r["energy"]))
+            check(r["converged"] and r["kacanov_iterations"] <= 15, "mu %.3f np %d: converged in %d <= 15 Kacanov iterations" % (mu, np_, r["kacanov_iterations"]))
+            check(r["nactive"] > 0, "mu %.3f np %d: contact is active (%d nodes)" % (mu, np_, r["nactive"]))
+            check_kkt(r)
+        (r1, (l1, x1)), (r2, (l2, x2)) = res[1], res[2]
+        for key in ("energy", "contact_force", "max_pressure"):
+            rel = abs(r1[key] - r2[key]) / abs(r1[key])
+            check(rel <= 1e-8, "mu %.3f: %s np1 %.12e np2 %.12e (rel %.1e <= 1e-8)" % (mu, key, r1[key], r2[key], rel))
+        check(np.array_equal(x1, x2), "mu %.3f: same slave vertices on 1 and 2 ranks" % mu)
+        dl = np.max(np.abs(l1 - l2)) / np.max(np.abs(l1))
+        check(dl <= 1e-8, "mu %.3f: multipliers np1 vs np2 max rel diff %.1e <= 1e-8" % (mu, dl))
+
+
+def kkt_all(args):
+    print("KKT residuals on every scene (np %d)" % args.np)
+    for s in ("ring_on_block", "half_disks", "hertz", "flat_punch"):
+        r, _ = run(args, args.np, "runs/%s.opts" % s, args.extra, s)
+        print("  %-14s ndofs %6d R %4d active %4d Kacanov its %2d" % (s, r["ndofs"], r["ncontact"], r["nactive"], r["kacanov_iterations"]))
+        check_kkt(r)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all"])
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--np", type=int, default=1)
+    ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])
+    ap.add_argument("--mu", type=float, nargs="+", default=[0.95, 1.05, 1.15])
+    ap.add_argument("--extra", nargs=argparse.REMAINDER, default=[])
+    args = ap.parse_args()
+    globals()[args.check](args)
+    if FAILED:
+        print("%d check(s) failed" % len(FAILED))
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# tests/expect_error.sh -- owns the bad-input test driver of the ctest suite.
+# Usage: expect_error.sh REGEX cmd [args...]
+# Runs the command (stdin closed) and passes only if
+#   * its exit code is non-zero,
+#   * its combined stdout + stderr matches the extended regular expression REGEX (grep -E), and
+#   * that output contains no sign of a crash or of a NaN: 'SEGV', 'Segmentation', 'Caught signal',
+#     'nan' (as a word, any case).
+# Prints the command, the exit code and the error lines, so a failing test shows why.
+# Special arguments: the tokens @GARBAGE_MSH@ / @GARBAGE_GEO@ in the command are replaced by the path
+# of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards.
+set -u
+if [ $# -lt 2 ]; then
+  echo "usage: $0 REGEX cmd [args...]" >&2
+  exit 2
+fi
+regex=$1
+shift
+
+tmpdir=$(mktemp -d "${TMPDIR:-/tmp}/rbc_expect_error.XXXXXX") || exit 2
+trap 'rm -rf "$tmpdir"' EXIT
+args=()
+for a in "$@"; do
+  if [ "$a" = "@GARBAGE_MSH@" ]; then
+    printf '$MeshFormat\nthis is not a mesh\n$EndMeshFormat\n$Nodes\n3\n1 0 0\n2 x y z\n' > "$tmpdir/garbage_mesh.msh"
+    args+=("$tmpdir/garbage_mesh.msh")
+  elif [ "$a" = "@GARBAGE_GEO@" ]; then
+    printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
+    args+=("$tmpdir/garbage_geometry.geo")
+  else
+    args+=("$a")
+  fi
+done
+
+out="$tmpdir/output.txt"
+echo "expect_error: running: ${args[*]}"
+"${args[@]}" < /dev/null > "$out" 2>&1
+rc=$?
+echo "expect_error: exit code $rc"
+# The error lines (PETSc prints many lines of configuration noise after the message).
+grep -E "ERROR: [^-]|error|Error" "$out" | grep -vE "Configure options|See https|Petsc Release|named .* by|#[0-9]+ " | head -n 12
+
+status=0
+if [ "$rc" -eq 0 ]; then
+  echo "expect_error: FAILED: the command succeeded (exit code 0), an error was expected"
+  status=1
+fi
+if ! grep -Eq -- "$regex" "$out"; then
+  echo "expect_error: FAILED: the output does not match /$regex/; full output:"
+  cat "$out"
+  status=1
+fi
+if grep -Eiq 'SEGV|Segmentation|Caught signal|\bnan\b' "$out"; then
+  echo "expect_error: FAILED: the output shows a crash or a NaN:"
+  grep -Ein 'SEGV|Segmentation|Caught signal|\bnan\b' "$out" | head -n 5
+  status=1
+fi
+[ $status -eq 0 ] && echo "expect_error: passed (non-zero exit, message matches /$regex/)"
+exit $status
