@@ -12,6 +12,17 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "  fom       solve the full-order model of a scene (-options_file runs/<scene>.opts)\n"
                            "See docs/options.md for the options of each stage.\n";
 
+// Error handler: the message and a short trace, without PETSc's configure banner; the first line
+// names the option, file or value at fault (every check in rbcontact says which).
+static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
+{
+  PetscMPIInt rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (p == PETSC_ERROR_INITIAL) std::fprintf(stderr, "[%d] rbcontact error: %s\n", (int)rank, mess ? mess : "(no message)");
+  std::fprintf(stderr, "[%d]     in %s() at %s:%d\n", (int)rank, fun ? fun : "?", file ? file : "?", line);
+  return n;
+}
+
 int main(int argc, char **argv)
 {
   if (argc < 2 || argv[1][0] == '-') {
@@ -24,6 +35,11 @@ int main(int argc, char **argv)
   --argc;
 
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
+  {
+    PetscBool full = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-rbc_full_traceback", &full, NULL));
+    if (!full) PetscCall(PetscPushErrorHandler(ConciseErrorHandler, NULL));
+  }
   PetscErrorCode ierr = 0;
   if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
   else {
