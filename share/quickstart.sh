@@ -3,7 +3,7 @@
 #   1. share/setup.sh             installs the missing Debian packages (idempotent)
 #   2. cmake configure + build    into build/ (Release)
 #   3. the main job               (the MAIN JOB block below) under mpirun -n $NP
-#   4. prints where the reports and pictures are
+#   4. prints where the reports, fields and pictures are
 # Runs from any working directory (it changes to the repository root).
 # Environment: RBC_BUILD_DIR (default build), RBC_NP (default 2).
 set -euo pipefail
@@ -54,24 +54,38 @@ plot() {
   PICTURES+=("$2")
 }
 
+# plot_pressure <fields.h5> <picture.png> <title> [plot_contact.py options...]: plots the contact
+# pressure along the slave surface with share/plot_contact.py (needs a run with contact).
+plot_pressure() {
+  local h5="$1" png="$2" title="$3"
+  shift 3
+  echo "+ $PYTHON share/plot_contact.py $h5 -o $png --title $title${*:+ $*}"
+  "$PYTHON" share/plot_contact.py "$h5" -o "$png" --title "$title" "$@" || die "plotting the contact pressure of $h5 failed"
+  PICTURES+=("$png")
+}
+
 # ============================== MAIN JOB ==============================
 # Extend here: the offline/online pipeline (offline snapshots, bases, EIM, online, validate) goes
 # below the fom stage, each writing its report into $OUT.
 SCENE=ring_on_block
 OUT="results/$SCENE"
-# Contact is not implemented yet: the FOM runs without it. When contact lands: CONTACT_OPTS=()
-CONTACT_OPTS=(-contact 0)
+# The FOM runs with contact (the scene's -contact_slave/-contact_master pair). Add options here,
+# e.g. CONTACT_OPTS=(-kacanov_monitor); CONTACT_OPTS=(-contact 0) solves the elastic problem only
+# (then there is no contact pressure to plot: drop the plot_pressure line).
+CONTACT_OPTS=()
 
 main_job() {
   step "main job: scene $SCENE on $NP ranks -> $OUT/"
-  rbc fom "$OUT/fom.json" -options_file "runs/$SCENE.opts" "${CONTACT_OPTS[@]}" -fom_output "$OUT/fom.h5"
+  rbc fom "$OUT/fom.json" -options_file "runs/$SCENE.opts" ${CONTACT_OPTS[@]+"${CONTACT_OPTS[@]}"} -fom_output "$OUT/fom.h5"
   plot "$OUT/fom.h5" "$OUT/fom.png" "$SCENE"
+  plot_pressure "$OUT/fom.h5" "$OUT/pressure.png" "$SCENE"
 }
 # ============================ END MAIN JOB ============================
 
 main_job
 
-step "done"
+step "done: outputs"
 for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
+echo "fields:  $ROOT/$OUT/fom.h5"
+echo "fields:  $ROOT/$OUT/fom.xmf (open it in ParaView)"
 for p in "${PICTURES[@]}"; do echo "picture: $ROOT/$p"; done
-echo "fields:  $ROOT/$OUT/fom.h5 (open $ROOT/$OUT/fom.xmf in ParaView)"

@@ -1,12 +1,16 @@
 // rbcontact/elasticity.hpp: linear elasticity (Hooke's law, plane strain in 2D, 3D) of one or several
-// bodies on one DMPlex with PetscFE. Owns the discretization (vector Lagrange P1/P2), the per-cell
-// material field (Lamé coefficients as a P0 auxiliary field set from the body labels), essential and
-// natural boundary conditions, and the assembly of A (free dofs only) and f (loads + Dirichlet lifting).
+// bodies on one DMPlex with PetscFE, on a reference mesh mapped per body by x = G_b(mu) xr + t_b(mu).
+// Owns the discretization (vector Lagrange P1/P2), the per-cell auxiliary P0 field (the effective
+// elasticity tensor |det G| C(G^-T ., G^-T .), the Lamé coefficients, G^-1, the body-force scale),
+// essential and natural boundary conditions, and the assembly of A (free dofs only) and f (loads +
+// Dirichlet lifting) in the current state: the physical state at mu (SetMu), or any state the affine
+// decomposition sets (SetBodyAux, SetLoadScales).
 #pragma once
 #include <petscdmplex.h>
 #include <petscsnes.h>
 #include <petscds.h>
 #include <deque>
+#include "rbcontact/geometry_map.hpp"
 #include "rbcontact/scene.hpp"
 
 namespace rbc {
@@ -22,7 +26,25 @@ public:
   ~Elasticity();
 
   // Takes a reference to dm (which must carry the scene's labels), creates the FE space and the DS.
+  // The state is the physical one at the scene's parameter values, with the identity map.
   PetscErrorCode Setup(DM dm, const SceneSpec &scene);
+  // The geometric map used by SetMu (not owned; nullptr = identity).
+  void SetGeometryMap(const GeometryMap *map) { map_ = map; }
+  // Physical state at mu: materials E(mu), nu(mu), map G_b(mu), Dirichlet and traction scales.
+  PetscErrorCode SetMu(const std::vector<PetscReal> &mu);
+  // Raw state for the affine decomposition: per body, the aux values (AuxSize() each) ...
+  PetscErrorCode SetBodyAux(const std::vector<std::vector<PetscReal>> &perBody);
+  // ... and the load scales: per Dirichlet boundary, body force, per traction boundary.
+  PetscErrorCode SetLoadScales(const std::vector<PetscReal> &dirichlet, PetscReal bodyForce, const std::vector<PetscReal> &traction);
+  // Aux layout: L, G, G^-1 (dim x dim), body-force scale, then the effective tensor T (dim^4).
+  PetscInt AuxSize() const { return dim * dim * dim * dim + 3 + dim * dim; }
+  // The physical aux values of a body with moduli (E, nu) under the map a.
+  void PhysicalAux(PetscReal E, PetscReal nu, const Affine &a, std::vector<PetscReal> *aux) const;
+  // The material of body b at mu.
+  void Material(PetscInt b, const std::vector<PetscReal> &mu, PetscReal *E, PetscReal *nu) const;
+  // Assemble only A, or only f = -F(0) (loads + lifting), in the current state.
+  PetscErrorCode AssembleMatrix(Mat *A);
+  PetscErrorCode AssembleRhs(Vec *f);
   // A (SPD, free dofs) and f = loads - A_{free,constrained} u_D. Creates A, f on the first call.
   PetscErrorCode Assemble(Mat *A, Vec *f);
   // Full local field (constrained dofs set to their Dirichlet values) from a global (free-dof) vector.
@@ -41,13 +63,18 @@ public:
   PetscInt dim    = 0;
   PetscInt degree = 1;
 
+  SceneSpec scene; // a copy (names, materials, loads, parameters)
+
 private:
-  PetscErrorCode SetupMaterials(const SceneSpec &scene);
+  PetscErrorCode SetupMaterials();
+  PetscErrorCode ApplyConstants(PetscReal bodyForceScale, const std::vector<PetscReal> &tractionScale);
+  const GeometryMap        *map_ = nullptr;
   SNES                      snes_ = nullptr; // carries the DM's FEM callbacks; never solved
   Vec                       aux_  = nullptr; // (L, G) per cell
   DM                        dmAux_ = nullptr;
   std::deque<DirichletSpec> bcs_;            // stable storage for boundary-condition contexts
   std::vector<PetscInt>     cellBody_;
+  std::vector<PetscInt>     tractionBody_;
 };
 
 } // namespace rbc

@@ -37,6 +37,8 @@ public:
   // Fills ndofs, nranks, energy, time_s.
   PetscErrorCode FillReport(Report *rep);
   PetscInt GlobalSize() const;
+  // Checks the factorization after KSPSetUp (diagnosis, one retry on a MUMPS workspace shortage).
+  PetscErrorCode CheckFactorization();
 
   SceneSpec  scene;
   Elasticity elas;

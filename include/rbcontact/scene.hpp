@@ -12,6 +12,7 @@ struct BodySpec {
   std::string name;   // physical name of the body's cells in the mesh ("all": every cell)
   PetscReal   E  = 1; // Young's modulus (> 0)
   PetscReal   nu = 0; // Poisson ratio (-1 < nu < 0.5)
+  PetscInt    paramE = -1, paramNu = -1; // -param_E_<body> NAME: E (nu) equals that parameter
 };
 
 // Pointwise vector function of the position (PETSc's projection signature).
@@ -23,11 +24,14 @@ struct DirichletSpec {
   std::vector<PetscReal> values; // imposed displacement, one per space component
   PointFn                fn    = nullptr; // C++ API: a function instead of constant values
   void                  *fnCtx = nullptr;
+  PetscInt               param = -1;  // -param_bc_<label> NAME: values scale by mu_NAME / default
+  PetscReal              scale = 1.0; // current scale (set by Elasticity::SetMu)
 };
 
 struct TractionSpec {
   std::string            label;
   std::vector<PetscReal> traction; // one per space component
+  PetscInt               param = -1; // -param_t_<label> NAME: traction scales by mu_NAME / default
 };
 
 struct MeshSpec {
@@ -41,7 +45,7 @@ struct MeshSpec {
 // generated at that value; the reference-configuration map of the next stage replaces this).
 struct ParamSpec {
   std::string name;
-  PetscReal   min = 0, max = 0, value = 0;
+  PetscReal   min = 0, max = 0, value = 0, def = 0; // box, current value, default (reference)
   std::string geoName; // gmsh constant (-mu_geo_set), empty if not a geometry parameter
 };
 

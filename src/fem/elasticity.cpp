@@ -1,5 +1,6 @@
-// src/fem/elasticity.cpp: PetscFE elasticity with per-cell Lamé coefficients (auxiliary P0 field),
-// constant body force / tractions from the scene, essential boundary values by lifting.
+// src/fem/elasticity.cpp: PetscFE elasticity on a mapped reference mesh: the per-cell auxiliary P0
+// field carries the effective tensor, the Lamé coefficients, G^-1 and the body-force scale; constant
+// body force / tractions from the scene (scaled through the constants); essential values by lifting.
 #include "rbcontact/elasticity.hpp"
 #include "rbcontact/mesh.hpp"
 #include <cmath>
@@ -12,57 +13,69 @@ namespace rbc {
 // Constants layout: [0, 3) body force; [3 + 3k, 6 + 3k) traction of natural boundary k.
 static const PetscInt kMaxTractions = 8;
 
+// Aux layout (see Elasticity::AuxSize): L, G, G^-1 (dim x dim), body-force scale, then the tensor T.
+#define RBC_D4 (dim * dim * dim * dim)
+#define RBC_AUX_L 0
+#define RBC_AUX_G 1
+#define RBC_AUX_GINV 2
+#define RBC_AUX_BF (2 + dim * dim)
+#define RBC_AUX_T (3 + dim * dim)
+
 static void f0_body_force(RBC_POINTWISE_ARGS, PetscScalar f0[])
 {
-  for (PetscInt d = 0; d < dim; ++d) f0[d] = -constants[d];
+  const PetscScalar scale = a[RBC_AUX_BF];
+  for (PetscInt d = 0; d < dim; ++d) f0[d] = -constants[d] * scale;
 }
 
-// sigma(u) = L tr(eps) I + 2 G eps, aux a = (L, G)
+// Reference-configuration stress: f1[c][a] = sum_{e,b} T[c][a][e][b] du_e/dxr_b
 static void f1_stress(RBC_POINTWISE_ARGS, PetscScalar f1[])
 {
-  const PetscScalar L = a[0], G = a[1];
-  PetscScalar       tr = 0;
-  for (PetscInt d = 0; d < dim; ++d) tr += u_x[d * dim + d];
-  for (PetscInt c = 0; c < dim; ++c) {
-    for (PetscInt d = 0; d < dim; ++d) f1[c * dim + d] = G * (u_x[c * dim + d] + u_x[d * dim + c]);
-    f1[c * dim + c] += L * tr;
+  for (PetscInt ca = 0; ca < dim * dim; ++ca) {
+    PetscScalar s = 0;
+    for (PetscInt eb = 0; eb < dim * dim; ++eb) s += a[RBC_AUX_T + ca * dim * dim + eb] * u_x[eb];
+    f1[ca] = s;
   }
 }
 
 static void g3_stiffness(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g3[])
 {
-  const PetscScalar L = a[0], G = a[1];
-  for (PetscInt c = 0; c < dim; ++c) {
-    for (PetscInt d = 0; d < dim; ++d) {
-      g3[((c * dim + c) * dim + d) * dim + d] += G;
-      g3[((c * dim + d) * dim + d) * dim + c] += G;
-      g3[((c * dim + d) * dim + c) * dim + d] += L;
-    }
-  }
+  // PetscDS layout g3[test comp c][trial comp e][test deriv a][trial deriv b]; T is [c][a][e][b]
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt aa = 0; aa < dim; ++aa)
+      for (PetscInt e = 0; e < dim; ++e)
+        for (PetscInt b = 0; b < dim; ++b) g3[((c * dim + e) * dim + aa) * dim + b] += a[RBC_AUX_T + ((c * dim + aa) * dim + e) * dim + b];
 }
 
-static void EnergyDensity(PetscInt dim, const PetscScalar u_x[], const PetscScalar a[], PetscScalar *w)
+// Physical displacement gradient: du_c/dx_d = sum_a du_c/dxr_a (G^-1)_{a d}
+static void PhysicalGradient(PetscInt dim, const PetscScalar u_x[], const PetscScalar a[], PetscScalar gx[])
 {
-  const PetscScalar L = a[0], G = a[1];
-  PetscScalar       tr = 0, ee = 0;
-  for (PetscInt d = 0; d < dim; ++d) tr += u_x[d * dim + d];
+  const PetscScalar *Ginv = a + RBC_AUX_GINV;
   for (PetscInt c = 0; c < dim; ++c)
     for (PetscInt d = 0; d < dim; ++d) {
-      const PetscScalar e = 0.5 * (u_x[c * dim + d] + u_x[d * dim + c]);
-      ee += e * e;
+      gx[c * dim + d] = 0;
+      for (PetscInt k = 0; k < dim; ++k) gx[c * dim + d] += u_x[c * dim + k] * Ginv[k * dim + d];
     }
-  *w = 0.5 * L * tr * tr + G * ee;
+}
+
+// Energy density in the reference configuration: 1/2 grad u : T : grad u (includes |det G|).
+static void EnergyDensity(PetscInt dim, const PetscScalar u_x[], const PetscScalar a[], PetscScalar *w)
+{
+  PetscScalar e = 0;
+  for (PetscInt ca = 0; ca < dim * dim; ++ca)
+    for (PetscInt eb = 0; eb < dim * dim; ++eb) e += u_x[ca] * a[RBC_AUX_T + ca * dim * dim + eb] * u_x[eb];
+  *w = 0.5 * e;
 }
 
 static void obj_energy(RBC_POINTWISE_ARGS, PetscScalar obj[]) { EnergyDensity(dim, u_x, a, &obj[0]); }
 
 static void obj_von_mises(RBC_POINTWISE_ARGS, PetscScalar obj[])
 {
-  const PetscScalar L = a[0], G = a[1];
-  PetscScalar       s[3][3] = {{0}}, tr = 0;
-  for (PetscInt d = 0; d < dim; ++d) tr += u_x[d * dim + d];
+  const PetscScalar L = a[RBC_AUX_L], G = a[RBC_AUX_G];
+  PetscScalar       s[3][3] = {{0}}, tr = 0, gx[9];
+  PhysicalGradient(dim, u_x, a, gx);
+  for (PetscInt d = 0; d < dim; ++d) tr += gx[d * dim + d];
   for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt d = 0; d < dim; ++d) s[c][d] = G * (u_x[c * dim + d] + u_x[d * dim + c]) + (c == d ? L * tr : 0);
+    for (PetscInt d = 0; d < dim; ++d) s[c][d] = G * (gx[c * dim + d] + gx[d * dim + c]) + (c == d ? L * tr : 0);
   if (dim == 2) s[2][2] = L * tr; // plane strain
   const PetscScalar j2 = 0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) + (s[1][1] - s[2][2]) * (s[1][1] - s[2][2]) + (s[2][2] - s[0][0]) * (s[2][2] - s[0][0])) + 3 * (s[0][1] * s[0][1] + s[1][2] * s[1][2] + s[0][2] * s[0][2]);
   obj[0] = PetscSqrtReal(PetscRealPart(j2));
@@ -71,7 +84,7 @@ static void obj_von_mises(RBC_POINTWISE_ARGS, PetscScalar obj[])
 template <int K>
 static void f0_traction(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
-  for (PetscInt d = 0; d < dim; ++d) f0[d] = -constants[3 + 3 * K + d];
+  for (PetscInt d = 0; d < dim; ++d) f0[d] = -constants[3 + 3 * K + d]; // scaled in ApplyConstants
 }
 
 using BdF = void (*)(PetscInt, PetscInt, PetscInt, const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], PetscReal, const PetscReal[], const PetscReal[], PetscInt, const PetscScalar[], PetscScalar[]);
@@ -80,7 +93,7 @@ static const BdF kTractionFns[kMaxTractions] = {f0_traction<0>, f0_traction<1>, 
 static PetscErrorCode ConstantBC(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar *u, void *ctx)
 {
   const DirichletSpec *bc = static_cast<const DirichletSpec *>(ctx);
-  for (PetscInt c = 0; c < Nc; ++c) u[c] = c < (PetscInt)bc->values.size() ? bc->values[c] : 0.0;
+  for (PetscInt c = 0; c < Nc; ++c) u[c] = c < (PetscInt)bc->values.size() ? bc->scale * bc->values[c] : 0.0;
   return 0;
 }
 
@@ -93,7 +106,7 @@ Elasticity::~Elasticity()
   (void)DMDestroy(&dm);
 }
 
-PetscErrorCode Elasticity::SetupMaterials(const SceneSpec &scene)
+PetscErrorCode Elasticity::SetupMaterials()
 {
   PetscInt cStart, cEnd;
   PetscFE  fe, feAux;
@@ -125,31 +138,134 @@ PetscErrorCode Elasticity::SetupMaterials(const SceneSpec &scene)
   PetscCall(DMClone(dm, &dmAux_));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetDiscretization(ds, 0, (PetscObject *)&fe));
-  PetscCall(PetscFECreateLagrange(PETSC_COMM_SELF, dim, 2, PETSC_TRUE, 0, PETSC_DETERMINE, &feAux));
+  PetscCall(PetscFECreateLagrange(PETSC_COMM_SELF, dim, AuxSize(), PETSC_TRUE, 0, PETSC_DETERMINE, &feAux));
   PetscCall(PetscFECopyQuadrature(fe, feAux));
   PetscCall(DMSetField(dmAux_, 0, NULL, (PetscObject)feAux));
   PetscCall(DMCreateDS(dmAux_));
   PetscCall(PetscFEDestroy(&feAux));
   PetscCall(DMCreateLocalVector(dmAux_, &aux_));
-  {
-    PetscScalar *arr;
-    PetscCall(VecGetArray(aux_, &arr));
-    for (PetscInt c = cStart; c < cEnd; ++c) {
-      PetscScalar   *p;
-      const BodySpec &body = scene.bodies[cellBody_[c - cStart]];
-      PetscReal      L, G;
-      LameFromYoung(body.E, body.nu, &L, &G);
-      PetscCall(DMPlexPointLocalRef(dmAux_, c, arr, &p));
-      p[0] = L;
-      p[1] = G;
-    }
-    PetscCall(VecRestoreArray(aux_, &arr));
-  }
   PetscCall(DMSetAuxiliaryVec(dm, NULL, 0, 0, aux_));
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &scene)
+void Elasticity::Material(PetscInt b, const std::vector<PetscReal> &mu, PetscReal *E, PetscReal *nu) const
+{
+  const BodySpec &body = scene.bodies[b];
+  *E                   = body.paramE >= 0 && body.paramE < (PetscInt)mu.size() ? mu[body.paramE] : body.E;
+  *nu                  = body.paramNu >= 0 && body.paramNu < (PetscInt)mu.size() ? mu[body.paramNu] : body.nu;
+}
+
+void Elasticity::PhysicalAux(PetscReal E, PetscReal nu, const Affine &a, std::vector<PetscReal> *aux) const
+{
+  PetscReal L, G;
+  LameFromYoung(E, nu, &L, &G);
+  aux->assign(AuxSize(), 0.0);
+  // G^-1 of the dim x dim block
+  PetscReal Gi[9] = {0};
+  const PetscReal det = a.Det(dim);
+  if (dim == 2) {
+    Gi[0] = a.G[4] / det; Gi[1] = -a.G[1] / det; Gi[2] = -a.G[3] / det; Gi[3] = a.G[0] / det;
+  } else {
+    const auto &m = a.G;
+    Gi[0] = (m[4] * m[8] - m[5] * m[7]) / det; Gi[1] = (m[2] * m[7] - m[1] * m[8]) / det; Gi[2] = (m[1] * m[5] - m[2] * m[4]) / det;
+    Gi[3] = (m[5] * m[6] - m[3] * m[8]) / det; Gi[4] = (m[0] * m[8] - m[2] * m[6]) / det; Gi[5] = (m[2] * m[3] - m[0] * m[5]) / det;
+    Gi[6] = (m[3] * m[7] - m[4] * m[6]) / det; Gi[7] = (m[1] * m[6] - m[0] * m[7]) / det; Gi[8] = (m[0] * m[4] - m[1] * m[3]) / det;
+  }
+  // T[c][a][e][b] = |det G| sum_{d,f} C[c][d][e][f] Gi[a][d] Gi[b][f], C = L d_cd d_ef + G (d_ce d_df + d_cf d_de)
+  const PetscReal J = std::abs(det);
+  auto C = [&](PetscInt c, PetscInt d, PetscInt e, PetscInt f) { return L * (c == d) * (e == f) + G * ((c == e) * (d == f) + (c == f) * (d == e)); };
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt aa = 0; aa < dim; ++aa)
+      for (PetscInt e = 0; e < dim; ++e)
+        for (PetscInt b = 0; b < dim; ++b) {
+          PetscReal v = 0;
+          for (PetscInt d = 0; d < dim; ++d)
+            for (PetscInt f = 0; f < dim; ++f) v += C(c, d, e, f) * Gi[aa * dim + d] * Gi[b * dim + f];
+          (*aux)[3 + dim * dim + ((c * dim + aa) * dim + e) * dim + b] = J * v;
+        }
+  (*aux)[0] = L;
+  (*aux)[1] = G;
+  for (PetscInt k = 0; k < dim * dim; ++k) (*aux)[2 + k] = Gi[k];
+  (*aux)[2 + dim * dim] = J; // body force scale
+}
+
+PetscErrorCode Elasticity::SetBodyAux(const std::vector<std::vector<PetscReal>> &perBody)
+{
+  PetscInt     cStart, cEnd;
+  PetscScalar *arr;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(VecGetArray(aux_, &arr));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscScalar *p;
+    PetscCall(DMPlexPointLocalRef(dmAux_, c, arr, &p));
+    const auto &v = perBody[cellBody_[c - cStart]];
+    for (PetscInt k = 0; k < AuxSize(); ++k) p[k] = v[k];
+  }
+  PetscCall(VecRestoreArray(aux_, &arr));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::ApplyConstants(PetscReal bodyForceScale, const std::vector<PetscReal> &tractionScale)
+{
+  PetscDS ds;
+
+  PetscFunctionBeginUser;
+  std::vector<PetscScalar> constants(3 + 3 * kMaxTractions, 0.0);
+  for (size_t d = 0; d < scene.bodyForce.size(); ++d) constants[d] = scene.bodyForce[d] * (bodyForceScale != 0 ? 1.0 : 0.0);
+  for (size_t k = 0; k < scene.tractions.size(); ++k)
+    for (PetscInt d = 0; d < dim; ++d) constants[3 + 3 * k + d] = scene.tractions[k].traction[d] * tractionScale[k];
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetConstants(ds, (PetscInt)constants.size(), constants.data()));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::SetLoadScales(const std::vector<PetscReal> &dirichlet, PetscReal bodyForce, const std::vector<PetscReal> &traction)
+{
+  PetscFunctionBeginUser;
+  size_t k = 0;
+  for (auto &bc : bcs_) bc.scale = dirichlet[k++];
+  PetscCall(ApplyConstants(bodyForce, traction));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::SetMu(const std::vector<PetscReal> &mu)
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+
+  PetscFunctionBeginUser;
+  std::vector<std::vector<PetscReal>> perBody(scene.bodies.size());
+  std::vector<Affine>                 maps(scene.bodies.size());
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    PetscReal E, nu;
+    Material((PetscInt)b, mu, &E, &nu);
+    PetscCheck(E > 0 && nu > -1 && nu < 0.5, comm, PETSC_ERR_ARG_OUTOFRANGE, "Body '%s' at this parameter: E = %g, nu = %g out of range", scene.bodies[b].name.c_str(), (double)E, (double)nu);
+    maps[b] = map_ ? map_->Evaluate((PetscInt)b, mu) : Affine();
+    PetscCheck(maps[b].Det(dim) > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "The geometric map of body '%s' is not orientation preserving at this parameter (det %g)", scene.bodies[b].name.c_str(), (double)maps[b].Det(dim));
+    PhysicalAux(E, nu, maps[b], &perBody[b]);
+  }
+  PetscCall(SetBodyAux(perBody));
+  std::vector<PetscReal> dsc, tsc;
+  for (const auto &bc : scene.dirichlet) dsc.push_back(bc.param >= 0 ? mu[bc.param] / scene.params[bc.param].def : 1.0);
+  for (size_t k = 0; k < scene.tractions.size(); ++k) {
+    const TractionSpec &t = scene.tractions[k];
+    // the surface measure of a mapped boundary: s^(dim-1) under G = s I (conformal maps only)
+    PetscReal      s = 1.0;
+    const PetscInt b = tractionBody_[k];
+    if (b >= 0 && !(map_ ? map_->bodies[b].blocks.empty() : true)) {
+      const Affine &a   = maps[b];
+      const bool    conf = std::abs(a.G[1]) + std::abs(a.G[3]) + std::abs(a.G[2]) + std::abs(a.G[5]) + std::abs(a.G[6]) + std::abs(a.G[7]) < 1e-14 && std::abs(a.G[0] - a.G[4]) <= 1e-14 * std::abs(a.G[0]) && (dim == 2 || std::abs(a.G[0] - a.G[8]) <= 1e-14 * std::abs(a.G[0]));
+      PetscCheck(conf, comm, PETSC_ERR_SUP, "-bc_traction %s: tractions on a body with a non-conformal map (stretch) are not supported", t.label.c_str());
+      s = std::pow(a.G[0], (PetscReal)(dim - 1));
+    }
+    tsc.push_back(s * (t.param >= 0 ? mu[t.param] / scene.params[t.param].def : 1.0));
+  }
+  PetscCall(SetLoadScales(dsc, 1.0, tsc));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
 {
   PetscFE  fe;
   PetscDS  ds;
@@ -158,6 +274,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &scene)
 
   PetscFunctionBeginUser;
   dm = dmIn;
+  scene = sceneIn;
   PetscCall(PetscObjectReference((PetscObject)dm));
   PetscCall(DMGetDimension(dm, &dim));
   degree = scene.degree;
@@ -231,7 +348,27 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &scene)
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_INT, MPI_MAX, comm));
     PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, bc.label.c_str(), label, 1, &v, 0, (PetscInt)bc.comps.size(), bc.comps.empty() ? NULL : bc.comps.data(), (void (*)(void))(bc.fn ? bc.fn : ConstantBC), NULL, bc.fn ? bc.fnCtx : (void *)&bc, NULL));
   }
-  PetscCall(SetupMaterials(scene));
+  PetscCall(SetupMaterials());
+  // The body owning each traction boundary (the cell next to its facets)
+  tractionBody_.assign(scene.tractions.size(), -1);
+  for (size_t k = 0; k < scene.tractions.size(); ++k) {
+    DMLabel  label;
+    PetscInt fStart, fEnd, cStart, owner = -1;
+    PetscCall(DMGetLabel(dm, scene.tractions[k].label.c_str(), &label));
+    PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
+    for (PetscInt f = fStart; f < fEnd && owner < 0; ++f) {
+      PetscInt v, ns;
+      const PetscInt *supp;
+      PetscCall(DMLabelGetValue(label, f, &v));
+      if (v < 0) continue;
+      PetscCall(DMPlexGetSupportSize(dm, f, &ns));
+      PetscCall(DMPlexGetSupport(dm, f, &supp));
+      if (ns > 0) owner = cellBody_[supp[0] - cStart];
+    }
+    PetscCallMPI(MPI_Allreduce(&owner, &tractionBody_[k], 1, MPIU_INT, MPI_MAX, comm));
+  }
+  PetscCall(SetMu(ParamValues(scene)));
 
   // P0 scalar DM for cell fields
   {
@@ -250,7 +387,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &scene)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode Elasticity::Assemble(Mat *A, Vec *f)
+PetscErrorCode Elasticity::AssembleMatrix(Mat *A)
 {
   Vec zero;
 
@@ -260,13 +397,32 @@ PetscErrorCode Elasticity::Assemble(Mat *A, Vec *f)
     PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
     PetscCall(MatSetOption(*A, MAT_SPD, PETSC_TRUE));
   }
-  if (!*f) PetscCall(DMCreateGlobalVector(dm, f));
   PetscCall(DMGetGlobalVector(dm, &zero));
   PetscCall(VecSet(zero, 0.0));
   PetscCall(SNESComputeJacobian(snes_, zero, *A, *A));
+  PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::AssembleRhs(Vec *f)
+{
+  Vec zero;
+
+  PetscFunctionBeginUser;
+  if (!*f) PetscCall(DMCreateGlobalVector(dm, f));
+  PetscCall(DMGetGlobalVector(dm, &zero));
+  PetscCall(VecSet(zero, 0.0));
   PetscCall(SNESComputeFunction(snes_, zero, *f)); // F(0) = -(loads) + A_{fc} u_D
   PetscCall(VecScale(*f, -1.0));
   PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::Assemble(Mat *A, Vec *f)
+{
+  PetscFunctionBeginUser;
+  PetscCall(AssembleMatrix(A));
+  PetscCall(AssembleRhs(f));
   PetscFunctionReturn(0);
 }
 

@@ -65,6 +65,49 @@ PetscInt ElasticFOM::GlobalSize() const
   return n;
 }
 
+// MUMPS on several ranks schedules the factorization dynamically, so its workspace can exceed the
+// analysis estimate (+ICNTL(14) percent) and the numeric phase fail with INFOG(1) = -9 -- at
+// random, more often on a loaded machine (seen on 2 ranks, 3D P2). The PC then silently fails and
+// the solve reports DIVERGED_PC_FAILED. Redo the factorization with a doubled ICNTL(14) (up to 4
+// times; a -fom_mat_mumps_icntl_14 option overrides it and ends the retries). INFOG is global, so
+// every rank sees the same factor error and takes the same branch.
+static PetscErrorCode RefactorIfMumpsOutOfMemory(KSP ksp, Mat A)
+{
+  PC            pc;
+  PetscBool     isfactor, ismumps = PETSC_FALSE;
+  MatSolverType st = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &isfactor, PCCHOLESKY, PCLU, ""));
+  if (!isfactor) PetscFunctionReturn(0);
+  PetscCall(PCFactorGetMatSolverType(pc, &st));
+  if (st) PetscCall(PetscStrcmp(st, MATSOLVERMUMPS, &ismumps));
+  if (!ismumps) PetscFunctionReturn(0);
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    Mat            F;
+    MatFactorError err;
+    PetscInt       icntl14;
+    PetscCall(PCFactorGetMatrix(pc, &F));
+    PetscCall(MatFactorGetError(F, &err));
+    if (err != MAT_FACTOR_OUTMEMORY) break;
+    PetscCall(MatMumpsGetIcntl(F, 14, &icntl14));
+    icntl14 = PetscMax(2 * icntl14, 50);
+    PetscCall(PetscInfo(ksp, "MUMPS workspace too small (INFOG(1) = -9): refactoring with ICNTL(14) = %" PetscInt_FMT "\n", icntl14));
+    PetscCall(KSPReset(ksp));
+    PetscCall(KSPSetOperators(ksp, A, A));
+    PetscCall(PCFactorSetUpMatSolverType(pc));
+    PetscCall(PCFactorGetMatrix(pc, &F));
+    PetscCall(MatMumpsSetIcntl(F, 14, icntl14));
+    PetscCall(KSPSetUp(ksp));
+    PetscInt used;
+    PetscCall(PCFactorGetMatrix(pc, &F));
+    PetscCall(MatMumpsGetIcntl(F, 14, &used));
+    if (used != icntl14) break; // -fom_mat_mumps_icntl_14 given: the user's value wins, stop
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ElasticFOM::AssembleAndFactor()
 {
   PetscLogDouble t0, t1;
@@ -89,6 +132,7 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   PetscCall(KSPSetOperators(ksp, A, A));
   PetscCall(PetscLogEventBegin(FOM_Factor, 0, 0, 0, 0));
   PetscCall(KSPSetUp(ksp));
+  PetscCall(RefactorIfMumpsOutOfMemory(ksp, A));
   PetscCall(PetscLogEventEnd(FOM_Factor, 0, 0, 0, 0));
   PetscCall(PetscTime(&t0));
   times.factorization += t0 - t1;
@@ -106,6 +150,16 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
   PetscCall(KSPSolve(ksp, rhs, x));
   PetscCall(PetscLogEventEnd(FOM_Solve, 0, 0, 0, 0));
   PetscCall(KSPGetConvergedReason(ksp, &reason));
+  if (reason == KSP_DIVERGED_PC_FAILED) {
+    // Say why the preconditioner / factorization failed (a zero pivot and an out-of-memory
+    // factorization call for different fixes).
+    PC              pc;
+    PCFailedReason  pcr;
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCGetFailedReasonRank(pc, &pcr));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &pcr, 1, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)ksp)));
+    SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-bc_dirichlet)", PCFailedReasons[pcr]);
+  }
   PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-bc_dirichlet)", KSPConvergedReasons[reason]);
   PetscFunctionReturn(0);
 }

@@ -114,7 +114,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
       p.name  = pnames[i];
       p.min   = lo[i];
       p.max   = hi[i];
-      p.value = flg ? val[i] : (def.empty() ? 0.5 * (lo[i] + hi[i]) : def[i]);
+      p.def   = def.empty() ? 0.5 * (lo[i] + hi[i]) : def[i];
+      p.value = flg ? val[i] : p.def;
       PetscCheck(lo[i] <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu_min %g > -mu_max %g for parameter '%s'", (double)lo[i], (double)hi[i], p.name.c_str());
       PetscCheck(p.value >= lo[i] && p.value <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' = %g is outside its box [%g, %g]", p.name.c_str(), (double)p.value, (double)lo[i], (double)hi[i]);
       if (i < geo.size() && geo[i] != "-") p.geoName = geo[i];
@@ -179,6 +180,34 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscCall(GetString("-contact_master", &scene->master, NULL));
   scene->contact = (!scene->slave.empty() || !scene->master.empty()) ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-contact", &scene->contact, NULL));
+
+  // Material and load parameters: -param_E_<body>, -param_nu_<body>, -param_bc_<label>, -param_t_<label>
+  auto paramIndex = [&](const std::string &opt, PetscInt *idx) -> PetscErrorCode {
+    char      nm[128];
+    PetscBool set;
+    PetscFunctionBeginUser;
+    *idx = -1;
+    PetscCall(PetscOptionsGetString(NULL, NULL, opt.c_str(), nm, sizeof nm, &set));
+    if (set) {
+      for (size_t i = 0; i < scene->params.size(); ++i) if (scene->params[i].name == nm) *idx = (PetscInt)i;
+      PetscCheck(*idx >= 0, comm, PETSC_ERR_USER_INPUT, "%s: unknown parameter '%s' (declared by -mu_names)", opt.c_str(), nm);
+    }
+    PetscFunctionReturn(0);
+  };
+  for (auto &b : scene->bodies) {
+    PetscCall(paramIndex("-param_E_" + b.name, &b.paramE));
+    PetscCall(paramIndex("-param_nu_" + b.name, &b.paramNu));
+    if (b.paramE >= 0) PetscCheck(scene->params[b.paramE].min > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-param_E_%s: the box of '%s' must be > 0", b.name.c_str(), scene->params[b.paramE].name.c_str());
+    if (b.paramNu >= 0) PetscCheck(scene->params[b.paramNu].min > -1 && scene->params[b.paramNu].max < 0.5, comm, PETSC_ERR_ARG_OUTOFRANGE, "-param_nu_%s: the box of '%s' must lie in (-1, 0.5)", b.name.c_str(), scene->params[b.paramNu].name.c_str());
+  }
+  for (auto &bc : scene->dirichlet) {
+    PetscCall(paramIndex("-param_bc_" + bc.label, &bc.param));
+    if (bc.param >= 0) PetscCheck(scene->params[bc.param].def != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-param_bc_%s: parameter '%s' needs a nonzero -mu_default (the scale is mu / default)", bc.label.c_str(), scene->params[bc.param].name.c_str());
+  }
+  for (auto &t : scene->tractions) {
+    PetscCall(paramIndex("-param_t_" + t.label, &t.param));
+    if (t.param >= 0) PetscCheck(scene->params[t.param].def != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-param_t_%s: parameter '%s' needs a nonzero -mu_default", t.label.c_str(), scene->params[t.param].name.c_str());
+  }
   if (scene->contact) PetscCheck(!scene->slave.empty() && !scene->master.empty(), comm, PETSC_ERR_USER_INPUT, "-contact 1 needs -contact_slave NAME and -contact_master NAME");
   PetscFunctionReturn(0);
 }

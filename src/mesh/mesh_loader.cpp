@@ -171,11 +171,29 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   PetscCall(PetscOptionsHasName(NULL, NULL, "-dm_plex_gmsh_use_regions", &set));
   if (!set) PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_gmsh_use_regions", "true"));
   {
-    PetscErrorCode ierr;
+    PetscErrorCode ierr = 0;
+    PetscMPIInt    size, rank;
+    PetscCallMPI(MPI_Comm_size(comm, &size));
+    PetscCallMPI(MPI_Comm_rank(comm, &rank));
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = DMPlexCreateFromFile(comm, msh.c_str(), "rbcontact", PETSC_TRUE, dm);
+    if (size > 1) {
+      // PETSc's gmsh reader parses the file on rank 0 while the other ranks wait in collectives:
+      // a malformed file made rank 0 return an error and the others hang. So on several ranks,
+      // rank 0 first parses it alone (PETSC_COMM_SELF) and every rank learns the outcome.
+      if (rank == 0) {
+        DM probe = NULL;
+        ierr     = DMPlexCreateFromFile(PETSC_COMM_SELF, msh.c_str(), "rbcontact", PETSC_TRUE, &probe);
+        if (!ierr) ierr = DMDestroy(&probe);
+      }
+      PetscCallMPI(MPI_Bcast(&ierr, 1, MPI_INT, 0, comm));
+    }
+    if (!ierr) ierr = DMPlexCreateFromFile(comm, msh.c_str(), "rbcontact", PETSC_TRUE, dm);
     PetscCall(PetscPopErrorHandler());
-    PetscCheck(!ierr, comm, PETSC_ERR_FILE_UNEXPECTED, "Cannot read mesh '%s' (from -mesh_file %s): not a valid gmsh file? (PETSc error %d)", msh.c_str(), scene.mesh.file.c_str(), (int)ierr);
+    if (ierr) {
+      const char *what = NULL;
+      PetscCall(PetscErrorMessage(ierr, &what, NULL));
+      SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "Cannot read mesh '%s' (from -mesh_file %s): not a valid gmsh file? (PETSc error %d: %s)", msh.c_str(), scene.mesh.file.c_str(), (int)ierr, what ? what : "?");
+    }
   }
   PetscCall(PetscObjectSetName((PetscObject)*dm, scene.name.c_str()));
   {

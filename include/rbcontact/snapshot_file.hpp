@@ -1,0 +1,92 @@
+// rbcontact/snapshot_file.hpp: the snapshot file of the offline stage (one HDF5 file): parameter
+// values, displacement u(mu) and multipliers lambda(mu) in a canonical (partition-independent)
+// ordering of the reference mesh, Kacanov iterations and KKT residuals per parameter, the contact
+// data the EIM will need, and provenance. Written by rank 0 of the communicator only (the HDF5 C
+// API, serial): every finished snapshot is written and flushed (H5Fflush) before the next starts,
+// and marked done last, so a killed job loses nothing but the snapshot in progress; a file being
+// created is written under a temporary name and renamed once its header is complete.
+// Also reads snapshot matrices produced by other codes (an HDF5 dataset, rows = dofs, columns =
+// snapshots, or a PETSc binary dense matrix).
+#pragma once
+#include <petscsys.h>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rbc {
+
+// What identifies the problem a snapshot file belongs to; a restart refuses a file whose header
+// differs (message names the file and the first field that differs).
+struct SnapshotHeader {
+  std::string                          scene;         // scene name
+  std::string                          optionsText;   // the scene's options (provenance, not compared)
+  unsigned long long                   sceneHash = 0; // hash of the options that define the problem
+  unsigned long long                   meshChecksum = 0;
+  std::string                          codeVersion;
+  std::vector<std::string>             paramNames;
+  std::vector<PetscReal>               paramMin, paramMax;
+  std::vector<std::vector<PetscReal>>  trainingPoints; // the full training set (ntrain x nparams)
+  PetscInt                             ndofs = 0;      // length of u
+  PetscInt                             nmult = 0;      // length of lambda (R)
+};
+
+// Per-snapshot data (all arrays in canonical ordering, identical on any rank count).
+struct Snapshot {
+  PetscInt                                 index = -1; // position in the training set
+  std::vector<PetscReal>                   mu;
+  std::vector<PetscReal>                   u;      // ndofs
+  std::vector<PetscReal>                   lambda; // nmult
+  PetscInt                                 kacanovIterations = 0;
+  std::vector<PetscReal>                   kkt;    // primal, dual, complementarity, stationarity
+  PetscReal                                seconds = 0;
+  // Named extra arrays (EIM data: contact map and gap at the converged state, ...), fixed length
+  // per name across snapshots (the first snapshot written fixes it).
+  std::map<std::string, std::vector<PetscReal>> extra;
+};
+
+class SnapshotFile {
+public:
+  SnapshotFile() = default;
+  SnapshotFile(const SnapshotFile &) = delete;
+  SnapshotFile &operator=(const SnapshotFile &) = delete;
+  ~SnapshotFile(); // closes the file (no error on destruction)
+
+  // Creates path (temp file + rename after the header) or, with restart = true and an existing file,
+  // opens it and checks that its header matches (sceneHash, meshChecksum, paramNames, boxes, the
+  // training points to 1e-14, ndofs, nmult). Collective on comm; only rank 0 touches the file.
+  PetscErrorCode Open(MPI_Comm comm, const std::string &path, const SnapshotHeader &header, bool restart);
+  // Indices of the training set already stored (done flags), on every rank.
+  PetscErrorCode DoneIndices(std::vector<PetscInt> *done) const;
+  // Rank 0 of comm writes s (others pass through): data, then H5Fflush, then the done flag, flush.
+  PetscErrorCode Write(const Snapshot &s);
+  PetscErrorCode Close();
+
+  // (Added) State of an open file: its path, the header it was opened with, whether it is open.
+  bool                  IsOpen() const { return open_; }
+  const std::string    &Path() const { return path_; }
+  const SnapshotHeader &Header() const { return header_; }
+
+  // Reading (any rank, independent; for the basis builders and the tests).
+  static PetscErrorCode ReadHeader(const std::string &path, SnapshotHeader *header);
+  // All done snapshots, ordered by training index.
+  static PetscErrorCode ReadAll(const std::string &path, std::vector<Snapshot> *snaps);
+
+private:
+  MPI_Comm    comm_ = MPI_COMM_NULL;
+  std::string path_;
+  long long   file_ = -1; // hid_t on rank 0
+  SnapshotHeader header_;
+  bool        open_ = false;         // on every rank of comm_ after a successful Open
+  std::vector<signed char> done_;    // done flags (ntrain), kept identical on every rank
+};
+
+// (Added) Compares the header of a file with the one of the current run: empty if they match, else
+// "<field> differs (file: a, now: b)" for the first field that differs (the fields Open checks).
+std::string SnapshotHeaderDiff(const SnapshotHeader &file, const SnapshotHeader &now);
+
+// Import a snapshot matrix from another code: "file.h5:/dataset" (HDF5, rows = dofs, columns =
+// snapshots; the reader also accepts the transposed layout with -import_transpose) or a PETSc binary
+// file holding a dense Mat ("file.bin"). Returns column-major data: cols[j] is snapshot j.
+PetscErrorCode ImportSnapshotMatrix(MPI_Comm comm, const std::string &spec, std::vector<std::vector<PetscReal>> *cols);
+
+} // namespace rbc

@@ -1,0 +1,173 @@
+// src/fem/geometry_map.cpp: affine building blocks of the reference-configuration map and their
+// setup from options.
+#include "rbcontact/geometry_map.hpp"
+#include <cmath>
+#include <sstream>
+
+namespace rbc {
+
+Affine Affine::Then(const Affine &n) const
+{
+  Affine r;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      r.G[3 * i + j] = 0;
+      for (int k = 0; k < 3; ++k) r.G[3 * i + j] += n.G[3 * i + k] * G[3 * k + j];
+    }
+    r.t[i] = n.t[i];
+    for (int k = 0; k < 3; ++k) r.t[i] += n.G[3 * i + k] * t[k];
+  }
+  return r;
+}
+
+void Affine::Apply(PetscInt dim, const PetscReal x[], PetscReal y[]) const
+{
+  for (PetscInt i = 0; i < dim; ++i) {
+    y[i] = t[i];
+    for (PetscInt k = 0; k < dim; ++k) y[i] += G[3 * i + k] * x[k];
+  }
+}
+
+PetscReal Affine::Det(PetscInt dim) const
+{
+  if (dim == 2) return G[0] * G[4] - G[1] * G[3];
+  return G[0] * (G[4] * G[8] - G[5] * G[7]) - G[1] * (G[3] * G[8] - G[5] * G[6]) + G[2] * (G[3] * G[7] - G[4] * G[6]);
+}
+
+bool Affine::IsIdentity() const
+{
+  const Affine id;
+  for (int i = 0; i < 9; ++i) if (G[i] != id.G[i]) return false;
+  for (int i = 0; i < 3; ++i) if (t[i] != 0) return false;
+  return true;
+}
+
+Affine Dilation::Evaluate(const std::vector<PetscReal> &mu) const
+{
+  const PetscReal s = mu[p_] / ref_;
+  Affine          a;
+  for (int i = 0; i < 3; ++i) {
+    a.G[4 * i] = s;
+    a.t[i]     = (1 - s) * c_[i];
+  }
+  return a;
+}
+std::string Dilation::Describe() const
+{
+  std::ostringstream o;
+  o << "dilation by mu[" << p_ << "]/" << ref_ << " about (" << c_[0] << ", " << c_[1] << ", " << c_[2] << ")";
+  return o.str();
+}
+
+Affine Stretch::Evaluate(const std::vector<PetscReal> &mu) const
+{
+  const PetscReal s = mu[p_] / ref_;
+  Affine          a;
+  a.G[4 * axis_] = s;
+  a.t[axis_]     = (1 - s) * c_;
+  return a;
+}
+std::string Stretch::Describe() const
+{
+  std::ostringstream o;
+  o << "stretch of axis " << axis_ << " by mu[" << p_ << "]/" << ref_ << " about " << c_;
+  return o.str();
+}
+
+Affine Translation::Evaluate(const std::vector<PetscReal> &mu) const
+{
+  Affine a;
+  for (int i = 0; i < 3; ++i) a.t[i] = (mu[p_] - ref_) * d_[i];
+  return a;
+}
+std::string Translation::Describe() const
+{
+  std::ostringstream o;
+  o << "translation by (mu[" << p_ << "] - " << ref_ << ") (" << d_[0] << ", " << d_[1] << ", " << d_[2] << ")";
+  return o.str();
+}
+
+Affine BodyMap::Evaluate(const std::vector<PetscReal> &mu) const
+{
+  Affine a;
+  for (const auto &b : blocks) a = a.Then(b->Evaluate(mu));
+  return a;
+}
+
+Affine GeometryMap::Evaluate(PetscInt body, const std::vector<PetscReal> &mu) const
+{
+  if (body < 0 || body >= (PetscInt)bodies.size()) return Affine();
+  return bodies[body].Evaluate(mu);
+}
+
+bool GeometryMap::IsIdentity() const
+{
+  for (const auto &b : bodies) if (!b.blocks.empty()) return false;
+  return true;
+}
+
+std::string GeometryMap::Describe(const SceneSpec &scene) const
+{
+  std::ostringstream o;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    o << scene.bodies[b].name << ": ";
+    if (bodies[b].blocks.empty()) o << "fixed";
+    for (size_t k = 0; k < bodies[b].blocks.size(); ++k) o << (k ? " then " : "") << bodies[b].blocks[k]->Describe();
+    o << (b + 1 < bodies.size() ? "; " : "");
+  }
+  return o.str();
+}
+
+std::vector<PetscReal> ParamValues(const SceneSpec &scene)
+{
+  std::vector<PetscReal> mu;
+  for (const auto &p : scene.params) mu.push_back(p.value);
+  return mu;
+}
+
+PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene)
+{
+  PetscFunctionBeginUser;
+  bodies.clear();
+  bodies.resize(scene.bodies.size());
+  for (size_t b = 0; b < scene.bodies.size(); ++b) {
+    const std::string pre = "-map_" + scene.bodies[b].name;
+    char              buf[256];
+    PetscBool         flg;
+    PetscCall(PetscOptionsGetString(NULL, NULL, pre.c_str(), buf, sizeof buf, &flg));
+    if (!flg) continue;
+    for (const auto &kind : SplitList(buf)) {
+      const std::string bp = pre + "_" + kind;
+      char              pname[128];
+      PetscCall(PetscOptionsGetString(NULL, NULL, (bp + "_param").c_str(), pname, sizeof pname, &flg));
+      PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s lists '%s' but %s_param (the driving parameter) is missing", pre.c_str(), kind.c_str(), bp.c_str());
+      PetscInt p = -1;
+      for (size_t i = 0; i < scene.params.size(); ++i) if (scene.params[i].name == pname) p = (PetscInt)i;
+      PetscCheck(p >= 0, comm, PETSC_ERR_USER_INPUT, "%s_param: unknown parameter '%s' (declared by -mu_names)", bp.c_str(), pname);
+      PetscCheck(scene.params[p].geoName.empty(), comm, PETSC_ERR_USER_INPUT, "Parameter '%s' both remeshes (-mu_geo_set) and drives %s: choose one", pname, pre.c_str());
+      PetscReal ref = scene.params[p].def;
+      PetscCall(PetscOptionsGetReal(NULL, NULL, (bp + "_ref").c_str(), &ref, NULL));
+      PetscCheck(ref != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_ref must be nonzero", bp.c_str());
+      if (kind == "dilation" || kind == "translation") {
+        PetscReal v[3] = {0, 0, 0};
+        PetscInt  n    = 3;
+        const std::string opt = bp + (kind == "dilation" ? "_center" : "_dir");
+        PetscCall(PetscOptionsGetRealArray(NULL, NULL, opt.c_str(), v, &n, &flg));
+        PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s is required", opt.c_str());
+        const std::array<PetscReal, 3> a = {v[0], v[1], v[2]};
+        if (kind == "dilation") bodies[b].blocks.push_back(std::make_unique<Dilation>(p, ref, a));
+        else bodies[b].blocks.push_back(std::make_unique<Translation>(p, ref, a));
+      } else if (kind == "stretch") {
+        PetscInt  axis = -1;
+        PetscReal c    = 0;
+        PetscCall(PetscOptionsGetInt(NULL, NULL, (bp + "_axis").c_str(), &axis, NULL));
+        PetscCall(PetscOptionsGetReal(NULL, NULL, (bp + "_center").c_str(), &c, NULL));
+        PetscCheck(axis >= 0 && axis < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_axis %" PetscInt_FMT " must be 0, 1 or 2", bp.c_str(), axis);
+        bodies[b].blocks.push_back(std::make_unique<Stretch>(p, ref, axis, c));
+      } else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "%s: unknown map block '%s' (dilation, stretch, translation)", pre.c_str(), kind.c_str());
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,1004 @@
+// src/io/snapshot_file.cpp: the HDF5 snapshot file of the offline stage (creation under a temporary
+// name, restart checks, crash-safe per-snapshot writes, reading) and the import of snapshot
+// matrices from other codes (HDF5 dataset or PETSc binary Mat). Only rank 0 touches files in the
+// collective calls; it broadcasts the status so that every rank fails together, never hangs.
+//
+// File layout (format_version 1; also in docs/snapshot_file.md). ntrain = training points,
+// nparams = parameters, ndofs = length of u, nmult = length of lambda. All reals IEEE float64 LE.
+//   / attributes      format = "rbcontact-snapshots" (string), format_version = 1 (int32),
+//                     scene, code_version, options (strings), scene_hash, mesh_checksum (uint64),
+//                     ntrain, nparams, ndofs, nmult (int64). options longer than 32 KiB: the
+//                     attribute says "@/options" and the text is the scalar string dataset /options.
+//   /params/names     nparams fixed-length strings (null-terminated)
+//   /params/min, /params/max           nparams
+//   /train/points                      ntrain x nparams
+//   /snapshots/u                       ntrain x ndofs    (row i = snapshot of training point i)
+//   /snapshots/lambda                  ntrain x nmult
+//   /snapshots/mu                      ntrain x nparams  (NaN until written)
+//   /snapshots/kacanov_iterations      ntrain, int64     (-1 until written)
+//   /snapshots/kkt                     ntrain x 4        (primal, dual, complementarity,
+//                                                         stationarity; NaN until written)
+//   /snapshots/seconds                 ntrain            (NaN until written)
+//   /snapshots/done                    ntrain, int8      (0/1; 1 = row i of every dataset valid)
+//   /snapshots/extra/<name>            ntrain x len      (created by the first Write carrying it)
+// Every dataset has its final shape at creation, contiguous layout, space allocated at creation
+// (u, lambda and the extras without writing fill values: the file stays sparse). A Write therefore
+// changes raw data only, never HDF5 metadata (except the first Write of a new extra, which creates
+// its dataset and flushes before writing data): rows of u, lambda, mu, ..., then H5Fflush + fsync,
+// then done[i] = 1, H5Fflush + fsync. A killed job loses only the snapshot in progress. The file
+// uses the default (oldest) HDF5 file format, which has no "file open for writing" flag, so a file
+// left by a killed job opens normally.
+#include "rbcontact/snapshot_file.hpp"
+#include <hdf5.h>
+#include <petscmat.h>
+#include <petscviewer.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <type_traits>
+
+namespace rbc {
+
+static_assert(std::is_same<PetscReal, double>::value, "the snapshot file stores PetscReal as float64");
+
+namespace {
+
+constexpr const char *kFormat        = "rbcontact-snapshots";
+constexpr int         kFormatVersion = 1;
+constexpr size_t      kMaxAttrString = 32768;
+const double          kNaN           = std::numeric_limits<double>::quiet_NaN();
+
+// Silences HDF5's automatic error-stack printing while alive (we report errors ourselves), then
+// restores the previous handler.
+class H5Quiet {
+public:
+  H5Quiet()
+  {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  H5Quiet(const H5Quiet &)            = delete;
+  H5Quiet &operator=(const H5Quiet &) = delete;
+
+private:
+  H5E_auto2_t func_ = nullptr;
+  void       *data_ = nullptr;
+};
+
+// Owns an HDF5 identifier (closed on destruction; files are closed explicitly where it matters).
+class H5Id {
+public:
+  H5Id() = default;
+  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5Id(const H5Id &)            = delete;
+  H5Id &operator=(const H5Id &) = delete;
+  H5Id(H5Id &&o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+  H5Id &operator=(H5Id &&o) noexcept
+  {
+    if (this != &o) {
+      Reset();
+      id_   = o.id_;
+      close_ = o.close_;
+      o.id_ = -1;
+    }
+    return *this;
+  }
+  ~H5Id() { Reset(); }
+  void Reset()
+  {
+    if (id_ >= 0 && close_) close_(id_);
+    id_ = -1;
+  }
+  hid_t Release()
+  {
+    hid_t id = id_;
+    id_      = -1;
+    return id;
+  }
+  bool  ok() const { return id_ >= 0; }
+  hid_t get() const { return id_; }
+
+private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+herr_t WalkErrors(unsigned n, const H5E_error2_t *e, void *ctx)
+{
+  auto *v = static_cast<std::vector<std::string> *>(ctx);
+  if (e && e->desc && *e->desc) v->push_back(e->desc);
+  return 0;
+}
+
+// The outermost and innermost descriptions of HDF5's error stack (then clears it).
+std::string H5Detail()
+{
+  std::vector<std::string> d;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, WalkErrors, &d);
+  H5Eclear2(H5E_DEFAULT);
+  if (d.empty()) return std::string();
+  return d.size() == 1 || d.front() == d.back() ? d.front() : d.front() + ": " + d.back();
+}
+
+// Error context: the first failure is kept as a message naming the file (and the dataset).
+struct Ctx {
+  std::string what; // "Snapshot file 'x.h5'"
+  std::string err;
+  bool Fail(const std::string &msg, bool hdf5 = true)
+  {
+    if (err.empty()) {
+      err = what + ": " + msg;
+      if (hdf5) {
+        const std::string d = H5Detail();
+        if (!d.empty()) err += " (HDF5: " + d + ")";
+      }
+    }
+    return false;
+  }
+};
+
+Ctx FileCtx(const std::string &path) { return Ctx{"Snapshot file '" + path + "'", std::string()}; }
+
+bool FileExists(const std::string &path)
+{
+  struct stat st;
+  return stat(path.c_str(), &st) == 0;
+}
+
+bool MakeStringType(Ctx &c, size_t len, H5Id *t)
+{
+  *t = H5Id(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!t->ok() || H5Tset_size(t->get(), len + 1) < 0 || H5Tset_strpad(t->get(), H5T_STR_NULLTERM) < 0) return c.Fail("cannot create a string type");
+  return true;
+}
+
+bool WriteAttr(Ctx &c, hid_t obj, const char *name, hid_t ftype, hid_t mtype, const void *buf)
+{
+  H5Id sp(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!sp.ok()) return c.Fail(std::string("cannot create the dataspace of attribute '") + name + "'");
+  H5Id a(H5Acreate2(obj, name, ftype, sp.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("cannot create attribute '") + name + "'");
+  if (H5Awrite(a.get(), mtype, buf) < 0) return c.Fail(std::string("cannot write attribute '") + name + "'");
+  return true;
+}
+
+bool WriteStringAttr(Ctx &c, hid_t obj, const char *name, const std::string &v)
+{
+  H5Id t;
+  if (!MakeStringType(c, v.size(), &t)) return false;
+  return WriteAttr(c, obj, name, t.get(), t.get(), v.c_str());
+}
+
+bool AttrExists(Ctx &c, hid_t obj, const char *name, bool *exists)
+{
+  const htri_t e = H5Aexists(obj, name);
+  if (e < 0) return c.Fail(std::string("cannot query attribute '") + name + "'");
+  *exists = e > 0;
+  return true;
+}
+
+bool ReadAttr(Ctx &c, hid_t obj, const char *name, hid_t mtype, void *buf)
+{
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("missing attribute '") + name + "'");
+  if (H5Aread(a.get(), mtype, buf) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+  return true;
+}
+
+// Reads a string attribute (fixed-length or variable-length).
+bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
+{
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("missing attribute '") + name + "'");
+  H5Id t(H5Aget_type(a.get()), H5Tclose);
+  if (!t.ok()) return c.Fail(std::string("cannot get the type of attribute '") + name + "'");
+  if (H5Tget_class(t.get()) != H5T_STRING) return c.Fail(std::string("attribute '") + name + "' is not a string", false);
+  const htri_t vlen = H5Tis_variable_str(t.get());
+  if (vlen < 0) return c.Fail(std::string("cannot inspect attribute '") + name + "'");
+  if (vlen) {
+    H5Id m(H5Tcopy(H5T_C_S1), H5Tclose);
+    if (!m.ok() || H5Tset_size(m.get(), H5T_VARIABLE) < 0) return c.Fail("cannot create a string type");
+    char *p = nullptr;
+    if (H5Aread(a.get(), m.get(), &p) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+    *v = p ? p : "";
+    H5free_memory(p);
+    return true;
+  }
+  const size_t size = H5Tget_size(t.get());
+  if (size == 0) return c.Fail(std::string("cannot get the size of attribute '") + name + "'");
+  std::vector<char> buf(size + 1, 0);
+  if (H5Aread(a.get(), t.get(), buf.data()) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+  *v = std::string(buf.data());
+  return true;
+}
+
+// Creates a dataset of its final shape, contiguous, allocated now; fill: the fill value (memory
+// type mtype), or nullptr for no fill (the space is allocated but never initialised: sparse).
+bool CreateDataset(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *fill, H5Id *out)
+{
+  H5Id sp(H5Screate_simple((int)dims.size(), dims.data(), nullptr), H5Sclose);
+  if (!sp.ok()) return c.Fail("cannot create the dataspace of dataset " + name);
+  H5Id dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  if (!dcpl.ok() || H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY) < 0) return c.Fail("cannot set the layout of dataset " + name);
+  if (fill) {
+    if (H5Pset_fill_value(dcpl.get(), mtype, fill) < 0 || H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_IFSET) < 0) return c.Fail("cannot set the fill value of dataset " + name);
+  } else if (H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) < 0) return c.Fail("cannot set the fill time of dataset " + name);
+  H5Id lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  if (!lcpl.ok() || H5Pset_create_intermediate_group(lcpl.get(), 1) < 0) return c.Fail("cannot create a link property list for " + name);
+  H5Id d(H5Dcreate2(file, name.c_str(), ftype, sp.get(), lcpl.get(), dcpl.get(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("cannot create dataset " + name);
+  if (out) *out = std::move(d);
+  return true;
+}
+
+bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hsize_t> *dims)
+{
+  H5Id sp(H5Dget_space(d), H5Sclose);
+  if (!sp.ok()) return c.Fail("cannot get the dataspace of dataset " + name);
+  const int rank = H5Sget_simple_extent_ndims(sp.get());
+  if (rank < 0) return c.Fail("cannot get the rank of dataset " + name);
+  dims->assign((size_t)rank, 0);
+  if (rank > 0 && H5Sget_simple_extent_dims(sp.get(), dims->data(), nullptr) < 0) return c.Fail("cannot get the shape of dataset " + name);
+  return true;
+}
+
+std::string ShapeString(const std::vector<hsize_t> &dims)
+{
+  std::string s;
+  for (hsize_t d : dims) s += (s.empty() ? "" : " x ") + std::to_string((unsigned long long)d);
+  return s.empty() ? "scalar" : s;
+}
+
+// Whole-dataset write / read with a shape check.
+bool WriteWhole(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *buf)
+{
+  H5Id d;
+  if (!CreateDataset(c, file, name, ftype, dims, mtype, nullptr, &d)) return false;
+  hsize_t n = 1;
+  for (hsize_t x : dims) n *= x;
+  if (n > 0 && H5Dwrite(d.get(), mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) return c.Fail("cannot write dataset " + name);
+  return true;
+}
+
+bool ReadWhole(Ctx &c, hid_t file, const std::string &name, const std::vector<hsize_t> &expect, std::vector<double> *v)
+{
+  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("missing dataset " + name);
+  std::vector<hsize_t> dims;
+  if (!DatasetDims(c, d.get(), name, &dims)) return false;
+  if (dims != expect) return c.Fail("dataset " + name + " has shape " + ShapeString(dims) + ", expected " + ShapeString(expect) + " (corrupt file?)", false);
+  hsize_t n = 1;
+  for (hsize_t x : dims) n *= x;
+  v->assign(n, 0.0);
+  if (n > 0 && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->data()) < 0) return c.Fail("cannot read dataset " + name);
+  return true;
+}
+
+// Reads or writes row `row` (ncols values) of a 1D (ncols = 1) or 2D dataset.
+bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsize_t row, hsize_t ncols, void *buf, bool write)
+{
+  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("missing dataset " + name);
+  H5Id fs(H5Dget_space(d.get()), H5Sclose);
+  if (!fs.ok()) return c.Fail("cannot get the dataspace of dataset " + name);
+  const int rank = H5Sget_simple_extent_ndims(fs.get());
+  hsize_t   dims[2] = {0, 0};
+  if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(fs.get(), dims, nullptr) < 0) return c.Fail("dataset " + name + " is not 1D or 2D");
+  const hsize_t cols = rank == 1 ? 1 : dims[1];
+  if (cols != ncols || row >= dims[0]) {
+    std::ostringstream m;
+    m << "dataset " << name << " has shape " << ShapeString(std::vector<hsize_t>(dims, dims + rank)) << "; cannot " << (write ? "write" : "read") << " row " << row << " of length " << ncols;
+    return c.Fail(m.str(), false);
+  }
+  if (ncols == 0) return true;
+  const hsize_t start[2] = {row, 0}, count[2] = {1, ncols};
+  if (H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) return c.Fail("cannot select row of dataset " + name);
+  H5Id ms(H5Screate_simple(1, &ncols, nullptr), H5Sclose);
+  if (!ms.ok()) return c.Fail("cannot create a memory dataspace for " + name);
+  const herr_t st = write ? H5Dwrite(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf) : H5Dread(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf);
+  if (st < 0) return c.Fail(std::string("cannot ") + (write ? "write" : "read") + " row " + std::to_string((unsigned long long)row) + " of dataset " + name);
+  return true;
+}
+
+// H5Fflush, then fsync of the file descriptor (data reaches the disk, not only the OS cache).
+bool FlushSync(Ctx &c, hid_t file)
+{
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) return c.Fail("H5Fflush failed");
+  void *handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) return c.Fail("cannot get the file descriptor");
+  if (fsync(*static_cast<int *>(handle)) != 0) return c.Fail(std::string("fsync failed: ") + std::strerror(errno), false);
+  return true;
+}
+
+bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
+{
+  const hsize_t            ntrain = h.trainingPoints.size(), np = h.paramNames.size();
+  const long long          i64[4] = {(long long)ntrain, (long long)np, (long long)h.ndofs, (long long)h.nmult};
+  const char              *i64names[4] = {"ntrain", "nparams", "ndofs", "nmult"};
+  const unsigned long long sh = h.sceneHash, mc = h.meshChecksum;
+  const int                version = kFormatVersion;
+
+  if (!WriteStringAttr(c, f, "format", kFormat)) return false;
+  if (!WriteAttr(c, f, "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &version)) return false;
+  if (!WriteStringAttr(c, f, "scene", h.scene)) return false;
+  if (!WriteAttr(c, f, "scene_hash", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &sh)) return false;
+  if (!WriteAttr(c, f, "mesh_checksum", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &mc)) return false;
+  if (!WriteStringAttr(c, f, "code_version", h.codeVersion)) return false;
+  if (h.optionsText.size() <= kMaxAttrString) {
+    if (!WriteStringAttr(c, f, "options", h.optionsText)) return false;
+  } else {
+    H5Id t, sp(H5Screate(H5S_SCALAR), H5Sclose), d;
+    if (!sp.ok()) return c.Fail("cannot create a scalar dataspace");
+    if (!MakeStringType(c, h.optionsText.size(), &t)) return false;
+    d = H5Id(H5Dcreate2(f, "/options", t.get(), sp.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose);
+    if (!d.ok() || H5Dwrite(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, h.optionsText.c_str()) < 0) return c.Fail("cannot write dataset /options");
+    if (!WriteStringAttr(c, f, "options", "@/options")) return false;
+  }
+  for (int k = 0; k < 4; ++k)
+    if (!WriteAttr(c, f, i64names[k], H5T_STD_I64LE, H5T_NATIVE_LLONG, &i64[k])) return false;
+
+  // /params/names: fixed-length strings.
+  size_t len = 0;
+  for (const auto &s : h.paramNames) len = std::max(len, s.size());
+  std::vector<char> names(np * (len + 1) + 1, 0);
+  for (size_t j = 0; j < np; ++j) std::memcpy(&names[j * (len + 1)], h.paramNames[j].c_str(), h.paramNames[j].size());
+  H5Id st;
+  if (!MakeStringType(c, len, &st)) return false;
+  if (!WriteWhole(c, f, "/params/names", st.get(), {np}, st.get(), names.data())) return false;
+  if (!WriteWhole(c, f, "/params/min", H5T_IEEE_F64LE, {np}, H5T_NATIVE_DOUBLE, h.paramMin.data())) return false;
+  if (!WriteWhole(c, f, "/params/max", H5T_IEEE_F64LE, {np}, H5T_NATIVE_DOUBLE, h.paramMax.data())) return false;
+  std::vector<double> pts;
+  for (const auto &x : h.trainingPoints) pts.insert(pts.end(), x.begin(), x.end());
+  if (!WriteWhole(c, f, "/train/points", H5T_IEEE_F64LE, {ntrain, np}, H5T_NATIVE_DOUBLE, pts.data())) return false;
+
+  // Per-snapshot datasets, final shape, allocated now.
+  const long long   minus1 = -1;
+  const signed char zero   = 0;
+  if (!CreateDataset(c, f, "/snapshots/u", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.ndofs}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/lambda", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.nmult}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/mu", H5T_IEEE_F64LE, {ntrain, np}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/kacanov_iterations", H5T_STD_I64LE, {ntrain}, H5T_NATIVE_LLONG, &minus1, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/kkt", H5T_IEEE_F64LE, {ntrain, 4}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/seconds", H5T_IEEE_F64LE, {ntrain}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
+  if (!CreateDataset(c, f, "/snapshots/done", H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr)) return false;
+  H5Id g(H5Gcreate2(f, "/snapshots/extra", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
+  if (!g.ok()) return c.Fail("cannot create group /snapshots/extra");
+  return true;
+}
+
+// Opens an existing file and checks that it is an rbcontact snapshot file.
+bool OpenExisting(Ctx &c, const std::string &path, bool rdwr, H5Id *file)
+{
+  if (!FileExists(path)) return c.Fail("does not exist", false);
+  const htri_t is = H5Fis_hdf5(path.c_str());
+  if (is < 0) return c.Fail("cannot be read");
+  if (is == 0) return c.Fail("is not an HDF5 file (not an rbcontact snapshot file)", false);
+  // Readers do not lock the file: a Write changes raw data and flags only, so reading the done
+  // snapshots of a file being written is safe, and a reader on another rank never makes the
+  // writer's open fail. The writer locks (HDF5's default), so two writers cannot share a file.
+  H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.ok() || (!rdwr && H5Pset_file_locking(fapl.get(), 0, 1) < 0)) return c.Fail("cannot create a file access property list");
+  *file = H5Id(H5Fopen(path.c_str(), rdwr ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl.get()), H5Fclose);
+  if (!file->ok()) return c.Fail(rdwr ? "cannot be opened for writing (is another job writing it?)" : "cannot be opened");
+  bool exists = false;
+  if (!AttrExists(c, file->get(), "format", &exists)) return false;
+  if (!exists) return c.Fail("is an HDF5 file but not an rbcontact snapshot file (no 'format' attribute)", false);
+  std::string fmt;
+  if (!ReadStringAttr(c, file->get(), "format", &fmt)) return false;
+  if (fmt != kFormat) return c.Fail("is not an rbcontact snapshot file (format '" + fmt + "', expected '" + kFormat + "')", false);
+  int version = 0;
+  if (!ReadAttr(c, file->get(), "format_version", H5T_NATIVE_INT, &version)) return false;
+  if (version != kFormatVersion) return c.Fail("has format_version " + std::to_string(version) + "; this build reads version " + std::to_string(kFormatVersion), false);
+  return true;
+}
+
+bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
+{
+  long long          i64[4];
+  const char        *i64names[4] = {"ntrain", "nparams", "ndofs", "nmult"};
+  unsigned long long sh = 0, mc = 0;
+
+  if (!ReadStringAttr(c, f, "scene", &h->scene)) return false;
+  if (!ReadAttr(c, f, "scene_hash", H5T_NATIVE_ULLONG, &sh) || !ReadAttr(c, f, "mesh_checksum", H5T_NATIVE_ULLONG, &mc)) return false;
+  h->sceneHash    = sh;
+  h->meshChecksum = mc;
+  if (!ReadStringAttr(c, f, "code_version", &h->codeVersion) || !ReadStringAttr(c, f, "options", &h->optionsText)) return false;
+  if (h->optionsText == "@/options") {
+    H5Id d(H5Dopen2(f, "/options", H5P_DEFAULT), H5Dclose);
+    if (!d.ok()) return c.Fail("missing dataset /options");
+    H5Id t(H5Dget_type(d.get()), H5Tclose);
+    if (!t.ok()) return c.Fail("cannot get the type of dataset /options");
+    std::vector<char> buf(H5Tget_size(t.get()) + 1, 0);
+    if (H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0) return c.Fail("cannot read dataset /options");
+    h->optionsText = buf.data();
+  }
+  for (int k = 0; k < 4; ++k) {
+    if (!ReadAttr(c, f, i64names[k], H5T_NATIVE_LLONG, &i64[k])) return false;
+    if (i64[k] < 0) return c.Fail(std::string("attribute '") + i64names[k] + "' is negative (corrupt file?)", false);
+  }
+  const hsize_t ntrain = (hsize_t)i64[0], np = (hsize_t)i64[1];
+  h->ndofs = (PetscInt)i64[2];
+  h->nmult = (PetscInt)i64[3];
+
+  // /params/names
+  {
+    H5Id d(H5Dopen2(f, "/params/names", H5P_DEFAULT), H5Dclose);
+    if (!d.ok()) return c.Fail("missing dataset /params/names");
+    std::vector<hsize_t> dims;
+    if (!DatasetDims(c, d.get(), "/params/names", &dims)) return false;
+    if (dims != std::vector<hsize_t>{np}) return c.Fail("dataset /params/names has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)np), false);
+    H5Id t(H5Dget_type(d.get()), H5Tclose);
+    if (!t.ok() || H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) != 0) return c.Fail("dataset /params/names is not a fixed-length string array");
+    const size_t      sz = H5Tget_size(t.get());
+    std::vector<char> buf(np * sz + 1, 0);
+    if (np > 0 && H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0) return c.Fail("cannot read dataset /params/names");
+    h->paramNames.clear();
+    for (hsize_t j = 0; j < np; ++j) h->paramNames.push_back(std::string(&buf[j * sz], strnlen(&buf[j * sz], sz)));
+  }
+  std::vector<double> v;
+  if (!ReadWhole(c, f, "/params/min", {np}, &h->paramMin) || !ReadWhole(c, f, "/params/max", {np}, &h->paramMax)) return false;
+  if (!ReadWhole(c, f, "/train/points", {ntrain, np}, &v)) return false;
+  h->trainingPoints.assign(ntrain, std::vector<PetscReal>(np));
+  for (hsize_t i = 0; i < ntrain; ++i)
+    for (hsize_t j = 0; j < np; ++j) h->trainingPoints[i][j] = v[i * np + j];
+  return true;
+}
+
+bool ReadDone(Ctx &c, hid_t f, hsize_t ntrain, std::vector<signed char> *done)
+{
+  H5Id d(H5Dopen2(f, "/snapshots/done", H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("missing dataset /snapshots/done");
+  std::vector<hsize_t> dims;
+  if (!DatasetDims(c, d.get(), "/snapshots/done", &dims)) return false;
+  if (dims != std::vector<hsize_t>{ntrain}) return c.Fail("dataset /snapshots/done has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)ntrain), false);
+  done->assign(ntrain, 0);
+  if (ntrain > 0 && H5Dread(d.get(), H5T_NATIVE_SCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, done->data()) < 0) return c.Fail("cannot read dataset /snapshots/done");
+  return true;
+}
+
+bool CloseFile(Ctx &c, H5Id *file)
+{
+  const hid_t id = file->Release();
+  if (id >= 0 && H5Fclose(id) < 0) return c.Fail("cannot close the file");
+  return true;
+}
+
+std::string Hex(unsigned long long v)
+{
+  char b[32];
+  std::snprintf(b, sizeof b, "0x%016llx", v);
+  return b;
+}
+
+// Shortest of %.15g, %.16g, %.17g that reads back as v.
+std::string Num(double v)
+{
+  char b[40];
+  for (int p = 15; p <= 17; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) break;
+  }
+  return b;
+}
+
+std::string Join(const std::vector<std::string> &v)
+{
+  std::string s;
+  for (const auto &x : v) s += (s.empty() ? "" : ",") + x;
+  return s.empty() ? "(none)" : s;
+}
+
+bool Close14(double a, double b) { return std::fabs(a - b) <= 1e-14 * std::max(1.0, std::max(std::fabs(a), std::fabs(b))); }
+
+PetscErrorCode BcastString(MPI_Comm comm, std::string *s)
+{
+  unsigned long long n = s->size();
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm));
+  s->resize(n);
+  if (n) PetscCallMPI(MPI_Bcast(&(*s)[0], (PetscMPIInt)n, MPI_CHAR, 0, comm));
+  PetscFunctionReturn(0);
+}
+
+// Large broadcasts in pieces (MPI counts are int).
+PetscErrorCode BcastReals(MPI_Comm comm, PetscReal *v, size_t n)
+{
+  const size_t piece = (size_t)1 << 26;
+
+  PetscFunctionBeginUser;
+  for (size_t off = 0; off < n; off += piece) PetscCallMPI(MPI_Bcast(v + off, (PetscMPIInt)std::min(piece, n - off), MPIU_REAL, 0, comm));
+  PetscFunctionReturn(0);
+}
+
+// Rank 0's part of Open: create (temp file + rename) or reopen and check. Returns the open file.
+bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool restart, H5Id *file, std::vector<signed char> *done)
+{
+  if (restart && FileExists(path)) {
+    if (!OpenExisting(c, path, true, file)) return false;
+    SnapshotHeader fh;
+    if (!ReadHeaderH5(c, file->get(), &fh)) return false;
+    const std::string diff = SnapshotHeaderDiff(fh, h);
+    if (!diff.empty()) {
+      c.err = "Snapshot file '" + path + "' was made for another scene/mesh/parameter box: " + diff + "; delete it or start without restart";
+      return false;
+    }
+    return ReadDone(c, file->get(), h.trainingPoints.size(), done);
+  }
+  const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+  Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
+  {
+    H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    bool ok = f.ok() || ct.Fail("cannot create the file (directory missing or not writable?)");
+    ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && FlushSync(ct, f.get()) && CloseFile(ct, &f);
+    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + path + "': " + std::strerror(errno), false);
+    if (!ok) {
+      f.Reset();
+      std::remove(tmp.c_str());
+      c.err = ct.err;
+      return false;
+    }
+  }
+  // Make the rename durable (best effort: a directory that cannot be opened is not an error).
+  {
+    const auto        slash = path.find_last_of('/');
+    const std::string dir   = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+    const int         fd    = open(dir.c_str(), O_RDONLY);
+    if (fd >= 0) {
+      (void)fsync(fd);
+      close(fd);
+    }
+  }
+  *file = H5Id(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+  if (!file->ok()) return c.Fail("cannot be reopened for writing after its creation");
+  done->assign(h.trainingPoints.size(), 0);
+  return true;
+}
+
+// Rank 0's part of Write. *doneState: the done flag of s.index in the file afterwards.
+bool WriteOnRoot(Ctx &c, hid_t f, const SnapshotHeader &h, bool wasDone, const Snapshot &s, signed char *doneState)
+{
+  const PetscInt ntrain = (PetscInt)h.trainingPoints.size();
+  const size_t   np     = h.paramNames.size();
+  *doneState            = wasDone ? 1 : 0;
+  std::ostringstream m;
+  if (s.index < 0 || s.index >= ntrain) m << "Write: snapshot index " << s.index << " outside the training set [0, " << ntrain << ")";
+  else if (s.u.size() != (size_t)h.ndofs) m << "Write: snapshot " << s.index << " has " << s.u.size() << " values of u; the file stores ndofs = " << h.ndofs;
+  else if (s.lambda.size() != (size_t)h.nmult) m << "Write: snapshot " << s.index << " has " << s.lambda.size() << " multipliers; the file stores nmult = " << h.nmult;
+  else if (!s.mu.empty() && s.mu.size() != np) m << "Write: snapshot " << s.index << " has " << s.mu.size() << " parameter values; the file has " << np << " parameters";
+  else if (s.kkt.size() > 4) m << "Write: snapshot " << s.index << " has " << s.kkt.size() << " KKT residuals (at most 4)";
+  if (m.str().empty() && !s.mu.empty())
+    for (size_t j = 0; j < np; ++j)
+      if (std::fabs(s.mu[j] - h.trainingPoints[s.index][j]) > 1e-12 * std::max(1.0, std::fabs(h.trainingPoints[s.index][j]))) {
+        m.precision(17);
+        m << "Write: snapshot " << s.index << " has " << h.paramNames[j] << " = " << s.mu[j] << " but training point " << s.index << " has " << h.trainingPoints[s.index][j];
+        break;
+      }
+  if (m.str().empty())
+    for (const auto &kv : s.extra)
+      if (kv.first.empty() || kv.first.find('/') != std::string::npos || kv.first == "." || kv.first == "..") {
+        m << "Write: extra array name '" << kv.first << "' is not a valid dataset name";
+        break;
+      }
+  if (!m.str().empty()) return c.Fail(m.str(), false);
+
+  const hsize_t     row = (hsize_t)s.index;
+  const signed char zero = 0, one = 1;
+  // Rewriting a done snapshot: clear its flag first, so a crash mid-write cannot leave a mix.
+  if (wasDone) {
+    if (!RowIO(c, f, "/snapshots/done", H5T_NATIVE_SCHAR, row, 1, const_cast<signed char *>(&zero), true) || !FlushSync(c, f)) return false;
+    *doneState = 0;
+  }
+  // New extras: create their datasets (metadata) and flush before any data is written.
+  bool created = false;
+  for (const auto &kv : s.extra) {
+    const std::string name = "/snapshots/extra/" + kv.first;
+    const htri_t      e    = H5Lexists(f, name.c_str(), H5P_DEFAULT);
+    if (e < 0) return c.Fail("cannot query dataset " + name);
+    if (e == 0) {
+      if (!CreateDataset(c, f, name, H5T_IEEE_F64LE, {(hsize_t)ntrain, (hsize_t)kv.second.size()}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
+      created = true;
+    }
+  }
+  if (created && !FlushSync(c, f)) return false;
+
+  std::vector<double> mu = s.mu.empty() ? h.trainingPoints[s.index] : s.mu;
+  std::vector<double> kkt(4, kNaN);
+  for (size_t k = 0; k < s.kkt.size(); ++k) kkt[k] = s.kkt[k];
+  long long it  = s.kacanovIterations;
+  double    sec = s.seconds;
+  if (!RowIO(c, f, "/snapshots/mu", H5T_NATIVE_DOUBLE, row, np, mu.data(), true)) return false;
+  if (!RowIO(c, f, "/snapshots/u", H5T_NATIVE_DOUBLE, row, s.u.size(), const_cast<double *>(s.u.data()), true)) return false;
+  if (!RowIO(c, f, "/snapshots/lambda", H5T_NATIVE_DOUBLE, row, s.lambda.size(), const_cast<double *>(s.lambda.data()), true)) return false;
+  if (!RowIO(c, f, "/snapshots/kacanov_iterations", H5T_NATIVE_LLONG, row, 1, &it, true)) return false;
+  if (!RowIO(c, f, "/snapshots/kkt", H5T_NATIVE_DOUBLE, row, 4, kkt.data(), true)) return false;
+  if (!RowIO(c, f, "/snapshots/seconds", H5T_NATIVE_DOUBLE, row, 1, &sec, true)) return false;
+  for (const auto &kv : s.extra)
+    if (!RowIO(c, f, "/snapshots/extra/" + kv.first, H5T_NATIVE_DOUBLE, row, kv.second.size(), const_cast<double *>(kv.second.data()), true)) {
+      c.err += " (extra arrays have a fixed length per name, set by the first snapshot written)";
+      return false;
+    }
+  if (!FlushSync(c, f)) return false;
+  if (!RowIO(c, f, "/snapshots/done", H5T_NATIVE_SCHAR, row, 1, const_cast<signed char *>(&one), true) || !FlushSync(c, f)) return false;
+  *doneState = 1;
+  return true;
+}
+
+} // namespace
+
+std::string SnapshotHeaderDiff(const SnapshotHeader &file, const SnapshotHeader &now)
+{
+  auto differs = [](const std::string &field, const std::string &a, const std::string &b) { return field + " differs (file: " + a + ", now: " + b + ")"; };
+  if (file.sceneHash != now.sceneHash) return differs("scene_hash", Hex(file.sceneHash), Hex(now.sceneHash));
+  if (file.meshChecksum != now.meshChecksum) return differs("mesh_checksum", Hex(file.meshChecksum), Hex(now.meshChecksum));
+  if (file.paramNames != now.paramNames) return differs("parameter names", Join(file.paramNames), Join(now.paramNames));
+  for (size_t j = 0; j < now.paramNames.size(); ++j) {
+    const double fmin = j < file.paramMin.size() ? file.paramMin[j] : kNaN, fmax = j < file.paramMax.size() ? file.paramMax[j] : kNaN;
+    const double nmin = j < now.paramMin.size() ? now.paramMin[j] : kNaN, nmax = j < now.paramMax.size() ? now.paramMax[j] : kNaN;
+    if (!Close14(fmin, nmin)) return differs("params/min of '" + now.paramNames[j] + "'", Num(fmin), Num(nmin));
+    if (!Close14(fmax, nmax)) return differs("params/max of '" + now.paramNames[j] + "'", Num(fmax), Num(nmax));
+  }
+  if (file.trainingPoints.size() != now.trainingPoints.size()) return differs("number of training points", std::to_string(file.trainingPoints.size()), std::to_string(now.trainingPoints.size()));
+  for (size_t i = 0; i < now.trainingPoints.size(); ++i) {
+    if (file.trainingPoints[i].size() != now.trainingPoints[i].size()) return differs("train/points row " + std::to_string(i) + " length", std::to_string(file.trainingPoints[i].size()), std::to_string(now.trainingPoints[i].size()));
+    for (size_t j = 0; j < now.trainingPoints[i].size(); ++j)
+      if (!Close14(file.trainingPoints[i][j], now.trainingPoints[i][j])) return differs("train/points[" + std::to_string(i) + "][" + std::to_string(j) + "]", Num(file.trainingPoints[i][j]), Num(now.trainingPoints[i][j]));
+  }
+  if (file.ndofs != now.ndofs) return differs("ndofs (length of u)", std::to_string(file.ndofs), std::to_string(now.ndofs));
+  if (file.nmult != now.nmult) return differs("nmult (length of lambda)", std::to_string(file.nmult), std::to_string(now.nmult));
+  return std::string();
+}
+
+SnapshotFile::~SnapshotFile()
+{
+  if (file_ >= 0) {
+    H5Quiet q;
+    H5Fclose((hid_t)file_);
+    file_ = -1;
+  }
+}
+
+PetscErrorCode SnapshotFile::Open(MPI_Comm comm, const std::string &path, const SnapshotHeader &header, bool restart)
+{
+  PetscMPIInt rank;
+  std::string err;
+
+  PetscFunctionBeginUser;
+  PetscCheck(!open_, comm, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::Open('%s'): this object has '%s' open; Close() it first", path.c_str(), path_.c_str());
+  PetscCheck(!path.empty(), comm, PETSC_ERR_ARG_WRONG, "SnapshotFile::Open: empty file name");
+  const size_t np = header.paramNames.size();
+  PetscCheck(header.paramMin.size() == np && header.paramMax.size() == np, comm, PETSC_ERR_ARG_SIZ, "Snapshot file '%s': the header has %zu parameter names but %zu/%zu box bounds", path.c_str(), np, header.paramMin.size(), header.paramMax.size());
+  PetscCheck(!header.trainingPoints.empty(), comm, PETSC_ERR_ARG_SIZ, "Snapshot file '%s': the training set is empty", path.c_str());
+  for (size_t i = 0; i < header.trainingPoints.size(); ++i) PetscCheck(header.trainingPoints[i].size() == np, comm, PETSC_ERR_ARG_SIZ, "Snapshot file '%s': training point %zu has %zu values for %zu parameters", path.c_str(), i, header.trainingPoints[i].size(), np);
+  PetscCheck(header.ndofs >= 0 && header.nmult >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "Snapshot file '%s': negative ndofs %" PetscInt_FMT " or nmult %" PetscInt_FMT, path.c_str(), header.ndofs, header.nmult);
+
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  std::vector<signed char> done(header.trainingPoints.size(), 0);
+  H5Id                     file;
+  if (rank == 0) {
+    H5Quiet q;
+    Ctx     c = FileCtx(path);
+    if (!OpenOnRoot(c, path, header, restart, &file, &done)) {
+      err = c.err;
+      file.Reset();
+    }
+  }
+  PetscCall(BcastString(comm, &err));
+  PetscCheck(err.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "%s", err.c_str());
+  PetscCallMPI(MPI_Bcast(done.data(), (PetscMPIInt)done.size(), MPI_SIGNED_CHAR, 0, comm));
+  comm_   = comm;
+  path_   = path;
+  header_ = header;
+  file_   = file.Release();
+  done_   = done;
+  open_   = true;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::DoneIndices(std::vector<PetscInt> *done) const
+{
+  PetscFunctionBeginUser;
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::DoneIndices: no snapshot file is open");
+  done->clear();
+  for (size_t i = 0; i < done_.size(); ++i)
+    if (done_[i]) done->push_back((PetscInt)i);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::Write(const Snapshot &s)
+{
+  PetscMPIInt rank;
+  std::string err;
+  long long   state[2] = {-1, 0}; // index, done flag afterwards
+
+  PetscFunctionBeginUser;
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::Write: no snapshot file is open");
+  PetscCallMPI(MPI_Comm_rank(comm_, &rank));
+  if (rank == 0) {
+    H5Quiet     q;
+    Ctx         c  = FileCtx(path_);
+    const bool  ok = s.index >= 0 && s.index < (PetscInt)done_.size();
+    signed char st = ok ? done_[s.index] : 0;
+    if (!WriteOnRoot(c, (hid_t)file_, header_, ok && done_[s.index], s, &st)) err = c.err;
+    state[0] = ok ? s.index : -1;
+    state[1] = st;
+  }
+  PetscCall(BcastString(comm_, &err));
+  PetscCallMPI(MPI_Bcast(state, 2, MPI_LONG_LONG, 0, comm_));
+  if (state[0] >= 0) done_[state[0]] = (signed char)state[1];
+  PetscCheck(err.empty(), comm_, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::Close()
+{
+  PetscMPIInt rank;
+  std::string err;
+
+  PetscFunctionBeginUser;
+  if (!open_) PetscFunctionReturn(0);
+  PetscCallMPI(MPI_Comm_rank(comm_, &rank));
+  if (rank == 0 && file_ >= 0) {
+    H5Quiet q;
+    Ctx     c = FileCtx(path_);
+    H5Id    f((hid_t)file_, H5Fclose);
+    file_ = -1;
+    if (!CloseFile(c, &f)) err = c.err;
+  }
+  MPI_Comm comm = comm_;
+  open_         = false;
+  comm_         = MPI_COMM_NULL;
+  done_.clear();
+  PetscCall(BcastString(comm, &err));
+  PetscCheck(err.empty(), comm, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::ReadHeader(const std::string &path, SnapshotHeader *header)
+{
+  std::string err;
+
+  PetscFunctionBeginUser;
+  {
+    H5Quiet q;
+    Ctx     c = FileCtx(path);
+    H5Id    f;
+    if (!OpenExisting(c, path, false, &f) || !ReadHeaderH5(c, f.get(), header) || !CloseFile(c, &f)) err = c.err;
+  }
+  PetscCheck(err.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapshot> *snaps)
+{
+  std::string err;
+
+  PetscFunctionBeginUser;
+  snaps->clear();
+  {
+    H5Quiet                  q;
+    Ctx                      c = FileCtx(path);
+    H5Id                     f;
+    SnapshotHeader           h;
+    std::vector<signed char> done;
+    std::vector<std::pair<std::string, hsize_t>> extras; // name, length
+    bool ok = OpenExisting(c, path, false, &f) && ReadHeaderH5(c, f.get(), &h) && ReadDone(c, f.get(), h.trainingPoints.size(), &done);
+    if (ok) {
+      H5Id g(H5Gopen2(f.get(), "/snapshots/extra", H5P_DEFAULT), H5Gclose);
+      H5G_info_t info{};
+      ok = (g.ok() && H5Gget_info(g.get(), &info) >= 0) || c.Fail("cannot open group /snapshots/extra");
+      for (hsize_t k = 0; ok && k < info.nlinks; ++k) {
+        const ssize_t n = H5Lget_name_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, k, nullptr, 0, H5P_DEFAULT);
+        if (n < 0) {
+          ok = c.Fail("cannot list group /snapshots/extra");
+          break;
+        }
+        std::vector<char> name((size_t)n + 1, 0);
+        if (H5Lget_name_by_idx(g.get(), ".", H5_INDEX_NAME, H5_ITER_INC, k, name.data(), (size_t)n + 1, H5P_DEFAULT) < 0) {
+          ok = c.Fail("cannot list group /snapshots/extra");
+          break;
+        }
+        const std::string    dn = std::string("/snapshots/extra/") + name.data();
+        H5Id                 d(H5Dopen2(f.get(), dn.c_str(), H5P_DEFAULT), H5Dclose);
+        std::vector<hsize_t> dims;
+        ok = (d.ok() || c.Fail("cannot open dataset " + dn)) && DatasetDims(c, d.get(), dn, &dims);
+        if (ok && (dims.size() != 2 || dims[0] != h.trainingPoints.size())) ok = c.Fail("dataset " + dn + " has shape " + ShapeString(dims) + ", expected ntrain x len", false);
+        if (ok) extras.emplace_back(name.data(), dims[1]);
+      }
+    }
+    const hsize_t np = h.paramNames.size();
+    for (size_t i = 0; ok && i < done.size(); ++i) {
+      if (!done[i]) continue;
+      Snapshot  s;
+      long long it = 0;
+      s.index      = (PetscInt)i;
+      s.mu.resize(np);
+      s.u.resize(h.ndofs);
+      s.lambda.resize(h.nmult);
+      s.kkt.resize(4);
+      ok = RowIO(c, f.get(), "/snapshots/mu", H5T_NATIVE_DOUBLE, i, np, s.mu.data(), false) && RowIO(c, f.get(), "/snapshots/u", H5T_NATIVE_DOUBLE, i, s.u.size(), s.u.data(), false) &&
+           RowIO(c, f.get(), "/snapshots/lambda", H5T_NATIVE_DOUBLE, i, s.lambda.size(), s.lambda.data(), false) && RowIO(c, f.get(), "/snapshots/kacanov_iterations", H5T_NATIVE_LLONG, i, 1, &it, false) &&
+           RowIO(c, f.get(), "/snapshots/kkt", H5T_NATIVE_DOUBLE, i, 4, s.kkt.data(), false) && RowIO(c, f.get(), "/snapshots/seconds", H5T_NATIVE_DOUBLE, i, 1, &s.seconds, false);
+      s.kacanovIterations = (PetscInt)it;
+      for (size_t k = 0; ok && k < extras.size(); ++k) {
+        std::vector<PetscReal> &x = s.extra[extras[k].first];
+        x.resize(extras[k].second);
+        ok = RowIO(c, f.get(), "/snapshots/extra/" + extras[k].first, H5T_NATIVE_DOUBLE, i, x.size(), x.data(), false);
+      }
+      if (ok) snaps->push_back(std::move(s));
+    }
+    if (ok) ok = CloseFile(c, &f);
+    if (!ok) err = c.err;
+  }
+  PetscCheck(err.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Import of snapshot matrices from other codes.
+
+namespace {
+
+// Splits "file.h5:/dataset" at the first ":/" whose left part is an existing file.
+void SplitSpec(const std::string &spec, std::string *file, std::string *dset)
+{
+  *file = spec;
+  dset->clear();
+  for (size_t p = spec.find(":/"); p != std::string::npos; p = spec.find(":/", p + 1))
+    if (FileExists(spec.substr(0, p))) {
+      *file = spec.substr(0, p);
+      *dset = spec.substr(p + 1);
+      return;
+    }
+  const size_t p = spec.find(":/"); // no such file: still name the file part in the error
+  if (p != std::string::npos) {
+    *file = spec.substr(0, p);
+    *dset = spec.substr(p + 1);
+  }
+}
+
+// HDF5 dataset -> column-major (nrows = dofs) data.
+bool ImportH5(Ctx &c, const std::string &file, const std::string &dset, bool transpose, unsigned long long *nr, unsigned long long *nc, std::vector<double> *data)
+{
+  const htri_t is = H5Fis_hdf5(file.c_str());
+  if (is <= 0) return c.Fail("is not an HDF5 file", is < 0);
+  H5Id f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!f.ok()) return c.Fail("cannot be opened");
+  const htri_t e = H5Lexists(f.get(), dset.c_str(), H5P_DEFAULT);
+  if (e <= 0) return c.Fail("has no dataset " + dset, false);
+  H5Id d(H5Dopen2(f.get(), dset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("cannot open dataset " + dset + " (a group?)");
+  H5Id t(H5Dget_type(d.get()), H5Tclose);
+  if (!t.ok()) return c.Fail("cannot get the type of dataset " + dset);
+  const H5T_class_t cls = H5Tget_class(t.get());
+  if (cls != H5T_FLOAT && cls != H5T_INTEGER) return c.Fail("dataset " + dset + " is not numeric (float or integer)", false);
+  std::vector<hsize_t> dims;
+  if (!DatasetDims(c, d.get(), dset, &dims)) return false;
+  if (dims.size() != 2) return c.Fail("dataset " + dset + " has shape " + ShapeString(dims) + "; a 2D matrix is expected (rows = dofs, columns = snapshots; -import_transpose for the transpose)", false);
+  std::vector<double> raw(dims[0] * dims[1]);
+  if (!raw.empty() && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0) return c.Fail("cannot read dataset " + dset);
+  // raw is row-major dims[0] x dims[1].
+  const hsize_t ndof = transpose ? dims[1] : dims[0], nsnap = transpose ? dims[0] : dims[1];
+  data->assign(ndof * nsnap, 0.0);
+  for (hsize_t i = 0; i < dims[0]; ++i)
+    for (hsize_t j = 0; j < dims[1]; ++j) {
+      const hsize_t dof = transpose ? j : i, snap = transpose ? i : j;
+      (*data)[snap * ndof + dof] = raw[i * dims[1] + j];
+    }
+  *nr = ndof;
+  *nc = nsnap;
+  return true;
+}
+
+// Checks a PETSc binary Mat file header (big-endian PetscInt classid, M, N, nz) and its size.
+bool CheckPetscBinary(Ctx &c, const std::string &file, PetscInt *nz)
+{
+  std::FILE *fp = std::fopen(file.c_str(), "rb");
+  if (!fp) return c.Fail(std::string("cannot be opened: ") + std::strerror(errno), false);
+  PetscInt      hdr[4] = {0, 0, 0, 0};
+  unsigned char raw[4 * sizeof(PetscInt)];
+  const size_t  got = std::fread(raw, 1, sizeof raw, fp);
+  std::fseek(fp, 0, SEEK_END);
+  const long long size = std::ftell(fp);
+  std::fclose(fp);
+  if (got == sizeof raw)
+    for (int k = 0; k < 4; ++k) {
+      unsigned long long v = 0;
+      for (size_t b = 0; b < sizeof(PetscInt); ++b) v = (v << 8) | raw[k * sizeof(PetscInt) + b];
+      hdr[k] = (PetscInt)(std::make_unsigned<PetscInt>::type)v; // two's complement
+    }
+  if (got != sizeof raw || hdr[0] != MAT_FILE_CLASSID) {
+    std::ostringstream m;
+    m << "is neither a PETSc binary Mat file (no Mat class id " << MAT_FILE_CLASSID << " at its start) nor given as file.h5:/dataset";
+    return c.Fail(m.str(), false);
+  }
+  const long long M = hdr[1], N = hdr[2], NZ = hdr[3], I = sizeof(PetscInt), S = sizeof(PetscScalar);
+  const long long need = NZ == -1 ? 4 * I + M * N * S : 4 * I + M * I + NZ * (I + S);
+  if (M < 0 || N < 0 || NZ < -1 || size < need) {
+    std::ostringstream m;
+    m << "PETSc binary Mat header says " << M << " x " << N << " (nz " << NZ << ") but the file is truncated or corrupt (" << size << " bytes, need " << need << ")";
+    return c.Fail(m.str(), false);
+  }
+  *nz = (PetscInt)NZ;
+  return true;
+}
+
+} // namespace
+
+PetscErrorCode ImportSnapshotMatrix(MPI_Comm comm, const std::string &spec, std::vector<std::vector<PetscReal>> *cols)
+{
+  PetscBool           transpose = PETSC_FALSE;
+  PetscMPIInt         rank;
+  std::string         err, file, dset;
+  unsigned long long  dim[3] = {0, 0, 0}; // rows (dofs), columns (snapshots), 1 = PETSc binary
+  std::vector<double> data;
+  PetscInt            nz = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-import_transpose", &transpose, NULL));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    H5Quiet q;
+    SplitSpec(spec, &file, &dset);
+    Ctx c{"Snapshot matrix file '" + file + "'", std::string()};
+    if (!FileExists(file)) c.Fail("does not exist (give file.h5:/dataset or a PETSc binary Mat file)", false);
+    else if (!dset.empty()) ImportH5(c, file, dset, transpose, &dim[0], &dim[1], &data);
+    else if (H5Fis_hdf5(file.c_str()) > 0) c.Fail("is an HDF5 file: name the dataset as '" + file + ":/path/to/dataset'", false);
+    else if (CheckPetscBinary(c, file, &nz)) dim[2] = 1;
+    H5Eclear2(H5E_DEFAULT);
+    err = c.err;
+  }
+  PetscCall(BcastString(comm, &err));
+  PetscCheck(err.empty(), comm, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  if (rank == 0 && dim[2] == 1) {
+    // The header was checked above, so MatLoad does not fail on rank 0 alone.
+    Mat                A, D = NULL;
+    PetscViewer        v;
+    PetscInt           M, N, lda;
+    const PetscScalar *a;
+    PetscCall(PetscViewerCreate(PETSC_COMM_SELF, &v));
+    PetscCall(PetscViewerSetType(v, PETSCVIEWERBINARY));
+    PetscCall(PetscViewerBinarySetSkipInfo(v, PETSC_TRUE)); // never read options from file.info
+    PetscCall(PetscViewerFileSetMode(v, FILE_MODE_READ));
+    PetscCall(PetscViewerFileSetName(v, file.c_str()));
+    PetscCall(MatCreate(PETSC_COMM_SELF, &A));
+    PetscCall(MatSetType(A, nz == -1 ? MATSEQDENSE : MATSEQAIJ));
+    PetscCall(MatLoad(A, v));
+    PetscCall(PetscViewerDestroy(&v));
+    if (nz == -1) D = A;
+    else {
+      PetscCall(MatConvert(A, MATSEQDENSE, MAT_INITIAL_MATRIX, &D));
+      PetscCall(MatDestroy(&A));
+    }
+    PetscCall(MatGetSize(D, &M, &N));
+    PetscCall(MatDenseGetLDA(D, &lda));
+    PetscCall(MatDenseGetArrayRead(D, &a));
+    dim[0] = transpose ? N : M;
+    dim[1] = transpose ? M : N;
+    data.assign(dim[0] * dim[1], 0.0);
+    for (PetscInt j = 0; j < N; ++j)
+      for (PetscInt i = 0; i < M; ++i) {
+        const size_t dof = transpose ? j : i, snap = transpose ? i : j;
+        data[snap * dim[0] + dof] = PetscRealPart(a[i + j * lda]);
+      }
+    PetscCall(MatDenseRestoreArrayRead(D, &a));
+    PetscCall(MatDestroy(&D));
+  }
+  PetscCallMPI(MPI_Bcast(dim, 3, MPI_UNSIGNED_LONG_LONG, 0, comm));
+  cols->assign(dim[1], std::vector<PetscReal>(dim[0]));
+  for (unsigned long long j = 0; j < dim[1]; ++j) {
+    if (rank == 0) std::copy(data.begin() + j * dim[0], data.begin() + (j + 1) * dim[0], (*cols)[j].begin());
+    PetscCall(BcastReals(comm, (*cols)[j].data(), dim[0]));
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
