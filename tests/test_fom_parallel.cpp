@@ -4,14 +4,17 @@
 // fom_ KSP from the options) and, in the same program, on PETSC_COMM_SELF on rank 0 with the default
 // direct solver (MUMPS Cholesky, forced). The energies 0.5 a(u, u) (ElasticFOM::FillReport's
 // "energy") must agree to -energy_rtol (default 1e-10); the energy must be positive and finite,
-// and on more than one rank every rank must own cells.
+// on more than one rank every rank must own cells, and with -mesh_partitioner metis the FOM mesh
+// must have the cells per rank of a direct rbc::DistributeMesh of the same file.
 // Options: the scene options, -mesh_partitioner, -fem_degree, -fom_ksp_*/-fom_pc_*,
 // -energy_rtol <tol>. Prints a table; exits 1 on failure.
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
+#include "rbcontact/partition.hpp"
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -72,6 +75,23 @@ PetscErrorCode Run(MPI_Comm comm, bool *ok)
   PetscInt              myCells = cEnd - cStart;
   PetscCallMPI(MPI_Allgather(&myCells, 1, MPIU_INT, cellsPerRank.data(), 1, MPIU_INT, comm));
 
+  // The FOM's mesh must carry the -mesh_partitioner partition: distribute the same .msh directly
+  // with rbc::DistributeMesh and compare the cells per rank (metis only: it is deterministic;
+  // PT-Scotch is not, run to run). MeshLoad used to distribute a second time in DMSetFromOptions.
+  std::vector<PetscInt> directCells(size);
+  {
+    std::string msh;
+    DM          dmd;
+    PetscCall(rbc::MeshGenerate(comm, scene.mesh, &msh));
+    PetscCall(DMPlexCreateFromFile(comm, msh.c_str(), "direct", PETSC_TRUE, &dmd));
+    PetscCall(rbc::DistributeMesh(&dmd));
+    PetscInt s, e;
+    PetscCall(DMPlexGetHeightStratum(dmd, 0, &s, &e));
+    PetscInt n = e - s;
+    PetscCallMPI(MPI_Allgather(&n, 1, MPIU_INT, directCells.data(), 1, MPIU_INT, comm));
+    PetscCall(DMDestroy(&dmd));
+  }
+
   // Serial reference on rank 0: same scene, PETSC_COMM_SELF, MUMPS Cholesky whatever the options.
   PetscReal eSer = 0;
   PetscInt  nSer = 0;
@@ -100,13 +120,19 @@ PetscErrorCode Run(MPI_Comm comm, bool *ok)
   PetscCallMPI(MPI_Bcast(descSer, sizeof descSer, MPI_CHAR, 0, comm));
 
   const PetscReal rel = PetscAbsReal(ePar - eSer) / PetscAbsReal(eSer);
-  std::string     cells;
+  std::string     cells, direct;
   for (PetscInt c : cellsPerRank) cells += (cells.empty() ? "" : "/") + std::to_string((long long)c);
+  for (PetscInt c : directCells) direct += (direct.empty() ? "" : "/") + std::to_string((long long)c);
   PetscCall(PetscPrintf(comm, "test_fom_parallel: scene %s, P%" PetscInt_FMT ", %d rank(s), partitioner %s, cells per rank %s\n", scene.name.c_str(), scene.degree, size, part, cells.c_str()));
   PetscCall(PetscPrintf(comm, "  %-9s %8s %-34s %22s %8s\n", "solve", "dofs", "solver", "energy 0.5 a(u,u)", "time s"));
   PetscCall(PetscPrintf(comm, "  %-9s %8" PetscInt_FMT " %-34s %22.15e %8.3f\n", "parallel", par.GlobalSize(), descPar.c_str(), (double)ePar, (double)(t1 - t0)));
   PetscCall(PetscPrintf(comm, "  %-9s %8" PetscInt_FMT " %-34s %22.15e %8.3f\n", "serial", nSer, descSer, (double)eSer, (double)(t2 - t1)));
   PetscCall(PetscPrintf(comm, "  relative energy difference %.3e (tol %.1e)\n", (double)rel, (double)tol));
+  PetscCall(PetscPrintf(comm, "  cells per rank: FOM mesh %s, direct rbc::DistributeMesh %s\n", cells.c_str(), direct.c_str()));
+  if (!std::strcmp(part, "metis") && cellsPerRank != directCells) {
+    *ok = false;
+    PetscCall(PetscPrintf(comm, "FAILED: the FOM mesh is not distributed as -mesh_partitioner metis partitions it (%s vs %s)\n", cells.c_str(), direct.c_str()));
+  }
 
   if (!(std::isfinite(ePar) && ePar > 0 && eSer > 0)) {
     *ok = false;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 #include "rbcontact/elasticity.hpp"
+#include "rbcontact/geometry_map.hpp"
 
 namespace rbc {
 
@@ -25,6 +26,8 @@ struct SurfaceFacet {
   std::array<PetscReal, 18>    Ubc{};        // Dirichlet values of constrained dofs
   std::array<PetscInt, 6>      nodeKind{};   // node i: vertex k (0..2) or edge (3 + e, e = edge (0,1),(1,2),(0,2))
   PetscReal                    outward = 1;  // sign making the facet normal point out of its body
+  std::array<PetscReal, 9>     Xref{};       // reference vertex coordinates (X = h_body(mu)(Xref))
+  PetscInt                     body = -1;    // body of the facet's cell
 };
 
 // Lagrange basis of the facet nodes at barycentric coordinates b (size nv).
@@ -38,6 +41,8 @@ public:
   PetscErrorCode Update(const Elasticity &elas, Vec uloc);
   // All ranks' facets (for the master).
   PetscErrorCode Gather(MPI_Comm comm, std::vector<SurfaceFacet> *all) const;
+  // Physical coordinates X = h_body(mu)(Xref) (identity map: X = Xref).
+  void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   std::vector<SurfaceFacet> facets;
   std::vector<PetscInt>     points; // DMPlex facet points, aligned with facets
   PetscInt                  dim = 0;
@@ -85,6 +90,8 @@ class ContactMap {
 public:
   // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet.
   PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
+  // Moves both surfaces to the physical configuration at mu (reference configuration + map).
+  void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   // Assembles K(u), g(u) at the full local field uloc (Dirichlet values included).
   PetscErrorCode Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys);
   PetscInt NumMultipliers() const { return R_; }

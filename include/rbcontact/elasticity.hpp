@@ -57,6 +57,9 @@ public:
   PetscErrorCode NearNullSpace(MatNullSpace *nsp) const;
   // Body index of each local cell (cStart..cEnd-1), -1 where no body label matched.
   const std::vector<PetscInt> &CellBody() const { return cellBody_; }
+  // Body owning each traction boundary of the scene (-1: none found).
+  const std::vector<PetscInt> &TractionBody() const { return tractionBody_; }
+  const GeometryMap           *Map() const { return map_; }
 
   DM       dm     = nullptr; // the solution DM (a reference is held)
   DM       dmCell = nullptr; // P0 scalar DM (cell fields: von Mises)

@@ -4,7 +4,9 @@
 #pragma once
 #include <petscksp.h>
 #include <memory>
+#include "rbcontact/affine_decomposition.hpp"
 #include "rbcontact/elasticity.hpp"
+#include "rbcontact/geometry_map.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/scene.hpp"
 
@@ -25,7 +27,11 @@ public:
   PetscErrorCode Create(MPI_Comm comm, const SceneSpec &scene);
   // Sets up on an existing DM (tests, manufactured solutions); takes a reference.
   PetscErrorCode CreateOnDM(DM dm, const SceneSpec &scene);
-  // Assembles A and f and factors A (KSPSetUp); times go to times.
+  // Builds the affine decomposition of A(mu), f(mu) (then AssembleAndFactor sums its terms).
+  PetscErrorCode SetupAffine();
+  // The parameter of the next assembly: physical state of the discretization at mu.
+  PetscErrorCode SetMu(const std::vector<PetscReal> &mu);
+  // Assembles A(mu) and f(mu) (affine sums if SetupAffine was called, else directly) and factors A.
   PetscErrorCode AssembleAndFactor();
   // u = A^{-1} rhs with the factored operator.
   PetscErrorCode ApplyInverse(Vec rhs, Vec x);
@@ -41,7 +47,11 @@ public:
   PetscErrorCode CheckFactorization();
 
   SceneSpec  scene;
+  GeometryMap map;          // h(mu) per body (-map_<body> ...)
   Elasticity elas;
+  AffineDecomposition affine;
+  bool                useAffine = false;
+  std::vector<PetscReal> mu; // current parameter
   DM         dm  = nullptr;
   Mat        A   = nullptr;
   Vec        f   = nullptr;

@@ -36,9 +36,15 @@ PetscErrorCode StageFom(MPI_Comm comm)
   ContactMap    map;
   KacanovSolver kacanov;
   PetscCall(fom.Create(comm, scene));
+  // On the reference mesh: A(mu), f(mu) from the affine decomposition (-fom_affine 0: direct assembly)
+  PetscBool affine = scene.params.empty() ? PETSC_FALSE : PETSC_TRUE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-fom_affine", &affine, NULL));
+  if (affine) PetscCall(fom.SetupAffine());
+  PetscCall(fom.SetMu(ParamValues(scene)));
   if (scene.contact) {
     PetscCall(kacanov.SetFromOptions(comm));
     PetscCall(map.Setup(fom.elas, scene.slave, scene.master));
+    map.SetGeometry(&fom.map, fom.mu);
   }
   PetscCall(fom.AssembleAndFactor());
   if (scene.contact) PetscCall(kacanov.Solve(fom, map));
@@ -81,6 +87,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
       hz["P"]        = (double)cs.force;
     }
   }
+  if (affine) fom.affine.Describe(&rep.root["affine_terms"]);
+  rep.root["geometry_map"] = fom.map.Describe(scene);
   if (!scene.params.empty()) {
     JsonValue &m = rep.root["mu"];
     for (const auto &p : scene.params) m[p.name] = (double)p.value;

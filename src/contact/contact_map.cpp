@@ -153,6 +153,12 @@ static void FacetNormal(const PetscReal *x, PetscInt dim, PetscReal outward, Pet
   }
 }
 
+void ContactMap::SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu)
+{
+  slave_.SetGeometry(map, mu);
+  master_.SetGeometry(map, mu);
+}
+
 PetscErrorCode ContactMap::SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const
 {
   std::vector<PetscInt> mine;

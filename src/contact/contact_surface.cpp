@@ -123,6 +123,12 @@ PetscErrorCode ContactSurface::Build(const Elasticity &elas, const std::string &
     PetscReal dot = 0;
     for (PetscInt d = 0; d < dim; ++d) dot += n[d] * (fc[d] - cc[d]);
     f.outward = dot >= 0 ? 1.0 : -1.0;
+    f.Xref    = f.X;
+    {
+      PetscInt cStart;
+      PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
+      f.body = elas.CellBody()[support[0] - cStart];
+    }
     facets.push_back(f);
     points.push_back(p);
   }
@@ -149,6 +155,14 @@ PetscErrorCode ContactSurface::Update(const Elasticity &elas, Vec uloc)
     PetscCall(DMPlexVecRestoreClosure(elas.dm, lsec, uloc, points[i], &n, &vals));
   }
   PetscFunctionReturn(0);
+}
+
+void ContactSurface::SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu)
+{
+  for (auto &f : facets) {
+    const Affine a = map ? map->Evaluate(f.body, mu) : Affine();
+    for (PetscInt k = 0; k < f.nv; ++k) a.Apply(dim, &f.Xref[k * dim], &f.X[k * dim]);
+  }
 }
 
 PetscErrorCode ContactSurface::Gather(MPI_Comm comm, std::vector<SurfaceFacet> *all) const

@@ -45,7 +45,10 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   PetscCall(RegisterEvents());
   scene = sc;
   dm    = dmIn;
+  mu    = ParamValues(scene);
   PetscCall(PetscObjectReference((PetscObject)dm));
+  PetscCall(map.SetFromOptions(PetscObjectComm((PetscObject)dm), scene));
+  elas.SetGeometryMap(&map);
   PetscCall(elas.Setup(dm, scene));
   PetscCall(KSPCreate(PetscObjectComm((PetscObject)dm), &ksp));
   PetscCall(KSPSetOptionsPrefix(ksp, "fom_"));
@@ -55,6 +58,30 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(KSPSetTolerances(ksp, 1e-12, 1e-50, PETSC_DEFAULT, 10000));
   PetscCall(KSPSetFromOptions(ksp));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ElasticFOM::SetupAffine()
+{
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(affine.Build(elas, &map));
+  useAffine = true;
+  PetscCall(PetscTime(&t1));
+  times.assembly += t1 - t0;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ElasticFOM::SetMu(const std::vector<PetscReal> &m)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(m.size() == scene.params.size(), PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_SIZ, "Parameter vector of size %zu, the scene has %zu parameters", m.size(), scene.params.size());
+  for (size_t i = 0; i < m.size(); ++i)
+    PetscCheck(m[i] >= scene.params[i].min && m[i] <= scene.params[i].max, PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_OUTOFRANGE, "Parameter '%s' = %g is outside its box [%g, %g]", scene.params[i].name.c_str(), (double)m[i], (double)scene.params[i].min, (double)scene.params[i].max);
+  mu = m;
+  PetscCall(elas.SetMu(mu));
   PetscFunctionReturn(0);
 }
 
@@ -117,7 +144,8 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(FOM_Assembly, 0, 0, 0, 0));
-  PetscCall(elas.Assemble(&A, &f));
+  if (useAffine) PetscCall(affine.Assemble(mu, &A, &f));
+  else PetscCall(elas.Assemble(&A, &f));
   PetscCall(PetscLogEventEnd(FOM_Assembly, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   times.assembly += t1 - t0;

@@ -229,6 +229,11 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     }
   }
   PetscCall(DistributeMesh(dm));
+  // DMSetFromOptions of a DMPlex distributes it again by default (-dm_distribute, with PETSc's own
+  // partitioner): that silently replaced the -mesh_partitioner partition by another one, different
+  // from run to run (ring_on_block, 2 ranks, metis: 3045/2902 cells became 2944/3003, 2953/2994,
+  // ...). The mesh is distributed already: turn that default off (an explicit -dm_distribute wins).
+  PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(*dm));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
   PetscCall(PetscLogEventEnd(MESH_Load, 0, 0, 0, 0));
