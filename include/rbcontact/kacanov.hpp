@@ -59,6 +59,9 @@ struct ContactSummary {
   PetscReal halfwidthMoment = 0; // 2D: 2 sqrt(int p x^2 / int p), x from the pressure centroid (= a for a Hertz profile)
   PetscReal pressureSpread = 0; // 2D: max/min - 1 of the nodal pressure over the active nodes but the two ends
 };
+// Rows of K restricted to the sorted global dofs D: dense R x nD, column-major, on every rank.
+PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD);
+
 PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s);
 
 } // namespace rbc

@@ -4,4 +4,5 @@
 
 namespace rbc {
 PetscErrorCode StageFom(MPI_Comm comm);
+PetscErrorCode StageOffline(MPI_Comm comm);
 } // namespace rbc

@@ -131,7 +131,7 @@ PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
 }
 
 // Rows of K restricted to the columns D, dense R x nD column-major, on every rank.
-static PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD)
+PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)K);
   PetscInt    R, rstart, rend;

@@ -1,0 +1,321 @@
+// src/apps/stage_offline.cpp: `rbcontact offline`: the snapshot stage (-offline_stop snapshots). Solves
+// the reference-configuration FOM for every training parameter, in parallel over parameters
+// (-snapshots_subcomm k groups of ranks, PetscSubcomm), and stores every finished snapshot in one HDF5
+// file (SnapshotFile) before the next round starts; -snapshots_restart resumes a killed job.
+#include "stages.hpp"
+#include "rbcontact/canonical_order.hpp"
+#include "rbcontact/fom.hpp"
+#include "rbcontact/kacanov.hpp"
+#include "rbcontact/mesh.hpp"
+#include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/training_set.hpp"
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#ifndef RBC_VERSION
+  #define RBC_VERSION "unknown"
+#endif
+
+namespace rbc {
+
+static PetscLogEvent OFF_Snapshots = 0;
+
+// Everything that defines the problem (not the run): the snapshot file's scene hash.
+static std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map)
+{
+  std::ostringstream o;
+  o.precision(17);
+  o << "scene " << s.name << "|mesh " << s.mesh.file << " " << s.mesh.clscale;
+  for (const auto &g : s.mesh.geoNumbers) o << " " << g.first << "=" << g.second;
+  o << "|degree " << s.degree;
+  for (const auto &b : s.bodies) o << "|body " << b.name << " " << b.E << " " << b.nu << " " << b.paramE << " " << b.paramNu;
+  for (const auto &d : s.dirichlet) {
+    o << "|dirichlet " << d.label << " " << d.param;
+    for (auto v : d.values) o << " " << v;
+    for (auto c : d.comps) o << " c" << c;
+  }
+  for (const auto &t : s.tractions) {
+    o << "|traction " << t.label << " " << t.param;
+    for (auto v : t.traction) o << " " << v;
+  }
+  for (auto v : s.bodyForce) o << "|bf " << v;
+  o << "|contact " << s.contact << " " << s.slave << " " << s.master;
+  for (const auto &p : s.params) o << "|param " << p.name << " " << p.min << " " << p.max << " " << p.def;
+  o << "|map " << map.Describe(s);
+  for (const char *opt : {"-contact_quadrature", "-contact_quadrature_points", "-contact_normal"}) {
+    char      v[256] = "";
+    PetscBool set;
+    if (!PetscOptionsGetString(NULL, NULL, opt, v, sizeof v, &set) && set) o << "|" << opt << " " << v;
+  }
+  return o.str();
+}
+
+// Rank 0 reads the mesh file: its checksum and node count (msh22: the line after $Nodes).
+static PetscErrorCode MeshFacts(MPI_Comm comm, const SceneSpec &scene, unsigned long long *checksum, PetscInt *nnodes)
+{
+  std::string path;
+  PetscMPIInt rank;
+  long long   buf[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshGenerate(comm, scene.mesh, &path));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    std::ifstream     f(path, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    const std::string text = ss.str();
+    buf[0]                 = (long long)Fnv1a(text);
+    const auto pos         = text.find("$Nodes");
+    if (pos != std::string::npos) buf[1] = std::atoll(text.c_str() + text.find('\n', pos) + 1);
+  }
+  PetscCallMPI(MPI_Bcast(buf, 2, MPI_LONG_LONG, 0, comm));
+  *checksum = (unsigned long long)buf[0];
+  *nnodes   = (PetscInt)buf[1];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode StageOffline(MPI_Comm world)
+{
+  SceneSpec      scene;
+  Report         rep;
+  char           reportPath[PETSC_MAX_PATH_LEN] = "", snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "snapshots";
+  PetscBool      restart = PETSC_FALSE, monitor = PETSC_FALSE, set;
+  PetscMPIInt    wrank, wsize;
+  PetscLogDouble t0, t1, tSnap0;
+
+  PetscFunctionBeginUser;
+  if (!OFF_Snapshots) PetscCall(PetscLogEventRegister("RBCSnapshots", DM_CLASSID, &OFF_Snapshots));
+  PetscCall(PetscTime(&t0));
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  PetscCallMPI(MPI_Comm_size(world, &wsize));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, NULL));
+  PetscCheck(!strcmp(stop, "snapshots"), world, PETSC_ERR_SUP, "-offline_stop %s: only 'snapshots' is implemented so far (bases, EIM and the ROM file come with the next stages)", stop);
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", snapPath, sizeof snapPath, &set));
+  PetscCheck(set && snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_restart", &restart, NULL));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_monitor", &monitor, NULL));
+  PetscCall(SceneSpecFromOptions(world, &scene));
+  PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
+  ParameterSet train;
+  PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
+  const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
+
+  // Groups of ranks, each solving its share of the parameters. Default: one group per rank for a
+  // small mesh (< 200k dofs, where one rank per solve is efficient), one group otherwise.
+  unsigned long long checksum = 0;
+  PetscInt           nnodes   = 0;
+  PetscCall(MeshFacts(world, scene, &checksum, &nnodes));
+  PetscInt k = (nnodes * 3 < 200000) ? wsize : 1;
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-snapshots_subcomm", &k, NULL));
+  PetscCheck(k >= 1 && k <= wsize, world, PETSC_ERR_ARG_OUTOFRANGE, "-snapshots_subcomm %" PetscInt_FMT " must lie in [1, %d] (the number of ranks)", k, (int)wsize);
+  PetscSubcomm psub;
+  PetscCall(PetscSubcommCreate(world, &psub));
+  PetscCall(PetscSubcommSetNumber(psub, (PetscInt)k));
+  PetscCall(PetscSubcommSetType(psub, PETSC_SUBCOMM_CONTIGUOUS));
+  MPI_Comm    group = PetscSubcommChild(psub);
+  PetscMPIInt grank;
+  PetscCallMPI(MPI_Comm_rank(group, &grank));
+  const PetscInt color = psub->color;
+
+  {
+    // Every group: the reference-configuration FOM with its affine decomposition and contact map.
+    ElasticFOM     fom;
+    ContactMap     cmap;
+    KacanovSolver  kac;
+    CanonicalOrder order;
+    PetscCall(fom.Create(group, scene));
+    PetscCall(fom.SetupAffine());
+    PetscInt ndofs;
+    {
+      Vec g;
+      PetscCall(DMGetGlobalVector(fom.dm, &g));
+      PetscCall(VecGetSize(g, &ndofs));
+      PetscCall(DMRestoreGlobalVector(fom.dm, &g));
+    }
+    PetscCall(order.BuildDofs(fom.elas));
+    PetscInt               R = 0;
+    std::vector<PetscInt>  D, Dc, Dperm;
+    if (scene.contact) {
+      PetscCall(kac.SetFromOptions(group));
+      PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+      R = cmap.NumMultipliers();
+      PetscCall(cmap.SurfaceDofs(group, &D));
+      // contact dofs in canonical numbering, sorted; Dperm[j] = position in D of the j-th canonical one
+      std::vector<std::pair<PetscInt, PetscInt>> cd;
+      for (size_t j = 0; j < D.size(); ++j) cd.emplace_back(order.CanonicalDof(D[j]), (PetscInt)j);
+      std::sort(cd.begin(), cd.end());
+      for (const auto &p : cd) { Dc.push_back(p.first); Dperm.push_back(p.second); }
+    }
+    const PetscInt nD = (PetscInt)D.size();
+
+    SnapshotHeader h;
+    h.scene          = scene.name;
+    h.sceneHash      = Fnv1a(SceneFingerprint(scene, fom.map));
+    h.meshChecksum   = checksum;
+    h.codeVersion    = RBC_VERSION;
+    h.paramNames     = train.names;
+    for (const auto &p : scene.params) { h.paramMin.push_back(p.min); h.paramMax.push_back(p.max); }
+    h.trainingPoints = train.points;
+    h.ndofs          = ndofs;
+    h.nmult          = R;
+    {
+      char *all = NULL;
+      PetscCall(PetscOptionsGetAll(NULL, &all));
+      h.optionsText = all ? all : "";
+      PetscCall(PetscFree(all));
+    }
+    SnapshotFile file;
+    PetscCall(file.Open(world, snapPath, h, restart));
+    std::vector<PetscInt> done, todo;
+    PetscCall(file.DoneIndices(&done));
+    for (PetscInt i = 0; i < ntrain; ++i)
+      if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
+    if (!restart) PetscCheck(done.empty(), world, PETSC_ERR_PLIB, "new snapshot file with done entries");
+
+    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], K_D[R*nD]
+    const size_t           L = 7 + np + ndofs + 2 * R + (size_t)R * nD;
+    std::vector<PetscReal> pack(L), gathered(wrank == 0 ? L * wsize : 0);
+    std::vector<PetscInt>  itsSolved;
+    bool                   multOrderBuilt = false;
+    PetscCall(PetscTime(&tSnap0));
+    PetscCall(PetscLogEventBegin(OFF_Snapshots, 0, 0, 0, 0));
+    const PetscInt rounds = ((PetscInt)todo.size() + k - 1) / k;
+    for (PetscInt r = 0; r < rounds; ++r) {
+      const PetscInt slot = r * k + color;
+      const PetscInt idx  = slot < (PetscInt)todo.size() ? todo[slot] : -1;
+      std::fill(pack.begin(), pack.end(), 0.0);
+      pack[0] = idx;
+      if (idx >= 0) {
+        PetscLogDouble s0, s1;
+        PetscCall(PetscTime(&s0));
+        const std::vector<PetscReal> &mu = train.points[idx];
+        PetscCall(fom.SetMu(mu));
+        PetscCall(fom.AssembleAndFactor());
+        std::vector<PetscReal> u, lam, gap, KDg;
+        if (scene.contact) {
+          cmap.SetGeometry(&fom.map, mu);
+          PetscCall(kac.Solve(fom, cmap));
+          if (!multOrderBuilt) {
+            PetscCall(order.BuildMultipliers(kac.sys.coord, fom.elas.dim));
+            multOrderBuilt = true;
+          }
+          PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));
+          PetscCall(order.MultipliersToCanonical(kac.sys.g, &gap));
+          PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KDg));
+        } else PetscCall(fom.SolveElastic());
+        PetscCall(order.DofsToCanonical(fom.u, &u));
+        PetscCall(PetscTime(&s1));
+        if (grank == 0) {
+          size_t o = 1;
+          pack[o++] = kac.iterations;
+          pack[o++] = s1 - s0;
+          pack[o++] = kac.kkt.primal;
+          pack[o++] = kac.kkt.dual;
+          pack[o++] = kac.kkt.complementarity;
+          pack[o++] = kac.kkt.stationarity;
+          for (PetscInt j = 0; j < np; ++j) pack[o++] = mu[j];
+          for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = u[j];
+          for (PetscInt j = 0; j < R; ++j) pack[o++] = lam[j];
+          for (PetscInt j = 0; j < R; ++j) pack[o++] = gap[j];
+          // K_D: rows in canonical multiplier order, columns in canonical dof order (row-major)
+          for (PetscInt g = 0; g < R; ++g) {
+            const PetscInt c = order.CanonicalMultiplier(g);
+            for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
+          }
+        }
+        itsSolved.push_back(kac.iterations);
+      }
+      // group roots -> world rank 0 (other ranks send an empty slot)
+      if (grank != 0) pack[0] = -1;
+      PetscCallMPI(MPI_Gather(pack.data(), (int)L, MPIU_REAL, gathered.data(), (int)L, MPIU_REAL, 0, world));
+      std::vector<Snapshot> snaps;
+      if (wrank == 0)
+        for (PetscMPIInt q = 0; q < wsize; ++q) {
+          const PetscReal *p = &gathered[(size_t)q * L];
+          if (p[0] < 0) continue;
+          Snapshot s;
+          size_t   o = 0;
+          s.index             = (PetscInt)p[o++];
+          s.kacanovIterations = (PetscInt)p[o++];
+          s.seconds           = p[o++];
+          s.kkt.assign(p + o, p + o + 4);
+          o += 4;
+          s.mu.assign(p + o, p + o + np);
+          o += np;
+          s.u.assign(p + o, p + o + ndofs);
+          o += ndofs;
+          s.lambda.assign(p + o, p + o + R);
+          o += R;
+          if (scene.contact) {
+            s.extra["contact_gap"].assign(p + o, p + o + R);
+            o += R;
+            s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
+            s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
+          }
+          snaps.push_back(s);
+        }
+      PetscInt nsnap = (PetscInt)snaps.size();
+      PetscCallMPI(MPI_Bcast(&nsnap, 1, MPIU_INT, 0, world));
+      for (PetscInt i = 0; i < nsnap; ++i) PetscCall(file.Write(wrank == 0 ? snaps[i] : Snapshot()));
+      if (monitor && wrank == 0) {
+        PetscLogDouble now;
+        PetscCall(PetscTime(&now));
+        const PetscInt  finished = std::min<PetscInt>((r + 1) * k, (PetscInt)todo.size());
+        const PetscReal eta      = (now - tSnap0) / finished * ((PetscInt)todo.size() - finished);
+        for (const auto &s : snaps) {
+          std::ostringstream m;
+          for (auto v : s.mu) m << " " << v;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "  snapshot %3" PetscInt_FMT "/%" PetscInt_FMT "  mu =%s  Kacanov its %2" PetscInt_FMT "  %.2f s  [%" PetscInt_FMT "/%zu done, ETA %.1f s]\n", s.index + 1, ntrain, m.str().c_str(), s.kacanovIterations, (double)s.seconds, finished, todo.size(), (double)eta));
+        }
+      }
+    }
+    PetscCall(PetscLogEventEnd(OFF_Snapshots, 0, 0, 0, 0));
+    PetscCall(file.Close());
+    PetscCall(PetscTime(&t1));
+
+    // statistics over every snapshot solved in this run
+    std::vector<int> myIts(itsSolved.begin(), itsSolved.end());
+    if (grank != 0) myIts.clear();
+    int              cnt = (int)myIts.size();
+    std::vector<int> counts(wsize), displs(wsize, 0);
+    PetscCallMPI(MPI_Allgather(&cnt, 1, MPI_INT, counts.data(), 1, MPI_INT, world));
+    for (int q = 1; q < wsize; ++q) displs[q] = displs[q - 1] + counts[q - 1];
+    std::vector<int> allIts(displs[wsize - 1] + counts[wsize - 1]);
+    PetscCallMPI(MPI_Allgatherv(myIts.data(), cnt, MPI_INT, allIts.data(), counts.data(), displs.data(), MPI_INT, world));
+
+    rep.root["stage"]       = "offline";
+    rep.root["scene"]       = scene.name;
+    rep.root["ntrain"]      = (long long)ntrain;
+    rep.root["nparams"]     = (long long)np;
+    rep.root["fom_solves"]  = (long long)allIts.size();
+    rep.root["resumed"]     = (long long)done.size();
+    rep.root["ndofs"]       = (long long)ndofs;
+    rep.root["ncontact"]    = (long long)R;
+    JsonValue &ki           = rep.root["kacanov_iterations"];
+    if (!allIts.empty()) {
+      ki["min"]  = (long long)*std::min_element(allIts.begin(), allIts.end());
+      ki["max"]  = (long long)*std::max_element(allIts.begin(), allIts.end());
+      double sum = 0;
+      for (int v : allIts) sum += v;
+      ki["mean"] = sum / allIts.size();
+    }
+    JsonValue at;
+    fom.affine.Describe(&at);
+    rep.root["affine_terms"]          = at;
+    rep.root["time_s"]["snapshots"]   = (double)(t1 - tSnap0);
+    rep.root["time_s"]["total"]       = (double)(t1 - t0);
+    rep.root["nranks"]                = (int)wsize;
+    rep.root["subcomms"]              = (long long)k;
+    rep.root["snapshots"]             = snapPath;
+    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), snapPath));
+  }
+  PetscCall(PetscSubcommDestroy(&psub));
+  PetscCall(rep.Write(world, reportPath));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
