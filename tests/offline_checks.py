@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""Checks of the offline snapshot stage, run by ctest (tests/offline.cmake).
+
+  ring        the seed's set-up: ring_on_block, 21 training radii, on 1 rank and on 2 ranks with 2
+              subcommunicators: identical snapshot files (u, lambda, contact data).
+  half_disks  2 parameters (lower radius, imposed displacement) on a 5 x 5 grid, 2 ranks.
+  resume      a run killed (SIGKILL) after a few snapshots, resumed with -snapshots_restart: only the
+              missing ones are solved and the file equals a clean run's.
+  mismatch    a snapshot file from another scene / parameter box is refused with a clear error.
+"""
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+FAILED = []
+os.environ["HDF5_USE_FILE_LOCKING"] = "FALSE"  # read while another process writes
+
+
+def check(cond, msg):
+    print(("  ok    " if cond else "  FAIL  ") + msg)
+    if not cond:
+        FAILED.append(msg)
+
+
+def cmd(args, np_, opts, extra):
+    return ["mpirun", "-n", str(np_), args.exe, "offline", "-options_file", opts, "-offline_stop", "snapshots"] + extra
+
+
+def run(args, np_, opts, extra, expect_ok=True):
+    c = cmd(args, np_, opts, extra)
+    p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if expect_ok and p.returncode != 0:
+        print(p.stdout[-4000:])
+        sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
+    return p
+
+
+def report(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def arrays(path):
+    with h5py.File(path, "r") as f:
+        out = {k: np.array(f["snapshots/" + k]) for k in ("u", "lambda", "mu", "done", "kacanov_iterations")}
+        if "snapshots/extra" in f:
+            for k in f["snapshots/extra"]:
+                out["extra/" + k] = np.array(f["snapshots/extra/" + k])
+    return out
+
+
+def compare(a, b, tol, what):
+    for k in ("u", "lambda", "mu", "extra/contact_K", "extra/contact_gap", "extra/contact_dofs"):
+        if k not in a:
+            continue
+        scale = max(np.max(np.abs(a[k])), 1e-300)
+        d = np.max(np.abs(a[k] - b[k])) / scale
+        check(d <= tol, "%s: %s max rel. difference %.1e <= %g" % (what, k, d, tol))
+    check(np.array_equal(a["done"], b["done"]), "%s: same done flags" % what)
+
+
+def ring(args):
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    base = ["-train_type", "grid", "-train_size", "21"]
+    run(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", d + "/s1.h5", "-report", d + "/r1.json"])
+    run(args, 2, "runs/ring_on_block.opts", base + ["-snapshots", d + "/s2.h5", "-report", d + "/r2.json", "-snapshots_subcomm", "2", "-snapshots_monitor"])
+    r1, r2 = report(d + "/r1.json"), report(d + "/r2.json")
+    for r, n in ((r1, 1), (r2, 2)):
+        print("  np %d: %d solves, Kacanov its %s, snapshots %.2f s, total %.2f s, subcomms %d"
+              % (n, r["fom_solves"], r["kacanov_iterations"], r["time_s"]["snapshots"], r["time_s"]["total"], r["subcomms"]))
+        check(r["ntrain"] == 21 and r["fom_solves"] == 21 and r["resumed"] == 0, "np %d: 21 training radii solved" % n)
+        check(r["kacanov_iterations"]["max"] <= 15, "np %d: at most 15 Kacanov iterations" % n)
+        check(r["affine_terms"]["A"] == 1 and r["affine_terms"]["f"] == 1, "np %d: affine terms A 1, f 1 (2D dilation leaves the stiffness unchanged)" % n)
+    check(r2["subcomms"] == 2 and r2["nranks"] == 2, "np 2 ran with 2 subcommunicators")
+    a1, a2 = arrays(d + "/s1.h5"), arrays(d + "/s2.h5")
+    check(np.all(a1["done"] == 1), "all 21 snapshots done")
+    mu = a1["mu"][:, 0]
+    check(np.allclose(mu, 0.95 + 0.01 * np.arange(21), rtol=0, atol=1e-14), "training radii 0.95, 0.96, ..., 1.15")
+    compare(a1, a2, 1e-10, "np1 vs np2 (2 subcomms)")
+    check(np.all(a1["lambda"] >= 0), "multipliers >= 0")
+
+
+def half_disks(args):
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    run(args, 2, "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "5", "-snapshots", d + "/s.h5", "-report", d + "/r.json"])
+    r = report(d + "/r.json")
+    print("  half_disks: %d solves, Kacanov its %s, snapshots %.2f s, affine terms %s" % (r["fom_solves"], r["kacanov_iterations"], r["time_s"]["snapshots"], {k: r["affine_terms"][k] for k in ("A", "f")}))
+    check(r["ntrain"] == 25 and r["nparams"] == 2 and r["fom_solves"] == 25, "5 x 5 grid of (radius, displacement) solved")
+    a = arrays(d + "/s.h5")
+    check(np.all(a["done"] == 1), "all 25 snapshots done")
+    check(len(np.unique(a["mu"][:, 0])) == 5 and len(np.unique(a["mu"][:, 1])) == 5, "5 radii x 5 displacements")
+    check(r["affine_terms"]["f"] == 1, "f has one term (the lifting, scaled by the displacement)")
+    check(np.all(a["lambda"] >= 0) and np.all(np.max(a["lambda"], axis=1) > 0), "every snapshot is in contact, multipliers >= 0")
+
+
+def resume(args):
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    base = ["-train_type", "grid", "-train_size", "21"]
+    run(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", d + "/clean.h5"])
+    path = d + "/killed.h5"
+    # the job is the executable itself (singleton MPI), so that SIGKILL reaches the process that writes
+    c = cmd(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", path])[3:]
+    p = subprocess.Popen(c, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    ndone, t0 = 0, time.time()
+    while time.time() - t0 < 120 and p.poll() is None:
+        try:
+            with h5py.File(path, "r") as f:
+                ndone = int(np.sum(np.array(f["snapshots/done"])))
+        except Exception:
+            ndone = 0
+        if ndone >= 5:
+            p.send_signal(signal.SIGKILL)
+            break
+        time.sleep(0.05)
+    p.wait()
+    check(ndone >= 5 and ndone < 21, "run killed (SIGKILL) with %d of 21 snapshots done" % ndone)
+    with h5py.File(path, "r") as f:
+        kept = int(np.sum(np.array(f["snapshots/done"])))
+    check(kept >= ndone, "the killed file is readable and keeps its %d finished snapshots" % kept)
+    run(args, 2, "runs/ring_on_block.opts", base + ["-snapshots", path, "-snapshots_restart", "-report", d + "/r.json"])
+    r = report(d + "/r.json")
+    check(r["resumed"] == kept and r["fom_solves"] == 21 - kept, "restart solved only the missing %d (resumed %d)" % (r["fom_solves"], r["resumed"]))
+    compare(arrays(d + "/clean.h5"), arrays(path), 1e-10, "resumed vs clean run")
+    leftovers = [f for f in os.listdir(d) if ".tmp." in f]
+    check(not leftovers, "no temporary files left (%s)" % leftovers)
+
+
+def mismatch(args):
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    run(args, 1, "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-snapshots", d + "/s.h5"])
+    cases = [("another scene", "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "3"]),
+             ("another parameter box", "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-mu_max", "1.1"]),
+             ("another mesh", "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-mesh_refine", "1"])]
+    for what, opts, extra in cases:
+        p = run(args, 1, opts, extra + ["-snapshots", d + "/s.h5", "-snapshots_restart"], expect_ok=False)
+        msg = [l for l in p.stdout.splitlines() if "error" in l.lower()][:1]
+        print("  %s -> exit %d: %s" % (what, p.returncode, msg[0] if msg else p.stdout[-300:]))
+        check(p.returncode != 0 and "s.h5" in p.stdout and "differs" in p.stdout, "%s: refused, the message names the file and the field that differs" % what)
+        check("Segmentation" not in p.stdout and "SEGV" not in p.stdout, "%s: no crash" % what)
+    with h5py.File(d + "/s.h5", "r") as f:
+        check(int(np.sum(np.array(f["snapshots/done"]))) == 3, "the refused file is untouched")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch"])
+    ap.add_argument("--exe", required=True)
+    args = ap.parse_args()
+    globals()[args.check](args)
+    if FAILED:
+        print("%d check(s) failed" % len(FAILED))
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
