@@ -1,0 +1,281 @@
+// src/io/h5util.hpp: small RAII and error-context helpers over the HDF5 C API shared by the files
+// rbcontact writes on rank 0 (snapshot file, ROM file): identifiers closed on scope exit, errors kept
+// as one message naming the file and the dataset, whole-dataset and row I/O, attributes, flush+fsync.
+// Internal (not installed): include only from src/io/*.cpp.
+#pragma once
+#include <hdf5.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace rbc {
+namespace h5 {
+
+// Silences HDF5's automatic error-stack printing while alive (we report errors ourselves), then
+// restores the previous handler.
+class H5Quiet {
+public:
+  H5Quiet()
+  {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  H5Quiet(const H5Quiet &)            = delete;
+  H5Quiet &operator=(const H5Quiet &) = delete;
+
+private:
+  H5E_auto2_t func_ = nullptr;
+  void       *data_ = nullptr;
+};
+
+// Owns an HDF5 identifier (closed on destruction; files are closed explicitly where it matters).
+class H5Id {
+public:
+  H5Id() = default;
+  H5Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  H5Id(const H5Id &)            = delete;
+  H5Id &operator=(const H5Id &) = delete;
+  H5Id(H5Id &&o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+  H5Id &operator=(H5Id &&o) noexcept
+  {
+    if (this != &o) {
+      Reset();
+      id_   = o.id_;
+      close_ = o.close_;
+      o.id_ = -1;
+    }
+    return *this;
+  }
+  ~H5Id() { Reset(); }
+  void Reset()
+  {
+    if (id_ >= 0 && close_) close_(id_);
+    id_ = -1;
+  }
+  hid_t Release()
+  {
+    hid_t id = id_;
+    id_      = -1;
+    return id;
+  }
+  bool  ok() const { return id_ >= 0; }
+  hid_t get() const { return id_; }
+
+private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+inline herr_t WalkErrors(unsigned n, const H5E_error2_t *e, void *ctx)
+{
+  auto *v = static_cast<std::vector<std::string> *>(ctx);
+  if (e && e->desc && *e->desc) v->push_back(e->desc);
+  return 0;
+}
+
+// The outermost and innermost descriptions of HDF5's error stack (then clears it).
+inline std::string H5Detail()
+{
+  std::vector<std::string> d;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, WalkErrors, &d);
+  H5Eclear2(H5E_DEFAULT);
+  if (d.empty()) return std::string();
+  return d.size() == 1 || d.front() == d.back() ? d.front() : d.front() + ": " + d.back();
+}
+
+// Error context: the first failure is kept as a message naming the file (and the dataset).
+struct Ctx {
+  std::string what; // "Snapshot file 'x.h5'"
+  std::string err;
+  bool Fail(const std::string &msg, bool hdf5 = true)
+  {
+    if (err.empty()) {
+      err = what + ": " + msg;
+      if (hdf5) {
+        const std::string d = H5Detail();
+        if (!d.empty()) err += " (HDF5: " + d + ")";
+      }
+    }
+    return false;
+  }
+};
+
+inline bool FileExists(const std::string &path)
+{
+  struct stat st;
+  return stat(path.c_str(), &st) == 0;
+}
+
+inline bool MakeStringType(Ctx &c, size_t len, H5Id *t)
+{
+  *t = H5Id(H5Tcopy(H5T_C_S1), H5Tclose);
+  if (!t->ok() || H5Tset_size(t->get(), len + 1) < 0 || H5Tset_strpad(t->get(), H5T_STR_NULLTERM) < 0) return c.Fail("cannot create a string type");
+  return true;
+}
+
+inline bool WriteAttr(Ctx &c, hid_t obj, const char *name, hid_t ftype, hid_t mtype, const void *buf)
+{
+  H5Id sp(H5Screate(H5S_SCALAR), H5Sclose);
+  if (!sp.ok()) return c.Fail(std::string("cannot create the dataspace of attribute '") + name + "'");
+  H5Id a(H5Acreate2(obj, name, ftype, sp.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("cannot create attribute '") + name + "'");
+  if (H5Awrite(a.get(), mtype, buf) < 0) return c.Fail(std::string("cannot write attribute '") + name + "'");
+  return true;
+}
+
+inline bool WriteStringAttr(Ctx &c, hid_t obj, const char *name, const std::string &v)
+{
+  H5Id t;
+  if (!MakeStringType(c, v.size(), &t)) return false;
+  return WriteAttr(c, obj, name, t.get(), t.get(), v.c_str());
+}
+
+inline bool AttrExists(Ctx &c, hid_t obj, const char *name, bool *exists)
+{
+  const htri_t e = H5Aexists(obj, name);
+  if (e < 0) return c.Fail(std::string("cannot query attribute '") + name + "'");
+  *exists = e > 0;
+  return true;
+}
+
+inline bool ReadAttr(Ctx &c, hid_t obj, const char *name, hid_t mtype, void *buf)
+{
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("missing attribute '") + name + "'");
+  if (H5Aread(a.get(), mtype, buf) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+  return true;
+}
+
+// Reads a string attribute (fixed-length or variable-length).
+inline bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
+{
+  H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("missing attribute '") + name + "'");
+  H5Id t(H5Aget_type(a.get()), H5Tclose);
+  if (!t.ok()) return c.Fail(std::string("cannot get the type of attribute '") + name + "'");
+  if (H5Tget_class(t.get()) != H5T_STRING) return c.Fail(std::string("attribute '") + name + "' is not a string", false);
+  const htri_t vlen = H5Tis_variable_str(t.get());
+  if (vlen < 0) return c.Fail(std::string("cannot inspect attribute '") + name + "'");
+  if (vlen) {
+    H5Id m(H5Tcopy(H5T_C_S1), H5Tclose);
+    if (!m.ok() || H5Tset_size(m.get(), H5T_VARIABLE) < 0) return c.Fail("cannot create a string type");
+    char *p = nullptr;
+    if (H5Aread(a.get(), m.get(), &p) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+    *v = p ? p : "";
+    H5free_memory(p);
+    return true;
+  }
+  const size_t size = H5Tget_size(t.get());
+  if (size == 0) return c.Fail(std::string("cannot get the size of attribute '") + name + "'");
+  std::vector<char> buf(size + 1, 0);
+  if (H5Aread(a.get(), t.get(), buf.data()) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
+  *v = std::string(buf.data());
+  return true;
+}
+
+// Creates a dataset of its final shape, contiguous, allocated now; fill: the fill value (memory
+// type mtype), or nullptr for no fill (the space is allocated but never initialised: sparse).
+inline bool CreateDataset(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *fill, H5Id *out)
+{
+  H5Id sp(H5Screate_simple((int)dims.size(), dims.data(), nullptr), H5Sclose);
+  if (!sp.ok()) return c.Fail("cannot create the dataspace of dataset " + name);
+  H5Id dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  if (!dcpl.ok() || H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY) < 0) return c.Fail("cannot set the layout of dataset " + name);
+  if (fill) {
+    if (H5Pset_fill_value(dcpl.get(), mtype, fill) < 0 || H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_IFSET) < 0) return c.Fail("cannot set the fill value of dataset " + name);
+  } else if (H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) < 0) return c.Fail("cannot set the fill time of dataset " + name);
+  H5Id lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  if (!lcpl.ok() || H5Pset_create_intermediate_group(lcpl.get(), 1) < 0) return c.Fail("cannot create a link property list for " + name);
+  H5Id d(H5Dcreate2(file, name.c_str(), ftype, sp.get(), lcpl.get(), dcpl.get(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("cannot create dataset " + name);
+  if (out) *out = std::move(d);
+  return true;
+}
+
+inline bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hsize_t> *dims)
+{
+  H5Id sp(H5Dget_space(d), H5Sclose);
+  if (!sp.ok()) return c.Fail("cannot get the dataspace of dataset " + name);
+  const int rank = H5Sget_simple_extent_ndims(sp.get());
+  if (rank < 0) return c.Fail("cannot get the rank of dataset " + name);
+  dims->assign((size_t)rank, 0);
+  if (rank > 0 && H5Sget_simple_extent_dims(sp.get(), dims->data(), nullptr) < 0) return c.Fail("cannot get the shape of dataset " + name);
+  return true;
+}
+
+inline std::string ShapeString(const std::vector<hsize_t> &dims)
+{
+  std::string s;
+  for (hsize_t d : dims) s += (s.empty() ? "" : " x ") + std::to_string((unsigned long long)d);
+  return s.empty() ? "scalar" : s;
+}
+
+// Whole-dataset write / read with a shape check.
+inline bool WriteWhole(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *buf)
+{
+  H5Id d;
+  if (!CreateDataset(c, file, name, ftype, dims, mtype, nullptr, &d)) return false;
+  hsize_t n = 1;
+  for (hsize_t x : dims) n *= x;
+  if (n > 0 && H5Dwrite(d.get(), mtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) return c.Fail("cannot write dataset " + name);
+  return true;
+}
+
+inline bool ReadWhole(Ctx &c, hid_t file, const std::string &name, const std::vector<hsize_t> &expect, std::vector<double> *v)
+{
+  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("missing dataset " + name);
+  std::vector<hsize_t> dims;
+  if (!DatasetDims(c, d.get(), name, &dims)) return false;
+  if (dims != expect) return c.Fail("dataset " + name + " has shape " + ShapeString(dims) + ", expected " + ShapeString(expect) + " (corrupt file?)", false);
+  hsize_t n = 1;
+  for (hsize_t x : dims) n *= x;
+  v->assign(n, 0.0);
+  if (n > 0 && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->data()) < 0) return c.Fail("cannot read dataset " + name);
+  return true;
+}
+
+// Reads or writes row `row` (ncols values) of a 1D (ncols = 1) or 2D dataset.
+inline bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsize_t row, hsize_t ncols, void *buf, bool write)
+{
+  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.ok()) return c.Fail("missing dataset " + name);
+  H5Id fs(H5Dget_space(d.get()), H5Sclose);
+  if (!fs.ok()) return c.Fail("cannot get the dataspace of dataset " + name);
+  const int rank = H5Sget_simple_extent_ndims(fs.get());
+  hsize_t   dims[2] = {0, 0};
+  if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(fs.get(), dims, nullptr) < 0) return c.Fail("dataset " + name + " is not 1D or 2D");
+  const hsize_t cols = rank == 1 ? 1 : dims[1];
+  if (cols != ncols || row >= dims[0]) {
+    std::ostringstream m;
+    m << "dataset " << name << " has shape " << ShapeString(std::vector<hsize_t>(dims, dims + rank)) << "; cannot " << (write ? "write" : "read") << " row " << row << " of length " << ncols;
+    return c.Fail(m.str(), false);
+  }
+  if (ncols == 0) return true;
+  const hsize_t start[2] = {row, 0}, count[2] = {1, ncols};
+  if (H5Sselect_hyperslab(fs.get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) return c.Fail("cannot select row of dataset " + name);
+  H5Id ms(H5Screate_simple(1, &ncols, nullptr), H5Sclose);
+  if (!ms.ok()) return c.Fail("cannot create a memory dataspace for " + name);
+  const herr_t st = write ? H5Dwrite(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf) : H5Dread(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf);
+  if (st < 0) return c.Fail(std::string("cannot ") + (write ? "write" : "read") + " row " + std::to_string((unsigned long long)row) + " of dataset " + name);
+  return true;
+}
+
+// H5Fflush, then fsync of the file descriptor (data reaches the disk, not only the OS cache).
+inline bool FlushSync(Ctx &c, hid_t file)
+{
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) return c.Fail("H5Fflush failed");
+  void *handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) return c.Fail("cannot get the file descriptor");
+  if (fsync(*static_cast<int *>(handle)) != 0) return c.Fail(std::string("fsync failed: ") + std::strerror(errno), false);
+  return true;
+}
+
+
+} // namespace h5
+} // namespace rbc
