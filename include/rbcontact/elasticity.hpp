@@ -36,8 +36,14 @@ public:
   PetscErrorCode SetBodyAux(const std::vector<std::vector<PetscReal>> &perBody);
   // ... and the load scales: per Dirichlet boundary, body force, per traction boundary.
   PetscErrorCode SetLoadScales(const std::vector<PetscReal> &dirichlet, PetscReal bodyForce, const std::vector<PetscReal> &traction);
-  // Aux layout: L, G, G^-1 (dim x dim), body-force scale, then the effective tensor T (dim^4).
-  PetscInt AuxSize() const { return dim * dim * dim * dim + 3 + dim * dim; }
+  // Aux layout: L, G, G^-1 (dim x dim), body-force scale, mass coefficient, then the effective
+  // tensor T (dim^4). The mass term (zero in the physical state) serves the H1 inner product.
+  PetscInt AuxBodyForceIndex() const { return 2 + dim * dim; }
+  PetscInt AuxMassIndex() const { return 3 + dim * dim; }
+  PetscInt AuxTensorOffset() const { return 4 + dim * dim; }
+  PetscInt AuxSize() const { return AuxTensorOffset() + dim * dim * dim * dim; }
+  // The H1 inner-product matrix (vector mass + vector Laplacian) on the reference mesh, free dofs.
+  PetscErrorCode AssembleH1(Mat *M);
   // The physical aux values of a body with moduli (E, nu) under the map a.
   void PhysicalAux(PetscReal E, PetscReal nu, const Affine &a, std::vector<PetscReal> *aux) const;
   // The material of body b at mu.

@@ -4,9 +4,11 @@
 // BVDot, its dense symmetric eigendecomposition (LAPACK), and the modes X V S^{-1} by BVMultInPlace;
 // correct in parallel. -pod_inner l2 may instead use SVDSetOperators directly (-pod_method svd,
 // -pod_svd_type ...). Size: -pod_tol (relative energy left out, default 1e-8) or -pod_n (count).
+// Details, options, the sign convention and measured accuracy: docs/pod.md.
 #pragma once
 #include <petscmat.h>
 #include <slepcbv.h>
+#include <string>
 #include <vector>
 
 namespace rbc {
@@ -17,11 +19,40 @@ struct PODResult {
   PetscInt               N = 0;
   PetscReal              energyCaptured = 0; // sum_{i<N} s_i^2 / sum s_i^2
   PetscReal              orthonormalityError = 0; // max |V^T M V - I|
+  // Additions (pod.cpp):
+  PetscInt               rank = 0;          // numerical rank: #{i : s_i > rankTol * s_0} (N <= rank)
+  PetscReal              rankTol = 0;       // the relative threshold used (-pod_rank_tol)
+  PetscReal              orthonormalityErrorInitial = 0; // max |V^T M V - I| of X V S^{-1} before any re-orthonormalization
+  PetscBool              reorthonormalized = PETSC_FALSE; // BVOrthogonalize was applied (initial error > 1e-10)
+  std::string            method = "bv";     // "bv" (method of snapshots) or "svd" (SLEPc SVD, l2 only)
+  PODResult() = default;
+  PODResult(const PODResult &) = delete;
+  PODResult &operator=(const PODResult &) = delete;
+  PODResult(PODResult &&o) noexcept;
+  PODResult &operator=(PODResult &&o) noexcept;
   ~PODResult();
 };
 
+// The inner product selected by -pod_inner energy|h1|l2 (default energy). The caller builds M from it:
+// energy -> the reference stiffness A_ref, h1 -> an H1 Gram matrix, l2 -> M = nullptr.
+enum class PODInner { Energy, H1, L2 };
+PetscErrorCode PODInnerFromOptions(MPI_Comm comm, PODInner *inner);
+const char    *PODInnerName(PODInner inner);
+
 // snapshots: columns = snapshot vectors (same layout as M's rows, e.g. DMCreateGlobalVector), M the
 // inner-product matrix (nullptr: l2). Options prefix pod_.
+//   -pod_method bv|svd        bv (default): method of snapshots with BV; svd: SLEPc SVD of the dense
+//                             snapshot matrix (l2 only: M must be nullptr), -pod_svd_type etc.
+//   -pod_n <N> | -pod_tol <t> the size (count, or relative energy left out; -pod_n wins), both capped
+//                             by the numerical rank
+//   -pod_rank_tol <r>         s_i <= r s_0 counts as zero (default 10 sqrt(m eps))
+//   -pod_sv_out <file>        rank 0 writes the singular values (one per line, %.17e) to <file>
+//   -pod_view                 prints a summary on the snapshots' communicator
+// Collective on the snapshots' communicator. Replaces any previous content of *res.
 PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res);
+
+// M-norm projection error of each snapshot onto span(modes): ||x - V V^T M x||_M, M the modes' BV
+// matrix (l2 if none). sum_j err_j^2 = sum_{i >= N} s_i^2 (the left-out energy).
+PetscErrorCode PODProjectionErrors(BV modes, const std::vector<Vec> &snapshots, std::vector<PetscReal> *errors);
 
 } // namespace rbc

@@ -118,7 +118,7 @@ static void GroupProportional(const std::vector<std::vector<PetscReal>> &v, std:
 PetscErrorCode AffineDecomposition::Build(Elasticity &elas, const GeometryMap *map)
 {
   const SceneSpec &scene = elas.scene;
-  const PetscInt   dim   = elas.dim, d4 = dim * dim * dim * dim, t0 = 3 + dim * dim;
+  const PetscInt   dim   = elas.dim, d4 = dim * dim * dim * dim, t0 = elas.AuxTensorOffset();
   const size_t     nb    = scene.bodies.size();
   PetscInt         nsamples = 12;
 
@@ -199,7 +199,7 @@ PetscErrorCode AffineDecomposition::Build(Elasticity &elas, const GeometryMap *m
   if (!scene.bodyForce.empty() && !scene.bodyForceF0)
     for (size_t b = 0; b < nb; ++b) {
       std::vector<std::vector<PetscReal>> aux = zeroAux;
-      aux[b][2 + dim * dim] = 1.0; // body-force scale on body b only
+      aux[b][elas.AuxBodyForceIndex()] = 1.0; // body-force scale on body b only
       PetscCall(elas.SetBodyAux(aux));
       PetscCall(elas.SetLoadScales(std::vector<PetscReal>(nd, 0.0), 1.0, std::vector<PetscReal>(nt, 0.0)));
       Vec f = nullptr;

@@ -19,7 +19,8 @@ static const PetscInt kMaxTractions = 8;
 #define RBC_AUX_G 1
 #define RBC_AUX_GINV 2
 #define RBC_AUX_BF (2 + dim * dim)
-#define RBC_AUX_T (3 + dim * dim)
+#define RBC_AUX_M (3 + dim * dim)
+#define RBC_AUX_T (4 + dim * dim)
 
 static void f0_body_force(RBC_POINTWISE_ARGS, PetscScalar f0[])
 {
@@ -35,6 +36,12 @@ static void f1_stress(RBC_POINTWISE_ARGS, PetscScalar f1[])
     for (PetscInt eb = 0; eb < dim * dim; ++eb) s += a[RBC_AUX_T + ca * dim * dim + eb] * u_x[eb];
     f1[ca] = s;
   }
+}
+
+// Mass term of the H1 inner product (coefficient zero in the physical state).
+static void g0_mass(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g0[])
+{
+  for (PetscInt c = 0; c < dim; ++c) g0[c * dim + c] += a[RBC_AUX_M];
 }
 
 static void g3_stiffness(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g3[])
@@ -181,12 +188,12 @@ void Elasticity::PhysicalAux(PetscReal E, PetscReal nu, const Affine &a, std::ve
           PetscReal v = 0;
           for (PetscInt d = 0; d < dim; ++d)
             for (PetscInt f = 0; f < dim; ++f) v += C(c, d, e, f) * Gi[aa * dim + d] * Gi[b * dim + f];
-          (*aux)[3 + dim * dim + ((c * dim + aa) * dim + e) * dim + b] = J * v;
+          (*aux)[AuxTensorOffset() + ((c * dim + aa) * dim + e) * dim + b] = J * v;
         }
   (*aux)[0] = L;
   (*aux)[1] = G;
   for (PetscInt k = 0; k < dim * dim; ++k) (*aux)[2 + k] = Gi[k];
-  (*aux)[2 + dim * dim] = J; // body force scale
+  (*aux)[AuxBodyForceIndex()] = J; // body force scale
 }
 
 PetscErrorCode Elasticity::SetBodyAux(const std::vector<std::vector<PetscReal>> &perBody)
@@ -294,7 +301,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   PetscCall(PetscFEDestroy(&fe));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSSetResidual(ds, 0, (scene.bodyForceF0 ? scene.bodyForceF0 : (!scene.bodyForce.empty() ? f0_body_force : NULL)), f1_stress));
-  PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_stiffness));
+  PetscCall(PetscDSSetJacobian(ds, 0, 0, g0_mass, NULL, NULL, g3_stiffness));
 
   // Constants: body force and tractions
   PetscCheck((PetscInt)scene.tractions.size() <= kMaxTractions, comm, PETSC_ERR_SUP, "-bc_traction: at most %" PetscInt_FMT " traction boundaries", kMaxTractions);
@@ -401,6 +408,21 @@ PetscErrorCode Elasticity::AssembleMatrix(Mat *A)
   PetscCall(VecSet(zero, 0.0));
   PetscCall(SNESComputeJacobian(snes_, zero, *A, *A));
   PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::AssembleH1(Mat *M)
+{
+  PetscFunctionBeginUser;
+  std::vector<std::vector<PetscReal>> aux(scene.bodies.size(), std::vector<PetscReal>(AuxSize(), 0.0));
+  for (auto &a : aux) {
+    a[AuxMassIndex()] = 1.0;
+    for (PetscInt c = 0; c < dim; ++c)
+      for (PetscInt d = 0; d < dim; ++d) a[AuxTensorOffset() + ((c * dim + d) * dim + c) * dim + d] = 1.0; // grad u : grad v
+  }
+  PetscCall(SetBodyAux(aux));
+  PetscCall(AssembleMatrix(M));
+  PetscCall(SetMu(ParamValues(scene)));
   PetscFunctionReturn(0);
 }
 

@@ -1,0 +1,35 @@
+// rbcontact/rom_file.hpp: the ROM file (one HDF5 file holding everything the online stage needs):
+// root attributes (format "rbcontact-rom", format_version, provenance) and named float64 datasets.
+// Written by rank 0 only, to a temporary file renamed into place once complete (a killed job never
+// leaves a half-written ROM file). Read back dataset by dataset on any rank.
+// Layout written by the offline stage so far: docs/rom_file.md.
+#pragma once
+#include <petscsys.h>
+#include <string>
+#include <vector>
+
+namespace rbc {
+
+class RomWriter {
+public:
+  void Attr(const std::string &name, const std::string &value) { attrs_.emplace_back(name, value); }
+  // path like "/pod/modes"; dims row-major (the last index fastest), data.size() = prod(dims)
+  void Dataset(const std::string &path, const std::vector<unsigned long long> &dims, const std::vector<double> &data);
+  // Collective: rank 0 writes path (temp file + rename), errors reach every rank.
+  PetscErrorCode Write(MPI_Comm comm, const std::string &path) const;
+
+private:
+  struct Item {
+    std::string                     path;
+    std::vector<unsigned long long> dims;
+    std::vector<double>             data;
+  };
+  std::vector<std::pair<std::string, std::string>> attrs_;
+  std::vector<Item>                                items_;
+};
+
+// Reads a dataset (any rank, independent); errors name the file and the dataset.
+PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, std::vector<unsigned long long> *dims, std::vector<double> *data);
+PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value);
+
+} // namespace rbc

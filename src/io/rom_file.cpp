@@ -1,0 +1,100 @@
+// src/io/rom_file.cpp: writing and reading the ROM file (HDF5 C API on rank 0, atomic rename).
+#include "rbcontact/rom_file.hpp"
+#include "h5util.hpp"
+#include <cstdio>
+
+namespace rbc {
+
+using namespace rbc::h5;
+
+static const char *kRomFormat = "rbcontact-rom";
+
+void RomWriter::Dataset(const std::string &path, const std::vector<unsigned long long> &dims, const std::vector<double> &data)
+{
+  items_.push_back({path, dims, data});
+}
+
+PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
+{
+  PetscMPIInt rank;
+  char        msg[1024] = "";
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    H5Quiet           quiet;
+    Ctx               c{"ROM file '" + path + "'", std::string()};
+    const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+    bool              ok  = true;
+    {
+      H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+      if (!f.ok()) ok = c.Fail("cannot create the file (directory missing or not writable?)");
+      if (ok) ok = WriteStringAttr(c, f.get(), "format", kRomFormat);
+      if (ok) {
+        const int v = 1;
+        ok          = WriteAttr(c, f.get(), "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &v);
+      }
+      for (const auto &a : attrs_)
+        if (ok) ok = WriteStringAttr(c, f.get(), a.first.c_str(), a.second);
+      for (const auto &it : items_) {
+        if (!ok) break;
+        std::vector<hsize_t> dims(it.dims.begin(), it.dims.end());
+        ok = WriteWhole(c, f.get(), it.path, H5T_IEEE_F64LE, dims, H5T_NATIVE_DOUBLE, it.data.data());
+      }
+      if (ok) ok = FlushSync(c, f.get());
+    }
+    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) ok = c.Fail("cannot rename the temporary file into place", false);
+    if (!ok) {
+      std::remove(tmp.c_str());
+      std::snprintf(msg, sizeof msg, "%s", c.err.c_str());
+    }
+  }
+  PetscCallMPI(MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, comm));
+  PetscCheck(!msg[0], comm, PETSC_ERR_FILE_WRITE, "%s", msg);
+  PetscFunctionReturn(0);
+}
+
+static bool OpenRom(Ctx &c, const std::string &path, H5Id *f)
+{
+  if (!FileExists(path)) return c.Fail("does not exist", false);
+  *f = H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  if (!f->ok()) return c.Fail("is not an HDF5 file");
+  std::string fmt;
+  if (!ReadStringAttr(c, f->get(), "format", &fmt)) return false;
+  if (fmt != kRomFormat) return c.Fail("is not a ROM file (format '" + fmt + "')", false);
+  return true;
+}
+
+PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, std::vector<unsigned long long> *dims, std::vector<double> *data)
+{
+  H5Quiet quiet;
+  Ctx     c{"ROM file '" + path + "'", std::string()};
+  H5Id    f;
+
+  PetscFunctionBeginUser;
+  bool ok = OpenRom(c, path, &f);
+  if (ok) {
+    H5Id d(H5Dopen2(f.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    std::vector<hsize_t> hd;
+    if (!d.ok()) ok = c.Fail("missing dataset " + name, false);
+    if (ok) ok = DatasetDims(c, d.get(), name, &hd);
+    if (ok) ok = ReadWhole(c, f.get(), name, hd, data);
+    dims->assign(hd.begin(), hd.end());
+  }
+  PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", c.err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value)
+{
+  H5Quiet quiet;
+  Ctx     c{"ROM file '" + path + "'", std::string()};
+  H5Id    f;
+
+  PetscFunctionBeginUser;
+  bool ok = OpenRom(c, path, &f) && ReadStringAttr(c, f.get(), name.c_str(), value);
+  PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", c.err.c_str());
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
