@@ -149,9 +149,80 @@ def mismatch(args):
         check(int(np.sum(np.array(f["snapshots/done"]))) == 3, "the refused file is untouched")
 
 
+def bases(args):
+    """POD + the four dual types on the seed's set-up; 1 vs 2 ranks; nonnegativity; orthonormality."""
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    base = ["-train_type", "grid", "-train_size", "21", "-snapshots", d + "/s.h5", "-pod_tol", "1e-8", "-dual_tol", "1e-3", "-dual_tol_relative"]
+    table = []
+    for t in ("cpg", "mcpg", "angle", "nmf"):
+        extra = ["-dual_type", t] + (["-dual_r", "8"] if t == "nmf" else [])
+        reps = {}
+        for np_ in (1, 2):
+            rom = "%s/rom_%s_np%d.h5" % (d, t, np_)
+            run(args, np_, "runs/ring_on_block.opts", base + extra + ["-offline_stop", "bases", "-rom", rom, "-report", "%s/%s_np%d.json" % (d, t, np_)])
+            reps[np_] = (report("%s/%s_np%d.json" % (d, t, np_)), rom)
+        (r1, rom1), (r2, rom2) = reps[1], reps[2]
+        dd = r1["dual"]
+        table.append((t, dd["r"], dd["train_max_err"], dd["train_max_rel_err"], (dd["gram_cond"] or [float("nan")])[-1], r1["nnls"]["retries"]))
+        check(r1["pod"]["orthonormality_error"] <= 1e-10, "%s: POD modes orthonormal in the energy inner product (%.1e)" % (t, r1["pod"]["orthonormality_error"]))
+        with h5py.File(rom1, "r") as f1, h5py.File(rom2, "r") as f2:
+            W1, W2 = np.array(f1["dual/basis"]), np.array(f2["dual/basis"])
+            V1, V2 = np.array(f1["pod/modes"]), np.array(f2["pod/modes"])
+            s1, s2 = np.array(f1["pod/singular_values"]), np.array(f2["pod/singular_values"])
+        check(W1.min() >= 0, "%s: every dual basis vector is nonnegative (min entry %.3e)" % (t, W1.min()))
+        check(W1.shape == W2.shape and np.max(np.abs(W1 - W2)) <= 1e-10 * np.max(np.abs(W1)), "%s: dual basis identical on 1 and 2 ranks" % t)
+        check(np.max(np.abs(s1 - s2)) <= 1e-10 * s1[0], "%s: POD singular values identical on 1 and 2 ranks" % t)
+        if V1.shape == V2.shape:
+            sg = np.sign(np.sum(V1 * V2, axis=1))[:, None]
+            dv = np.max(np.abs(V1 - sg * V2)) / np.max(np.abs(V1))
+        else:
+            dv = float("inf")
+        check(dv <= 1e-8, "%s: POD modes identical up to sign on 1 and 2 ranks (%.1e)" % (t, dv))
+    print("  ring_on_block, 21 radii: dual type | R | max err | max rel err | cond(Gram) | NNLS retries")
+    for row in table:
+        print("    %-6s %3d  %.3e  %.3e  %.2e  %d" % row)
+    for t, r, e, er, c, _ in table:
+        if t in ("cpg", "mcpg"):
+            check(er <= 1e-3 + 1e-12, "%s reaches the relative tolerance 1e-3 (%.2e) with R = %d" % (t, er, r))
+
+
+def dualbasis_import(args):
+    """`dualbasis` on a multiplier matrix written by another code (HDF5 dataset and the transposed layout)."""
+    d = tempfile.mkdtemp(prefix="rbc_off_")
+    x = np.linspace(-1, 1, 120)
+    cols = []
+    for k in range(15):
+        a, c = 0.3 + 0.02 * k, 0.01 * (k - 7)
+        cols.append(np.sqrt(np.maximum(0.0, 1 - ((x - c) / a) ** 2)) * (1 + 0.1 * k))
+    L = np.array(cols).T  # rows = multipliers, columns = snapshots
+    with h5py.File(d + "/ext.h5", "w") as f:
+        f["lambda"] = L
+    c = [args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/lambda", "-dual_type", "cpg", "-dual_tol", "1e-3", "-dual_tol_relative", "-report", d + "/r.json", "-dual_out", d + "/w.h5"]
+    p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    print("  " + p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "  (no output)")
+    check(p.returncode == 0, "dualbasis ran on an imported HDF5 dataset (exit %d)" % p.returncode)
+    if p.returncode != 0:
+        print(p.stdout[-3000:])
+        return
+    r = report(d + "/r.json")
+    check(r["R_fom"] == 120 and r["m"] == 15, "read 120 multipliers x 15 snapshots")
+    check(r["dual"]["train_max_rel_err"] <= 1e-3 + 1e-12, "cpg reaches 1e-3 relative (%.2e, R = %d)" % (r["dual"]["train_max_rel_err"], r["dual"]["r"]))
+    with h5py.File(d + "/w.h5", "r") as f:
+        W = np.array(f["dual/basis"])
+    check(W.min() >= 0 and W.shape == (r["dual"]["r"], 120), "basis written, nonnegative, %s" % (W.shape,))
+    bad = L.copy()
+    bad[3, 2] = -1.0
+    with h5py.File(d + "/neg.h5", "w") as f:
+        f["lambda"] = bad
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/neg.h5:/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "negative" in p.stdout, "negative multipliers are refused with a clear error")
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/nosuch"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "nosuch" in p.stdout, "a missing dataset is an error naming it")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

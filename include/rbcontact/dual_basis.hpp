@@ -12,8 +12,10 @@
 //   mcpg:  modified CPG (Niakh, Drouet, Ehrlacher, Ern 2022): adds the normalized nonnegative remainder
 //          theta - Upsilon, Upsilon = argmin over the cone intersected with {Upsilon <= theta}
 //   -dual_max_r caps the size; -dual_monitor prints step, selected snapshot, largest error, cond(Gram).
+//   Implementation: src/reduction/nnls.cpp (NNLS), src/reduction/dual_basis.cpp (the four bases);
+//   algorithms, options and measured numbers: docs/dual_basis.md.
 #pragma once
-#include <petscsys.h>
+#include <petsctao.h>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,18 @@ struct DenseMatrix {
 struct NNLSStats {
   PetscInt  solves = 0, retries = 0, failures = 0;
   PetscReal maxKKT = 0; // worst scaled KKT residual over the solves
+  PetscInt  taoIterations = 0, polishIterations = 0; // totals over the solves
+};
+
+// What one NNLS solve did (optional output of NNLSSolver::Solve).
+struct NNLSInfo {
+  PetscInt           attempts = 0;         // 1: first try accepted; 2: gatol/10 retry; 3: active set alone
+  PetscInt           taoIterations = 0;    // of the accepted attempt (0 if TAO was not used)
+  TaoConvergedReason taoReason = TAO_CONTINUE_ITERATING;
+  PetscInt           polishIterations = 0; // active-set changes of the Lawson-Hanson polish
+  PetscReal          kkt = 0;              // scaled KKT residual (equilibrated problem), see NNLSKKT
+  PetscReal          residual = 0;         // ||Q x - b|| with the original Q and b
+  PetscBool          ok = PETSC_TRUE;      // kkt <= -nnls_kkt_tol
 };
 
 // min_{x >= 0} || Q x - b ||_2 with TAO (default BQPIP, options prefix nnls_, -nnls_tao_type) following
@@ -38,26 +52,86 @@ struct NNLSStats {
 // then a Lawson-Hanson active-set polish from TAO's support. Every solve is checked (x >= 0,
 // gradient >= -tol, complementarity <= tol); a failed check is retried (tighter gatol, then the
 // active-set method alone) and counted in stats.
+//   Options (collective on PETSC_COMM_WORLD, so -help lists them): -nnls_method tao|activeset,
+//   -nnls_polish <bool>, -nnls_kkt_tol <1e-9>, -nnls_support_tol <1e-6>, and the Tao's own options
+//   with prefix nnls_ (-nnls_tao_type, -nnls_tao_gatol <1e-7>, -nnls_tao_grtol <0>, -nnls_tao_max_it <200>,
+//   -nnls_ksp_type <preonly>, -nnls_pc_type <cholesky>). Without SetFromOptions the defaults are used.
+// One Tao is kept and reused while the number of columns stays the same (a new one when it changes).
 class NNLSSolver {
 public:
+  NNLSSolver() = default;
+  NNLSSolver(const NNLSSolver &) = delete;
+  NNLSSolver &operator=(const NNLSSolver &) = delete;
+  ~NNLSSolver(); // destroys the cached Tao (call Reset() before PetscFinalize if the solver outlives it)
   PetscErrorCode SetFromOptions(); // reads the nnls_ options
-  PetscErrorCode Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats);
+  // stats (may be null) accumulates; info (may be null) describes this solve.
+  PetscErrorCode Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats, NNLSInfo *info = nullptr);
+  PetscErrorCode Reset(); // destroys the cached Tao and problem data
+
+private:
+  static PetscErrorCode ObjGrad(Tao, Vec, PetscReal *, Vec, void *);
+  PetscErrorCode SetupTao(PetscInt n);
+  PetscErrorCode SolveTao(const std::vector<PetscReal> &H, const std::vector<PetscReal> &c, PetscBool bounded, PetscReal gatolFactor, std::vector<PetscReal> *y, PetscInt *its, TaoConvergedReason *reason);
+
+  PetscBool useTao_ = PETSC_TRUE, polish_ = PETSC_TRUE;
+  PetscReal kktTol_ = 1e-9, supportTol_ = 1e-6;
+  Tao       tao_ = nullptr;
+  Mat       H_   = nullptr;
+  Vec       x_ = nullptr, c_ = nullptr, lo_ = nullptr, hi_ = nullptr;
+  PetscInt  n_ = -1;
+  // equilibrated copy of the last Q (reused while Q does not change, e.g. all snapshots of a greedy step)
+  DenseMatrix            lastQ_, Qs_;
+  std::vector<PetscReal> colNorm_, Hs_;
+  std::vector<PetscInt>  cols_; // nonzero columns of Q
+  bool                   nonnegative_ = true;
 };
+
+// Lawson-Hanson active-set NNLS on Q itself (least-squares subproblems by Householder QR of the passive
+// columns, LAPACK geqrf/ormqr/trtrs): min ||Q x - b|| over x >= 0 for any Q (nonnegative or not,
+// rank-deficient allowed: columns that would make the passive set numerically dependent are rejected).
+// x: on input its positive entries are the starting support (empty: classic Lawson-Hanson from 0);
+// on output the solution. Used as TAO's polish, as the fallback of NNLSSolver and for mcpg's subproblem.
+PetscErrorCode NNLSLawsonHanson(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, PetscInt maxit, PetscInt *iterations);
+
+// Scaled KKT residual of x for min ||Q x - b||, x >= 0, i.e. that of the equilibrated problem (unit
+// columns, ||b|| = 1): with y_j = x_j ||q_j|| / ||b|| and g_j = (Q^T (Q x - b))_j / (||q_j|| ||b||),
+// max_j max(|min(y_j, g_j)|, |y_j g_j|) over the nonzero columns (0 iff optimal; covers x >= 0,
+// g >= 0 on the zeros and complementarity).
+PetscReal NNLSKKT(const DenseMatrix &Q, const std::vector<PetscReal> &b, const std::vector<PetscReal> &x);
 
 struct DualBasisResult {
   std::string           type;
   DenseMatrix           W;          // R x r, every entry >= 0
   std::vector<PetscInt> selected;   // greedy: snapshot index chosen at each step (nmf: empty)
   std::vector<PetscReal> history;   // largest training projection error after each step (greedy), objective per iteration (nmf)
-  std::vector<PetscReal> gramCond;  // condition number of W^T W after each step (cpg, mcpg, angle)
+  std::vector<PetscReal> gramCond;  // condition number of W^T W after each step (cpg, mcpg, angle); nmf: of the final W
   PetscReal             trainMaxErr = 0, trainMaxRelErr = 0; // projection of every snapshot onto the final cone (NNLS), in the chosen norm
   NNLSStats             nnls;
+  std::string           norm = "linf";      // norm of the errors: linf or l2
+  PetscReal             initialMaxErr = 0;  // largest snapshot norm (the error of the empty basis)
+  PetscReal             tolAbs = 0;         // the absolute tolerance the greedy used (after -dual_tol_relative)
+  std::vector<PetscReal> trainErr;          // final projection error of every snapshot (NNLS onto the cone of W)
+  PetscReal             mcpgMinRemainder = 0;    // mcpg: min over steps of min(theta - Upsilon) / ||theta|| before clipping (>= -1e-12)
+  PetscReal             mcpgMaxLDPViolation = 0; // mcpg: max over steps of the LDP solution's violation of Upsilon <= theta (before restoration), / ||theta||
 };
 
 // Builds the dual basis of the snapshot matrix L (R x m, nonnegative) with the options above.
+// Collective on PETSC_COMM_WORLD only for reading options; the computation is local and identical on every rank.
 PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res);
 
 // Projection errors of every column of L onto the cone of W (NNLS), in l-infinity or l2.
-PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats);
+// solver: a configured NNLSSolver to use (null: a local one, configured from the options: collective).
+PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats, NNLSSolver *solver = nullptr);
+
+// mcpg's subproblem: Upsilon = W y, y = argmin ||theta - W y|| s.t. y >= 0, W y <= theta (theta >= 0).
+// Solved as a least-squares problem with inequality constraints by Lawson-Hanson's LSI -> LDP -> NNLS
+// reduction (see docs/dual_basis.md), then made feasible by scaling Upsilon by s <= 1.
+// remainderMin: min_i (theta - Upsilon)_i / ||theta|| of the returned Upsilon (feasibility, >= 0 up to
+// rounding); ldpViolation: max_i (Upsilon - theta)_i / ||theta|| of the LDP solution before the scaling.
+PetscErrorCode ConeLowerProjection(const DenseMatrix &W, const std::vector<PetscReal> &theta, std::vector<PetscReal> *upsilon, PetscReal *remainderMin, PetscReal *ldpViolation = nullptr);
+
+// cond(W^T W) = lambda_max / lambda_min of the Gram matrix (LAPACK syev); inf if lambda_min <= n eps lambda_max
+// (numerically singular: values above ~1e15 are not resolved through the Gram matrix).
+PetscErrorCode GramConditionNumber(const DenseMatrix &W, PetscReal *cond);
 
 } // namespace rbc

@@ -42,7 +42,8 @@ const char    *PODInnerName(PODInner inner);
 // snapshots: columns = snapshot vectors (same layout as M's rows, e.g. DMCreateGlobalVector), M the
 // inner-product matrix (nullptr: l2). Options prefix pod_.
 //   -pod_method bv|svd        bv (default): method of snapshots with BV; svd: SLEPc SVD of the dense
-//                             snapshot matrix (l2 only: M must be nullptr), -pod_svd_type etc.
+//                             snapshot matrix (l2 only: M must be nullptr), -pod_svd_type (default
+//                             trlanczos), -pod_svd_nsv (triplets requested, default m), -pod_svd_*
 //   -pod_n <N> | -pod_tol <t> the size (count, or relative energy left out; -pod_n wins), both capped
 //                             by the numerical rank
 //   -pod_rank_tol <r>         s_i <= r s_0 counts as zero (default 10 sqrt(m eps))

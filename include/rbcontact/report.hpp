@@ -57,6 +57,9 @@ public:
   JsonValue &operator=(JsonValue &&) = default;
 };
 
+// Values at or above PETSc's "infinity" (1e300 here) become NaN, which the JSON writer reports as null.
+std::vector<double> Finite(const std::vector<double> &v);
+
 // Writes text to path atomically (path.tmp.<pid> then rename) on rank 0 of comm; errors name the file.
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text);
 

@@ -10,7 +10,8 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "Usage: rbcontact <stage> [PETSc options]\n"
                            "Stages:\n"
                            "  fom       solve the full-order model of a scene (-options_file runs/<scene>.opts)\n"
-                           "  offline   snapshots over a training set (-offline_stop snapshots -snapshots out.h5)\n"
+                           "  offline   snapshots over a training set (-offline_stop snapshots|bases -snapshots s.h5 -rom rom.h5)\n"
+                           "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
                            "See docs/options.md for the options of each stage.\n";
 
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
@@ -44,8 +45,9 @@ int main(int argc, char **argv)
   PetscErrorCode ierr = 0;
   if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
   else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
+  else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
   else {
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom, offline)\n", stage.c_str()));
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom, offline, dualbasis)\n", stage.c_str()));
     ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
   }
   if (ierr) {

@@ -3,6 +3,7 @@
 // (-snapshots_subcomm k groups of ranks, PetscSubcomm), and stores every finished snapshot in one HDF5
 // file (SnapshotFile) before the next round starts; -snapshots_restart resumes a killed job.
 #include "stages.hpp"
+#include "offline_bases.hpp"
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov.hpp"
@@ -93,9 +94,15 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCallMPI(MPI_Comm_size(world, &wsize));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, NULL));
-  PetscCheck(!strcmp(stop, "snapshots"), world, PETSC_ERR_SUP, "-offline_stop %s: only 'snapshots' is implemented so far (bases, EIM and the ROM file come with the next stages)", stop);
+  PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases"), world, PETSC_ERR_SUP, "-offline_stop %s: 'snapshots' and 'bases' are implemented so far (the EIM and the online data come with the next stage)", stop);
+  const PetscBool bases = strcmp(stop, "bases") ? PETSC_FALSE : PETSC_TRUE;
+  char            romPath[PETSC_MAX_PATH_LEN] = "";
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
+  PetscCheck(!bases || romPath[0], world, PETSC_ERR_USER_INPUT, "-offline_stop bases writes the bases to the ROM file: give -rom <file.h5>");
   PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", snapPath, sizeof snapPath, &set));
   PetscCheck(set && snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
+  restart = bases;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_restart", &restart, NULL));
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_monitor", &monitor, NULL));
   PetscCall(SceneSpecFromOptions(world, &scene));
@@ -311,6 +318,12 @@ PetscErrorCode StageOffline(MPI_Comm world)
     rep.root["nranks"]                = (int)wsize;
     rep.root["subcomms"]              = (long long)k;
     rep.root["snapshots"]             = snapPath;
+    if (bases) {
+      // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
+      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep));
+      PetscCall(PetscTime(&t1));
+      rep.root["time_s"]["total"] = (double)(t1 - t0);
+    }
     PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), snapPath));
   }
   PetscCall(PetscSubcommDestroy(&psub));

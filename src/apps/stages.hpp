@@ -5,4 +5,5 @@
 namespace rbc {
 PetscErrorCode StageFom(MPI_Comm comm);
 PetscErrorCode StageOffline(MPI_Comm comm);
+PetscErrorCode StageDualBasis(MPI_Comm comm);
 } // namespace rbc

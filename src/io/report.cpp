@@ -111,6 +111,13 @@ std::string JsonValue::Dump(int indent) const
   return os.str();
 }
 
+std::vector<double> Finite(const std::vector<double> &v)
+{
+  std::vector<double> o(v);
+  for (auto &x : o) if (!(std::abs(x) < 1e300)) x = std::nan("");
+  return o;
+}
+
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text)
 {
   PetscMPIInt rank;

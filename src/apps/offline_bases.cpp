@@ -1,0 +1,143 @@
+// src/apps/offline_bases.cpp: POD of the displacement snapshots (energy, H1 or l2 inner product of the
+// reference configuration) and the nonnegative dual basis of the multiplier snapshots; ROM file.
+#include "offline_bases.hpp"
+#include "rbcontact/dual_basis.hpp"
+#include "rbcontact/pod.hpp"
+#include "rbcontact/rom_file.hpp"
+#include <cstring>
+#include <sstream>
+
+namespace rbc {
+
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep)
+{
+  MPI_Comm       group = PetscObjectComm((PetscObject)fom.dm);
+  PetscMPIInt    wrank;
+  PetscLogDouble t0, t1, t2;
+  char           inner[32] = "energy";
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  std::vector<Snapshot> snaps;
+  PetscCall(SnapshotFile::ReadAll(snapPath, &snaps));
+  const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size();
+  PetscCheck(m == ntrain, world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
+
+  // --- primal: POD in the chosen inner product of the reference configuration
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pod_inner", inner, sizeof inner, NULL));
+  Mat M = nullptr;
+  if (!strcmp(inner, "energy")) {
+    Vec fref = nullptr;
+    PetscCall(fom.SetMu(ParamValues(fom.scene))); // the reference (default) parameter
+    if (fom.useAffine) PetscCall(fom.affine.Assemble(fom.mu, &M, &fref));
+    else PetscCall(fom.elas.Assemble(&M, &fref));
+    PetscCall(VecDestroy(&fref));
+  } else if (!strcmp(inner, "h1")) PetscCall(fom.elas.AssembleH1(&M));
+  else PetscCheck(!strcmp(inner, "l2"), world, PETSC_ERR_ARG_UNKNOWN_TYPE, "-pod_inner: unknown value '%s' (energy, h1 or l2)", inner);
+  std::vector<Vec> X(m);
+  {
+    PetscInt lo, hi;
+    Vec      tmpl;
+    PetscCall(DMCreateGlobalVector(fom.dm, &tmpl));
+    PetscCall(VecGetOwnershipRange(tmpl, &lo, &hi));
+    for (PetscInt j = 0; j < m; ++j) {
+      PetscScalar *a;
+      PetscCall(VecDuplicate(tmpl, &X[j]));
+      PetscCall(VecGetArray(X[j], &a));
+      for (PetscInt i = lo; i < hi; ++i) a[i - lo] = snaps[j].u[order.CanonicalDof(i)];
+      PetscCall(VecRestoreArray(X[j], &a));
+    }
+    PetscCall(VecDestroy(&tmpl));
+  }
+  PODResult pod;
+  PetscCall(ComputePOD(X, M, &pod));
+  std::vector<double> modes; // N x ndofs, canonical order (group rank 0)
+  for (PetscInt j = 0; j < pod.N; ++j) {
+    Vec                 v;
+    std::vector<double> c;
+    PetscCall(BVGetColumn(pod.modes, j, &v));
+    PetscCall(order.DofsToCanonical(v, &c));
+    PetscCall(BVRestoreColumn(pod.modes, j, &v));
+    modes.insert(modes.end(), c.begin(), c.end());
+  }
+  for (auto &v : X) PetscCall(VecDestroy(&v));
+  PetscCall(MatDestroy(&M));
+  PetscCall(PetscTime(&t1));
+
+  // --- dual: nonnegative basis of the multiplier snapshots (every rank, redundant and deterministic)
+  DualBasisResult dual;
+  const PetscInt  R = header.nmult;
+  if (R > 0) {
+    DenseMatrix L;
+    L.Resize(R, m);
+    for (PetscInt j = 0; j < m; ++j)
+      for (PetscInt i = 0; i < R; ++i) L(i, j) = snaps[j].lambda[i];
+    PetscCall(BuildDualBasis(L, &dual));
+    PetscReal wmin = 0;
+    for (PetscReal w : dual.W.a) wmin = std::min(wmin, w);
+    PetscCheck(wmin >= 0, world, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
+  }
+  PetscCall(PetscTime(&t2));
+
+  // --- ROM file
+  RomWriter w;
+  if (wrank == 0) {
+    std::ostringstream hs;
+    hs << std::hex << header.sceneHash;
+    w.Attr("scene", header.scene);
+    w.Attr("scene_hash", hs.str());
+    w.Attr("code_version", header.codeVersion);
+    w.Attr("snapshots", snapPath);
+    w.Attr("options", header.optionsText);
+    w.Attr("pod_inner", inner);
+    w.Attr("dual_type", dual.type);
+    std::vector<double> box;
+    for (size_t i = 0; i < header.paramMin.size(); ++i) { box.push_back(header.paramMin[i]); box.push_back(header.paramMax[i]); }
+    w.Dataset("/params/box", {header.paramMin.size(), 2}, box);
+    w.Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
+    w.Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
+    if (R > 0) {
+      // W^T: r rows of R
+      const PetscInt       r = dual.W.cols;
+      std::vector<double> wt((size_t)r * R);
+      for (PetscInt k = 0; k < r; ++k)
+        for (PetscInt i = 0; i < R; ++i) wt[(size_t)k * R + i] = dual.W(i, k);
+      w.Dataset("/dual/basis", {(unsigned long long)r, (unsigned long long)R}, wt);
+      w.Dataset("/dual/history", {dual.history.size()}, dual.history);
+      w.Dataset("/dual/gram_cond", {dual.gramCond.size()}, dual.gramCond);
+      std::vector<double> sel(dual.selected.begin(), dual.selected.end());
+      w.Dataset("/dual/selected", {sel.size()}, sel);
+    }
+  }
+  PetscCall(w.Write(world, romPath));
+
+  JsonValue &p = rep->root["pod"];
+  p["n"]               = (long long)pod.N;
+  p["inner"]           = inner;
+  p["singular_values"] = pod.singularValues;
+  p["energy_captured"] = (double)pod.energyCaptured;
+  p["orthonormality_error"] = (double)pod.orthonormalityError;
+  if (R > 0) {
+    JsonValue &d       = rep->root["dual"];
+    d["type"]          = dual.type;
+    d["r"]             = (long long)dual.W.cols;
+    d["train_max_err"] = (double)dual.trainMaxErr;
+    d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
+    d["history"]       = dual.history;
+    d["gram_cond"]     = Finite(dual.gramCond);
+    std::vector<double> sel(dual.selected.begin(), dual.selected.end());
+    d["selected"] = sel;
+    JsonValue &n  = rep->root["nnls"];
+    n["solves"]   = (long long)dual.nnls.solves;
+    n["max_kkt"]  = (double)dual.nnls.maxKKT;
+    n["retries"]  = (long long)dual.nnls.retries;
+  }
+  rep->root["time_s"]["pod"]  = (double)(t1 - t0);
+  rep->root["time_s"]["dual"] = (double)(t2 - t1);
+  rep->root["rom"]            = romPath;
+  (void)group;
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

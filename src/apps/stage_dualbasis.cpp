@@ -1,0 +1,91 @@
+// src/apps/stage_dualbasis.cpp: `rbcontact dualbasis`: a nonnegative dual basis of a multiplier
+// snapshot matrix from any source: "file.h5:/dataset" or a PETSc binary matrix from another code
+// (rows = multipliers, columns = snapshots), or a snapshot file of the offline stage.
+#include "stages.hpp"
+#include "rbcontact/dual_basis.hpp"
+#include "rbcontact/report.hpp"
+#include "rbcontact/rom_file.hpp"
+#include "rbcontact/snapshot_file.hpp"
+#include <algorithm>
+
+namespace rbc {
+
+PetscErrorCode StageDualBasis(MPI_Comm comm)
+{
+  char           spec[PETSC_MAX_PATH_LEN] = "", reportPath[PETSC_MAX_PATH_LEN] = "", out[PETSC_MAX_PATH_LEN] = "";
+  PetscBool      set;
+  Report         rep;
+  PetscLogDouble t0, t1, t2;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", spec, sizeof spec, &set));
+  PetscCheck(set && spec[0], comm, PETSC_ERR_USER_INPUT, "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)");
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_out", out, sizeof out, NULL));
+  std::vector<std::vector<PetscReal>> cols;
+  const std::string                   s(spec);
+  if (s.find(':') == std::string::npos && s.size() > 3 && s.substr(s.size() - 3) == ".h5") {
+    std::vector<Snapshot> snaps;
+    PetscCall(SnapshotFile::ReadAll(s, &snaps));
+    for (const auto &sn : snaps) cols.push_back(sn.lambda);
+  } else PetscCall(ImportSnapshotMatrix(comm, s, &cols));
+  PetscCheck(!cols.empty() && !cols[0].empty(), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds no snapshots", spec);
+  DenseMatrix L;
+  L.Resize((PetscInt)cols[0].size(), (PetscInt)cols.size());
+  PetscReal vmax = 0, vmin = 0;
+  for (PetscInt j = 0; j < L.cols; ++j)
+    for (PetscInt i = 0; i < L.rows; ++i) {
+      L(i, j) = cols[j][i];
+      vmax    = std::max(vmax, std::abs(L(i, j)));
+      vmin    = std::min(vmin, L(i, j));
+    }
+  // multipliers are nonnegative; round-off negatives of imported data are clipped, real ones refused
+  PetscCheck(vmin >= -1e-12 * vmax, comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' has negative entries (min %g, max |.| %g): multiplier snapshots must be nonnegative", spec, (double)vmin, (double)vmax);
+  for (auto &v : L.a) v = std::max(v, 0.0);
+  PetscCall(PetscTime(&t1));
+  DualBasisResult dual;
+  PetscCall(BuildDualBasis(L, &dual));
+  PetscCall(PetscTime(&t2));
+  PetscReal wmin = 0;
+  for (PetscReal w : dual.W.a) wmin = std::min(wmin, w);
+  PetscCheck(wmin >= 0, comm, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
+
+  rep.root["stage"]     = "dualbasis";
+  rep.root["snapshots"] = spec;
+  rep.root["R_fom"]     = (long long)L.rows;
+  rep.root["m"]         = (long long)L.cols;
+  JsonValue &d          = rep.root["dual"];
+  d["type"]             = dual.type;
+  d["r"]                = (long long)dual.W.cols;
+  d["train_max_err"]    = (double)dual.trainMaxErr;
+  d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
+  d["history"]          = dual.history;
+  d["gram_cond"]        = dual.gramCond;
+  d["min_entry"]        = (double)wmin;
+  std::vector<double> sel(dual.selected.begin(), dual.selected.end());
+  d["selected"]  = sel;
+  JsonValue &n   = rep.root["nnls"];
+  n["solves"]    = (long long)dual.nnls.solves;
+  n["max_kkt"]   = (double)dual.nnls.maxKKT;
+  n["retries"]   = (long long)dual.nnls.retries;
+  rep.root["time_s"]["dual"]  = (double)(t2 - t1);
+  rep.root["time_s"]["total"] = (double)(t2 - t0);
+  if (out[0]) {
+    RomWriter           w;
+    std::vector<double> wt((size_t)dual.W.cols * L.rows);
+    for (PetscInt k = 0; k < dual.W.cols; ++k)
+      for (PetscInt i = 0; i < L.rows; ++i) wt[(size_t)k * L.rows + i] = dual.W(i, k);
+    w.Attr("dual_type", dual.type);
+    w.Attr("snapshots", spec);
+    w.Dataset("/dual/basis", {(unsigned long long)dual.W.cols, (unsigned long long)L.rows}, wt);
+    w.Dataset("/dual/history", {dual.history.size()}, dual.history);
+    PetscCall(w.Write(comm, out));
+    rep.root["dual_out"] = out;
+  }
+  PetscCall(PetscPrintf(comm, "rbcontact dualbasis: %s, %" PetscInt_FMT " multipliers x %" PetscInt_FMT " snapshots -> r = %" PetscInt_FMT ", max training error %.3e (rel. %.3e), %.2f s\n", dual.type.c_str(), L.rows, L.cols, dual.W.cols, (double)dual.trainMaxErr, (double)dual.trainMaxRelErr, (double)(t2 - t1)));
+  PetscCall(rep.Write(comm, reportPath));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
