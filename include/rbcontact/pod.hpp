@@ -1,7 +1,7 @@
 // rbcontact/pod.hpp: the primal basis by POD of displacement snapshots with SLEPc, in the energy
 // inner product (x^T A y, A the reference stiffness), H1 or l2 (-pod_inner energy|h1|l2).
 // The weighted problem is formed with BV: BVSetMatrix(X, M), the correlation matrix C = X^T M X by
-// BVDot, its dense symmetric eigendecomposition (LAPACK), and the modes X V S^{-1} by BVMultInPlace;
+// BVDot, its dense symmetric eigendecomposition (LAPACK), and the modes X V S^{-1} by BVMult;
 // correct in parallel. -pod_inner l2 may instead use SVDSetOperators directly (-pod_method svd,
 // -pod_svd_type ...). Size: -pod_tol (relative energy left out, default 1e-8) or -pod_n (count).
 // Details, options, the sign convention and measured accuracy: docs/pod.md.

@@ -125,6 +125,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     d["train_max_err"] = (double)dual.trainMaxErr;
     d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
     d["history"]       = dual.history;
+    d["tol_abs"] = (double)dual.tolAbs;
+    d["norm"] = dual.norm;
     d["gram_cond"]     = Finite(dual.gramCond);
     std::vector<double> sel(dual.selected.begin(), dual.selected.end());
     d["selected"] = sel;

@@ -61,7 +61,9 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   d["train_max_err"]    = (double)dual.trainMaxErr;
   d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
   d["history"]          = dual.history;
-  d["gram_cond"]        = dual.gramCond;
+  d["tol_abs"] = (double)dual.tolAbs;
+  d["norm"] = dual.norm;
+  d["gram_cond"]        = Finite(dual.gramCond);
   d["min_entry"]        = (double)wmin;
   std::vector<double> sel(dual.selected.begin(), dual.selected.end());
   d["selected"]  = sel;
