@@ -4,6 +4,7 @@
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
+#include <cmath>
 #include <cstring>
 #include <sstream>
 
@@ -52,17 +53,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
   }
   PODResult pod;
   PetscCall(ComputePOD(X, M, &pod));
-  std::vector<double> modes; // N x ndofs, canonical order (group rank 0)
-  for (PetscInt j = 0; j < pod.N; ++j) {
-    Vec                 v;
-    std::vector<double> c;
-    PetscCall(BVGetColumn(pod.modes, j, &v));
-    PetscCall(order.DofsToCanonical(v, &c));
-    PetscCall(BVRestoreColumn(pod.modes, j, &v));
-    modes.insert(modes.end(), c.begin(), c.end());
-  }
   for (auto &v : X) PetscCall(VecDestroy(&v));
-  PetscCall(MatDestroy(&M));
   PetscCall(PetscTime(&t1));
 
   // --- dual: nonnegative basis of the multiplier snapshots (every rank, redundant and deterministic)
@@ -79,6 +70,83 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     PetscCheck(wmin >= 0, world, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
   }
   PetscCall(PetscTime(&t2));
+
+  // --- supremizers (-pod_supremizers): s_k = A^{-1} K(mu_k)^T xi_k for every dual basis vector xi_k,
+  // K(mu_k) the constraint of the snapshot the greedy selected for xi_k (nmf: the snapshot whose
+  // multipliers are most aligned with xi_k), A the reference stiffness; then the enlarged primal basis
+  // is re-orthonormalized in the POD inner product (inf-sup stability of the reduced saddle point).
+  PetscBool supremizers = PETSC_FALSE;
+  PetscInt  nsup        = 0;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-pod_supremizers", &supremizers, NULL));
+  if (supremizers && R > 0) {
+    const PetscInt r = dual.W.cols;
+    BV             Vs;
+    PetscInt       lo, hi;
+    PetscCall(fom.SetMu(ParamValues(fom.scene)));
+    PetscCall(fom.AssembleAndFactor());
+    PetscCall(BVDuplicateResize(pod.modes, pod.N + r, &Vs));
+    PetscCall(BVCopy(pod.modes, Vs)); // copies the N active columns
+    PetscCall(VecGetOwnershipRange(fom.f, &lo, &hi));
+    // global dof of each canonical index (owned entries only)
+    std::vector<PetscInt> globalOf(header.ndofs, -1);
+    for (PetscInt i = lo; i < hi; ++i) globalOf[order.CanonicalDof(i)] = i;
+    Vec rhs, sv;
+    PetscCall(VecDuplicate(fom.f, &rhs));
+    for (PetscInt k = 0; k < r; ++k) {
+      PetscInt j = k < (PetscInt)dual.selected.size() ? dual.selected[k] : -1;
+      if (j < 0) { // nmf: the most aligned snapshot
+        PetscReal best = -1;
+        for (PetscInt q = 0; q < m; ++q) {
+          PetscReal dot = 0, nrm = 0;
+          for (PetscInt i = 0; i < R; ++i) { dot += snaps[q].lambda[i] * dual.W(i, k); nrm += snaps[q].lambda[i] * snaps[q].lambda[i]; }
+          if (nrm > 0 && dot / std::sqrt(nrm) > best) { best = dot / std::sqrt(nrm); j = q; }
+        }
+      }
+      const auto &KD = snaps[j].extra.at("contact_K"), &Dc = snaps[j].extra.at("contact_dofs");
+      const PetscInt nD = (PetscInt)Dc.size();
+      PetscCall(VecSet(rhs, 0.0));
+      for (PetscInt c = 0; c < nD; ++c) {
+        PetscReal y = 0; // (K_D^T xi)_c, K_D row-major R x nD in canonical orders
+        for (PetscInt i = 0; i < R; ++i) y += KD[(size_t)i * nD + c] * dual.W(i, k);
+        const PetscInt g = globalOf[(PetscInt)Dc[c]];
+        if (g >= 0) PetscCall(VecSetValue(rhs, g, y, INSERT_VALUES));
+      }
+      PetscCall(VecAssemblyBegin(rhs));
+      PetscCall(VecAssemblyEnd(rhs));
+      PetscCall(BVGetColumn(Vs, pod.N + k, &sv));
+      PetscCall(fom.ApplyInverse(rhs, sv));
+      PetscCall(BVRestoreColumn(Vs, pod.N + k, &sv));
+    }
+    PetscCall(VecDestroy(&rhs));
+    PetscCall(BVSetActiveColumns(Vs, 0, pod.N + r));
+    PetscCall(BVOrthogonalize(Vs, NULL));
+    // drop columns that became (numerically) dependent: none expected; measure orthonormality
+    Mat G;
+    PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, pod.N + r, pod.N + r, NULL, &G));
+    PetscCall(BVDot(Vs, Vs, G));
+    PetscReal err = 0;
+    const PetscScalar *g;
+    PetscCall(MatDenseGetArrayRead(G, &g));
+    for (PetscInt i = 0; i < pod.N + r; ++i)
+      for (PetscInt q = 0; q < pod.N + r; ++q) err = std::max(err, std::abs(PetscRealPart(g[i + q * (pod.N + r)]) - (i == q ? 1.0 : 0.0)));
+    PetscCall(MatDenseRestoreArrayRead(G, &g));
+    PetscCall(MatDestroy(&G));
+    PetscCall(BVDestroy(&pod.modes));
+    pod.modes               = Vs;
+    nsup                    = r;
+    pod.N                   = pod.N + r;
+    pod.orthonormalityError = err;
+  }
+  PetscCall(MatDestroy(&M));
+  std::vector<double> modes; // N x ndofs, canonical order (group rank 0)
+  for (PetscInt j = 0; j < pod.N; ++j) {
+    Vec                 v;
+    std::vector<double> c;
+    PetscCall(BVGetColumn(pod.modes, j, &v));
+    PetscCall(order.DofsToCanonical(v, &c));
+    PetscCall(BVRestoreColumn(pod.modes, j, &v));
+    modes.insert(modes.end(), c.begin(), c.end());
+  }
 
   // --- ROM file
   RomWriter w;
@@ -118,6 +186,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
   p["singular_values"] = pod.singularValues;
   p["energy_captured"] = (double)pod.energyCaptured;
   p["orthonormality_error"] = (double)pod.orthonormalityError;
+  p["supremizers"]     = (long long)nsup;
   if (R > 0) {
     JsonValue &d       = rep->root["dual"];
     d["type"]          = dual.type;
