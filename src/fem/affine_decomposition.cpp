@@ -283,7 +283,7 @@ PetscErrorCode AffineDecomposition::Assemble(const std::vector<PetscReal> &mu, M
   }
   PetscCall(MatZeroEntries(*A));
   for (size_t q = 0; q < Aq.size(); ++q) PetscCall(MatAXPY(*A, ta[q], Aq[q], SAME_NONZERO_PATTERN));
-  if (!*f) PetscCall(MatCreateVecs(Aq[0], NULL, f));
+  if (!*f) PetscCall(DMCreateGlobalVector(elas_->dm, f)); // carries the DM (output, BC insertion)
   PetscCall(VecSet(*f, 0.0));
   for (size_t q = 0; q < fq.size(); ++q) PetscCall(VecAXPY(*f, tf[q], fq[q]));
   PetscFunctionReturn(0);
