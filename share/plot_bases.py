@@ -55,7 +55,8 @@ def main():
             nmf.append((d["r"], d["train_max_rel_err"]))
         else:
             h = d["history"]
-            axes[1].semilogy(range(1, len(h) + 1), [max(x, 1e-17) for x in h], "o-", ms=3, label=d["type"])
+            lab = d["type"] + (" (onto the span)" if d["type"] == "angle" else "")
+            axes[1].semilogy(range(1, len(h) + 1), [max(x, 1e-17) for x in h], "o-", ms=3, label=lab)
     if nmf:
         nmf.sort()
         axes[1].semilogy([x for x, _ in nmf], [max(y, 1e-17) for _, y in nmf], "s--", ms=4, label="nmf (rel.)")
