@@ -1,8 +1,9 @@
 // rbcontact/compliance.hpp: the contact-surface compliance G = (A^{-1})_{DD}, D = the free dofs that
 // the constraint rows can touch (slave and master facet dofs). With G, each Kacanov iterate's dual
 // Hessian S = K_D G K_D^T costs dense operations only; computed once per parameter.
-// Methods (-contact_compliance): schur (MUMPS Schur complement on D, then G = S_A^{-1}; serial only),
-// solves (one back-solve with the factored A per dof of D; any rank count), auto (schur on 1 rank).
+// Methods (-contact_compliance): schur (MUMPS Schur complement on D, then G = S_A^{-1}; 1 rank),
+// redundant (the same on a sequential copy of A on every rank: several ranks), solves (one parallel
+// back-solve per dof of D), auto (schur on 1 rank, redundant otherwise).
 #pragma once
 #include <petscmat.h>
 #include <vector>

@@ -235,15 +235,26 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     const PetscBLASInt R = (PetscBLASInt)sys.R;
     PetscCall(GatherRowsOnDofs(sys.K, D, &KD));
     PetscCall(GatherVec(sys.g, &gfull));
+    // K_D is sparse (a row touches the dofs of a few facets): T = G K_D^T and S = K_D T by its
+    // nonzeros, O(nD nnz + R nnz) instead of dense products
+    std::vector<std::vector<std::pair<PetscInt, PetscReal>>> rows(R);
+    for (PetscInt c = 0; c < nD; ++c)
+      for (PetscInt i = 0; i < R; ++i)
+        if (KD[i + (size_t)c * R] != 0.0) rows[i].emplace_back(c, KD[i + (size_t)c * R]);
     T.assign((size_t)nD * R, 0.0);
     Sfull.assign((size_t)R * R, 0.0);
-    {
-      const PetscScalar one = 1.0, zero = 0.0;
-      if (nD && R) {
-        BLASgemm_("N", "T", &nD, &R, &nD, &one, compliance.G.data(), &nD, KD.data(), &R, &zero, T.data(), &nD); // T = G K_D^T
-        BLASgemm_("N", "N", &R, &R, &nD, &one, KD.data(), &R, T.data(), &nD, &zero, Sfull.data(), &R);          // S = K_D T
+    for (PetscInt i = 0; i < R; ++i)
+      for (const auto &cv : rows[i]) {
+        const PetscReal *g = &compliance.G[(size_t)cv.first * nD];
+        PetscReal       *t = &T[(size_t)i * nD];
+        for (PetscInt q = 0; q < nD; ++q) t[q] += g[q] * cv.second;
       }
-    }
+    for (PetscInt j = 0; j < R; ++j)
+      for (PetscInt i = 0; i < R; ++i) {
+        PetscReal v = 0;
+        for (const auto &cv : rows[i]) v += cv.second * T[(size_t)j * nD + cv.first];
+        Sfull[i + (size_t)j * R] = v;
+      }
     for (PetscInt i = 0; i < R; ++i)
       for (PetscInt j = 0; j < R; ++j)
         if (j > i) Sfull[i + (size_t)j * R] = Sfull[j + (size_t)i * R] = 0.5 * (Sfull[i + (size_t)j * R] + Sfull[j + (size_t)i * R]);
