@@ -75,7 +75,7 @@ private:
 struct ContactSystem {
   Mat       K = nullptr;       // R x ndofs (rows: slave vertices, owned where the vertex is owned)
   Vec       g = nullptr;       // R, gap (Dirichlet lifting included)
-  Vec       weight = nullptr;  // R, int psi_i over the slave surface (pressure = lambda_i / weight_i)
+  Vec       weight = nullptr;  // R, int psi_i over the slave surface (lambda_i is the nodal pressure; force = lambda_i weight_i)
   Vec       normal[3] = {nullptr, nullptr, nullptr}; // R, mean master normal of row i (int psi_i n2 / weight_i)
   Vec       coord[3]  = {nullptr, nullptr, nullptr}; // R, reference coordinates of slave vertex i
   PetscInt  R = 0;

@@ -12,7 +12,7 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "  fom       solve the full-order model of a scene (-options_file runs/<scene>.opts)\n"
                            "  offline   snapshots over a training set (-offline_stop snapshots|bases -snapshots s.h5 -rom rom.h5)\n"
                            "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
-                           "See docs/options.md for the options of each stage.\n";
+                           "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md).\n";
 
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
 // names the option, file or value at fault (every check in rbcontact says which).
