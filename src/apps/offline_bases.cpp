@@ -10,6 +10,44 @@
 
 namespace rbc {
 
+PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Report *rep)
+{
+  PetscReal wmin = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscReal w : dual.W.a) wmin = std::min(wmin, w);
+  PetscCheck(wmin >= 0, comm, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
+  JsonValue &d           = rep->root["dual"];
+  d["type"]              = dual.type;
+  d["r"]                 = (long long)dual.W.cols;
+  d["train_max_err"]     = (double)dual.trainMaxErr;
+  d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
+  d["history"]           = dual.history;
+  d["tol_abs"]           = (double)dual.tolAbs;
+  d["norm"]              = dual.norm;
+  d["gram_cond"]         = Finite(dual.gramCond);
+  d["selected"]          = std::vector<double>(dual.selected.begin(), dual.selected.end());
+  d["min_entry"]         = (double)wmin;
+  JsonValue &n           = rep->root["nnls"];
+  n["solves"]            = (long long)dual.nnls.solves;
+  n["max_kkt"]           = (double)dual.nnls.maxKKT;
+  n["retries"]           = (long long)dual.nnls.retries;
+  PetscFunctionReturn(0);
+}
+
+void WriteDualBasis(const DualBasisResult &dual, RomWriter *w)
+{
+  const PetscInt      r = dual.W.cols, R = dual.W.rows;
+  std::vector<double> wt((size_t)r * R);
+  for (PetscInt k = 0; k < r; ++k)
+    for (PetscInt i = 0; i < R; ++i) wt[(size_t)k * R + i] = dual.W(i, k);
+  w->Attr("dual_type", dual.type);
+  w->Dataset("/dual/basis", {(unsigned long long)r, (unsigned long long)R}, wt);
+  w->Dataset("/dual/history", {dual.history.size()}, dual.history);
+  w->Dataset("/dual/gram_cond", {dual.gramCond.size()}, dual.gramCond);
+  w->Dataset("/dual/selected", {dual.selected.size()}, std::vector<double>(dual.selected.begin(), dual.selected.end()));
+}
+
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep)
 {
   MPI_Comm       group = PetscObjectComm((PetscObject)fom.dm);
@@ -65,9 +103,6 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     for (PetscInt j = 0; j < m; ++j)
       for (PetscInt i = 0; i < R; ++i) L(i, j) = snaps[j].lambda[i];
     PetscCall(BuildDualBasis(L, &dual));
-    PetscReal wmin = 0;
-    for (PetscReal w : dual.W.a) wmin = std::min(wmin, w);
-    PetscCheck(wmin >= 0, world, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
   }
   PetscCall(PetscTime(&t2));
 
@@ -120,7 +155,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     PetscCall(VecDestroy(&rhs));
     PetscCall(BVSetActiveColumns(Vs, 0, pod.N + r));
     PetscCall(BVOrthogonalize(Vs, NULL));
-    // drop columns that became (numerically) dependent: none expected; measure orthonormality
+    // orthonormality of the enlarged basis (reported as pod.orthonormality_error)
     Mat G;
     PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, pod.N + r, pod.N + r, NULL, &G));
     PetscCall(BVDot(Vs, Vs, G));
@@ -159,24 +194,12 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     w.Attr("snapshots", snapPath);
     w.Attr("options", header.optionsText);
     w.Attr("pod_inner", inner);
-    w.Attr("dual_type", dual.type);
     std::vector<double> box;
     for (size_t i = 0; i < header.paramMin.size(); ++i) { box.push_back(header.paramMin[i]); box.push_back(header.paramMax[i]); }
     w.Dataset("/params/box", {header.paramMin.size(), 2}, box);
     w.Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
     w.Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
-    if (R > 0) {
-      // W^T: r rows of R
-      const PetscInt       r = dual.W.cols;
-      std::vector<double> wt((size_t)r * R);
-      for (PetscInt k = 0; k < r; ++k)
-        for (PetscInt i = 0; i < R; ++i) wt[(size_t)k * R + i] = dual.W(i, k);
-      w.Dataset("/dual/basis", {(unsigned long long)r, (unsigned long long)R}, wt);
-      w.Dataset("/dual/history", {dual.history.size()}, dual.history);
-      w.Dataset("/dual/gram_cond", {dual.gramCond.size()}, dual.gramCond);
-      std::vector<double> sel(dual.selected.begin(), dual.selected.end());
-      w.Dataset("/dual/selected", {sel.size()}, sel);
-    }
+    if (R > 0) WriteDualBasis(dual, &w);
   }
   PetscCall(w.Write(world, romPath));
 
@@ -187,23 +210,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
   p["energy_captured"] = (double)pod.energyCaptured;
   p["orthonormality_error"] = (double)pod.orthonormalityError;
   p["supremizers"]     = (long long)nsup;
-  if (R > 0) {
-    JsonValue &d       = rep->root["dual"];
-    d["type"]          = dual.type;
-    d["r"]             = (long long)dual.W.cols;
-    d["train_max_err"] = (double)dual.trainMaxErr;
-    d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
-    d["history"]       = dual.history;
-    d["tol_abs"] = (double)dual.tolAbs;
-    d["norm"] = dual.norm;
-    d["gram_cond"]     = Finite(dual.gramCond);
-    std::vector<double> sel(dual.selected.begin(), dual.selected.end());
-    d["selected"] = sel;
-    JsonValue &n  = rep->root["nnls"];
-    n["solves"]   = (long long)dual.nnls.solves;
-    n["max_kkt"]  = (double)dual.nnls.maxKKT;
-    n["retries"]  = (long long)dual.nnls.retries;
-  }
+  if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
   rep->root["time_s"]["pod"]  = (double)(t1 - t0);
   rep->root["time_s"]["dual"] = (double)(t2 - t1);
   rep->root["rom"]            = romPath;

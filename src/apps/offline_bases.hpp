@@ -2,6 +2,8 @@
 // and nonnegative dual basis from a complete snapshot file, written to the ROM file.
 #pragma once
 #include "rbcontact/canonical_order.hpp"
+#include "rbcontact/dual_basis.hpp"
+#include "rbcontact/rom_file.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/snapshot_file.hpp"
@@ -10,5 +12,11 @@ namespace rbc {
 
 // group: the ranks of fom (a subcommunicator of world); world rank 0 writes romPath.
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep);
+
+// Report keys dual {type, r, train_max_err, train_max_rel_err, history, tol_abs, norm, gram_cond,
+// selected, min_entry} and nnls {solves, max_kkt, retries}; a negative basis entry is an error.
+PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Report *rep);
+// /dual/basis (r rows of R), /dual/history, /dual/gram_cond, /dual/selected.
+void WriteDualBasis(const DualBasisResult &dual, RomWriter *w);
 
 } // namespace rbc

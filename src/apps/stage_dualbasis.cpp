@@ -2,6 +2,7 @@
 // snapshot matrix from any source: "file.h5:/dataset" or a PETSc binary matrix from another code
 // (rows = multipliers, columns = snapshots), or a snapshot file of the offline stage.
 #include "stages.hpp"
+#include "offline_bases.hpp"
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/rom_file.hpp"
@@ -47,41 +48,18 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   DualBasisResult dual;
   PetscCall(BuildDualBasis(L, &dual));
   PetscCall(PetscTime(&t2));
-  PetscReal wmin = 0;
-  for (PetscReal w : dual.W.a) wmin = std::min(wmin, w);
-  PetscCheck(wmin >= 0, comm, PETSC_ERR_PLIB, "dual basis has a negative entry (%g)", (double)wmin);
 
   rep.root["stage"]     = "dualbasis";
   rep.root["snapshots"] = spec;
   rep.root["R_fom"]     = (long long)L.rows;
   rep.root["m"]         = (long long)L.cols;
-  JsonValue &d          = rep.root["dual"];
-  d["type"]             = dual.type;
-  d["r"]                = (long long)dual.W.cols;
-  d["train_max_err"]    = (double)dual.trainMaxErr;
-  d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
-  d["history"]          = dual.history;
-  d["tol_abs"] = (double)dual.tolAbs;
-  d["norm"] = dual.norm;
-  d["gram_cond"]        = Finite(dual.gramCond);
-  d["min_entry"]        = (double)wmin;
-  std::vector<double> sel(dual.selected.begin(), dual.selected.end());
-  d["selected"]  = sel;
-  JsonValue &n   = rep.root["nnls"];
-  n["solves"]    = (long long)dual.nnls.solves;
-  n["max_kkt"]   = (double)dual.nnls.maxKKT;
-  n["retries"]   = (long long)dual.nnls.retries;
+  PetscCall(ReportDualBasis(comm, dual, &rep));
   rep.root["time_s"]["dual"]  = (double)(t2 - t1);
   rep.root["time_s"]["total"] = (double)(t2 - t0);
   if (out[0]) {
-    RomWriter           w;
-    std::vector<double> wt((size_t)dual.W.cols * L.rows);
-    for (PetscInt k = 0; k < dual.W.cols; ++k)
-      for (PetscInt i = 0; i < L.rows; ++i) wt[(size_t)k * L.rows + i] = dual.W(i, k);
-    w.Attr("dual_type", dual.type);
+    RomWriter w;
+    WriteDualBasis(dual, &w);
     w.Attr("snapshots", spec);
-    w.Dataset("/dual/basis", {(unsigned long long)dual.W.cols, (unsigned long long)L.rows}, wt);
-    w.Dataset("/dual/history", {dual.history.size()}, dual.history);
     PetscCall(w.Write(comm, out));
     rep.root["dual_out"] = out;
   }
