@@ -50,7 +50,6 @@ void WriteDualBasis(const DualBasisResult &dual, RomWriter *w)
 
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep)
 {
-  MPI_Comm       group = PetscObjectComm((PetscObject)fom.dm);
   PetscMPIInt    wrank;
   PetscLogDouble t0, t1, t2;
   char           inner[32] = "energy";
@@ -214,7 +213,6 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
   rep->root["time_s"]["pod"]  = (double)(t1 - t0);
   rep->root["time_s"]["dual"] = (double)(t2 - t1);
   rep->root["rom"]            = romPath;
-  (void)group;
   PetscFunctionReturn(0);
 }
 

@@ -54,7 +54,6 @@ static PetscErrorCode ComplianceBySolves(ElasticFOM &fom, const std::vector<Pets
   IS                 isD;
   const PetscInt     n = (PetscInt)D.size();
   PetscInt           lo, hi;
-  MPI_Comm           comm = PetscObjectComm((PetscObject)fom.A);
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(fom.f, &e));
@@ -88,7 +87,6 @@ static PetscErrorCode ComplianceBySolves(ElasticFOM &fom, const std::vector<Pets
   PetscCall(VecDestroy(&xall));
   PetscCall(VecDestroy(&e));
   PetscCall(VecDestroy(&x));
-  (void)comm;
   PetscFunctionReturn(0);
 }
 
@@ -107,16 +105,6 @@ PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<Pet
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_compliance", m, sizeof m, NULL));
   PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "redundant") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur, redundant or solves)", m);
-  PetscBool mumps = PETSC_FALSE;
-  {
-    PC          pc;
-    MatSolverType st = NULL;
-    PetscBool   isChol;
-    PetscCall(KSPGetPC(fom.ksp, &pc));
-    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCCHOLESKY, &isChol));
-    if (isChol) PetscCall(PCFactorGetMatSolverType(pc, &st));
-    mumps = (st && !strcmp(st, MATSOLVERMUMPS)) ? PETSC_TRUE : PETSC_FALSE;
-  }
   // auto: the Schur complement (on 1 rank directly, on several ranks on a redundant sequential copy of
   // A: PETSc 3.18 has no parallel MUMPS Schur complement); one back-solve per contact dof in parallel
   // was measured 20x slower on 2 ranks (ring_on_block refine 2: 14.5 s of an 18.8 s solve).
@@ -131,7 +119,6 @@ PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<Pet
     PetscCall(ComplianceBySchur(Aseq, D, &G)); // every rank, same data: the same G everywhere
     PetscCall(MatDestroy(&Aseq));
   } else PetscCall(ComplianceBySolves(fom, D, &G));
-  (void)mumps;
   PetscCall(PetscLogEventEnd(CMP_Compute, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   seconds = t1 - t0;

@@ -281,15 +281,13 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     const PetscReal     meas = FacetMeasure(F.X.data(), dim);
     PetscInt            rows[3];
     {
-      const PetscInt *cone = NULL;
-      PetscInt       *closure = NULL, ncl, k = 0;
+      PetscInt *closure = NULL, ncl, k = 0;
       PetscCall(DMPlexGetTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
       for (PetscInt c = 0; c < ncl; ++c) {
         const PetscInt pt = closure[2 * c];
         if (pt >= vStart_ && pt < vStart_ + (PetscInt)vertexRow_.size() && k < nv) rows[k++] = vertexRow_[pt - vStart_];
       }
       PetscCall(DMPlexRestoreTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
-      (void)cone;
     }
     // Integration points of this slave facet (barycentric b, weight w)
     std::vector<std::array<PetscReal, 4>> ipts;
