@@ -182,6 +182,12 @@ def bases(args):
         else:
             dv = float("inf")
         check(dv <= 1e-8, "%s: POD modes identical up to sign on 1 and 2 ranks (%.1e)" % (t, dv))
+    # supremizer enrichment: N = POD modes + one supremizer per dual vector, still orthonormal
+    run(args, 1, "runs/ring_on_block.opts", base + ["-dual_type", "mcpg", "-pod_supremizers", "-offline_stop", "bases", "-rom", d + "/rom_sup.h5", "-report", d + "/sup.json"])
+    rs, rp = report(d + "/sup.json"), report(d + "/mcpg_np1.json")
+    check(rs["pod"]["supremizers"] == rs["dual"]["r"] and rs["pod"]["n"] == rp["pod"]["n"] + rs["dual"]["r"],
+          "supremizers: N = %d POD modes + %d supremizers" % (rp["pod"]["n"], rs["pod"]["supremizers"]))
+    check(rs["pod"]["orthonormality_error"] <= 1e-10, "enriched primal basis orthonormal in the energy inner product (%.1e)" % rs["pod"]["orthonormality_error"])
     print("  ring_on_block, 21 radii: dual type | R | max err | max rel err | cond(Gram) | NNLS retries")
     for row in table:
         print("    %-6s %3d  %.3e  %.3e  %.2e  %d" % row)
