@@ -24,6 +24,13 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   PetscCheck(set && spec[0], comm, PETSC_ERR_USER_INPUT, "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)");
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_out", out, sizeof out, NULL));
+  {
+    // check the basis type before reading possibly large data
+    char type[32] = "cpg";
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_type", type, sizeof type, NULL));
+    const std::string t(type);
+    PetscCheck(t == "nmf" || t == "angle" || t == "cpg" || t == "mcpg", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-dual_type: unknown value '%s' (nmf, angle, cpg or mcpg)", type);
+  }
   std::vector<std::vector<PetscReal>> cols;
   const std::string                   s(spec);
   if (s.find(':') == std::string::npos && s.size() > 3 && s.substr(s.size() - 3) == ".h5") {
