@@ -60,6 +60,9 @@ public:
 // Values at or above PETSc's "infinity" (1e300 here) become NaN, which the JSON writer reports as null.
 std::vector<double> Finite(const std::vector<double> &v);
 
+// Broadcasts a string from rank 0 of comm (errors and file contents read on rank 0).
+PetscErrorCode BcastString(MPI_Comm comm, std::string *s);
+
 // Writes text to path atomically (path.tmp.<pid> then rename) on rank 0 of comm; errors name the file.
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text);
 

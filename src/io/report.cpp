@@ -118,6 +118,17 @@ std::vector<double> Finite(const std::vector<double> &v)
   return o;
 }
 
+PetscErrorCode BcastString(MPI_Comm comm, std::string *s)
+{
+  unsigned long long n = s->size();
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm));
+  s->resize(n);
+  if (n) PetscCallMPI(MPI_Bcast(&(*s)[0], (PetscMPIInt)n, MPI_CHAR, 0, comm));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text)
 {
   PetscMPIInt rank;

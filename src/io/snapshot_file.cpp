@@ -28,6 +28,7 @@
 // then done[i] = 1, H5Fflush + fsync. A killed job loses only the snapshot in progress. The file
 // uses the default (oldest) HDF5 file format, which has no "file open for writing" flag, so a file
 // left by a killed job opens normally.
+#include "rbcontact/report.hpp"
 #include "rbcontact/snapshot_file.hpp"
 #include "h5util.hpp"
 #include <hdf5.h>
@@ -240,16 +241,6 @@ std::string Join(const std::vector<std::string> &v)
 
 bool Close14(double a, double b) { return std::fabs(a - b) <= 1e-14 * std::max(1.0, std::max(std::fabs(a), std::fabs(b))); }
 
-PetscErrorCode BcastString(MPI_Comm comm, std::string *s)
-{
-  unsigned long long n = s->size();
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm));
-  s->resize(n);
-  if (n) PetscCallMPI(MPI_Bcast(&(*s)[0], (PetscMPIInt)n, MPI_CHAR, 0, comm));
-  PetscFunctionReturn(0);
-}
 
 // Large broadcasts in pieces (MPI counts are int).
 PetscErrorCode BcastReals(MPI_Comm comm, PetscReal *v, size_t n)

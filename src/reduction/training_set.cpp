@@ -2,6 +2,7 @@
 // Owns the -<prefix>type/size/seed/file options, the tensor grid, the uniform random and Latin
 // hypercube generators (xoshiro256** seeded through splitmix64: the same numbers on any platform
 // and compiler) and the reader of sample files (one point per line, checked against the box).
+#include "rbcontact/report.hpp"
 #include "rbcontact/training_set.hpp"
 #include <algorithm>
 #include <cerrno>
@@ -118,16 +119,6 @@ std::string ReadSampleFile(const std::string &path, const std::string &option, c
   return std::string();
 }
 
-PetscErrorCode BcastString(MPI_Comm comm, std::string *s)
-{
-  unsigned long long n = s->size();
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm));
-  s->resize(n);
-  if (n) PetscCallMPI(MPI_Bcast(&(*s)[0], (PetscMPIInt)n, MPI_CHAR, 0, comm));
-  PetscFunctionReturn(0);
-}
 
 } // namespace
 
