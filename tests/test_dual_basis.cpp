@@ -12,6 +12,8 @@
 #include <cstring>
 #include <string>
 
+#include "test_util.hpp"
+
 using namespace rbc;
 
 static int failures = 0;
@@ -21,15 +23,7 @@ static void Check(bool ok, const std::string &what, double v, double bound)
   if (!ok) ++failures;
 }
 
-static std::uint64_t Hash(std::uint64_t h, const std::vector<PetscReal> &v)
-{
-  for (PetscReal d : v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &d, sizeof bits);
-    h = (h ^ bits) * 0x100000001B3ULL;
-  }
-  return h;
-}
+using rbctest::Hash;
 
 static std::uint64_t HashResult(const DualBasisResult &r)
 {

@@ -18,6 +18,8 @@
 
 namespace {
 
+using rbc::GlobalPointCount;
+
 // ---------------------------------------------------------------------------------------------
 // Exact solution: a product of shifted sines per component (smooth, not a polynomial, so P2 is
 // not exact; non-zero on the boundary, so the Dirichlet data are non-homogeneous):
@@ -93,26 +95,6 @@ void f0_mms(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], co
 
 // Global number of points of a depth stratum (0: vertices) or height stratum (cells) of a possibly
 // distributed DMPlex: local points minus the ghosts (leaves of the point SF).
-PetscErrorCode GlobalPointCount(DM dm, bool cells, PetscInt *n)
-{
-  PetscSF         sf;
-  PetscInt        pStart, pEnd, nleaves;
-  const PetscInt *leaves;
-
-  PetscFunctionBeginUser;
-  if (cells) PetscCall(DMPlexGetHeightStratum(dm, 0, &pStart, &pEnd));
-  else PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd));
-  PetscCall(DMGetPointSF(dm, &sf));
-  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
-  PetscInt owned = pEnd - pStart;
-  for (PetscInt l = 0; l < PetscMax(nleaves, 0); ++l) {
-    const PetscInt p = leaves ? leaves[l] : l;
-    if (p >= pStart && p < pEnd) --owned;
-  }
-  PetscCallMPI(MPI_Allreduce(&owned, n, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
-  PetscFunctionReturn(0);
-}
-
 struct Case {
   std::string              id, mesh;
   PetscInt                 dim, degree;

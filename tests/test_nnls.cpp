@@ -13,6 +13,8 @@
 #include <cstring>
 #include <random>
 
+#include "test_util.hpp"
+
 using namespace rbc;
 
 static int failures = 0;
@@ -22,15 +24,7 @@ static void Check(bool ok, const char *what, double v, double bound)
   if (!ok) ++failures;
 }
 
-static std::uint64_t Hash(std::uint64_t h, const std::vector<PetscReal> &v)
-{
-  for (PetscReal d : v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &d, sizeof bits);
-    h = (h ^ bits) * 0x100000001B3ULL;
-  }
-  return h;
-}
+using rbctest::Hash;
 
 // Hertz-like pressure p0 sqrt(max(0, 1 - ((x - c)/a)^2)) on R points of [-1, 1]
 static std::vector<PetscReal> Hertz(PetscInt R, double p0, double c, double a)

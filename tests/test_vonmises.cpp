@@ -24,6 +24,8 @@
 
 namespace {
 
+using rbc::GlobalPointCount;
+
 // Displacement gradient B (u = B x): stretches, shear and (3D) out-of-plane terms.
 const PetscReal kB[3][3] = {{2.0e-3, 1.5e-3, 0.4e-3}, {-0.5e-3, -1.0e-3, 0.7e-3}, {0.3e-3, -0.6e-3, 0.8e-3}};
 
@@ -55,26 +57,6 @@ PetscReal AnalyticVonMises(PetscInt dim, PetscReal E, PetscReal nu)
       dd += s * s;
     }
   return std::sqrt(1.5 * dd);
-}
-
-PetscErrorCode GlobalPointCount(DM dm, bool cells, PetscInt *n)
-{
-  PetscSF         sf;
-  PetscInt        pStart, pEnd, nleaves;
-  const PetscInt *leaves;
-
-  PetscFunctionBeginUser;
-  if (cells) PetscCall(DMPlexGetHeightStratum(dm, 0, &pStart, &pEnd));
-  else PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd));
-  PetscCall(DMGetPointSF(dm, &sf));
-  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
-  PetscInt owned = pEnd - pStart;
-  for (PetscInt l = 0; l < PetscMax(nleaves, 0); ++l) {
-    const PetscInt p = leaves ? leaves[l] : l;
-    if (p >= pStart && p < pEnd) --owned;
-  }
-  PetscCallMPI(MPI_Allreduce(&owned, n, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
-  PetscFunctionReturn(0);
 }
 
 struct Case {

@@ -25,6 +25,9 @@ PetscErrorCode MeshCheckLabel(DM dm, const std::string &name, const char *option
 // Resolves a file name: as given, else relative to the source tree. Errors name the file.
 PetscErrorCode ResolveDataFile(MPI_Comm comm, const std::string &file, std::string *path);
 
+// Global number of cells (cells = true) or vertices of a distributed DMPlex (each counted once).
+PetscErrorCode GlobalPointCount(DM dm, bool cells, PetscInt *n);
+
 // 64-bit FNV-1a hash of a string (mesh cache keys, checksums).
 unsigned long long Fnv1a(const std::string &s, unsigned long long h = 1469598103934665603ULL);
 

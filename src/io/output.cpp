@@ -1,8 +1,8 @@
 // src/io/output.cpp: HDF5 output of the FOM fields (PetscViewerHDF5, VIZ layout) written to a temp
 // file and renamed, plus an XDMF index so that ParaView opens it.
 #include "rbcontact/fom.hpp"
+#include "rbcontact/mesh.hpp"
 #include <petscviewerhdf5.h>
-#include <petscsf.h>
 #include <cstdio>
 #include <sstream>
 #include <unistd.h>
@@ -52,7 +52,7 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   Vec         vm;
   PetscMPIInt rank;
   std::string tmp;
-  PetscInt    nverts, ncells, vStart, vEnd, cStart, cEnd;
+  PetscInt    nverts, ncells;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
@@ -79,23 +79,8 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   PetscCallMPI(MPI_Barrier(comm));
 
   // Sizes for the XDMF: count owned vertices and cells.
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  {
-    PetscSF sf;
-    PetscInt nleaves = 0;
-    const PetscInt *leaves;
-    PetscCall(DMGetPointSF(dm, &sf));
-    PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
-    PetscInt ownedV = vEnd - vStart, ownedC = cEnd - cStart;
-    for (PetscInt l = 0; l < PetscMax(nleaves, 0); ++l) {
-      const PetscInt p = leaves ? leaves[l] : l;
-      if (p >= vStart && p < vEnd) --ownedV;
-      if (p >= cStart && p < cEnd) --ownedC;
-    }
-    PetscCallMPI(MPI_Allreduce(&ownedV, &nverts, 1, MPIU_INT, MPI_SUM, comm));
-    PetscCallMPI(MPI_Allreduce(&ownedC, &ncells, 1, MPIU_INT, MPI_SUM, comm));
-  }
+  PetscCall(GlobalPointCount(dm, false, &nverts));
+  PetscCall(GlobalPointCount(dm, true, &ncells));
   // PETSc's VIZ layout names datasets <vector name>_<field name>.
   std::vector<XdmfAttribute> attrs = {{"displacement", "/vertex_fields/displacement_displacement", elas.dim, false}, {"von_mises", "/cell_fields/von_mises_von_mises", 1, true}};
   PetscCall(WriteXdmf(comm, h5file, elas.dim, nverts, ncells, elas.dim + 1, attrs));

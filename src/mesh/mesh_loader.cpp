@@ -2,6 +2,7 @@
 // physical names as labels, label checks, and distribution.
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/partition.hpp"
+#include <petscsf.h>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -115,6 +116,26 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   PetscCallMPI(MPI_Bcast(msg, sizeof msg, MPI_CHAR, 0, comm));
   PetscCheck(ok, comm, PETSC_ERR_FILE_UNEXPECTED, "%s", msg);
   PetscCall(PetscLogEventEnd(MESH_Generate, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GlobalPointCount(DM dm, bool cells, PetscInt *n)
+{
+  PetscSF         sf;
+  PetscInt        pStart, pEnd, nleaves;
+  const PetscInt *leaves;
+
+  PetscFunctionBeginUser;
+  if (cells) PetscCall(DMPlexGetHeightStratum(dm, 0, &pStart, &pEnd));
+  else PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd));
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
+  PetscInt owned = pEnd - pStart;
+  for (PetscInt l = 0; l < PetscMax(nleaves, 0); ++l) {
+    const PetscInt p = leaves ? leaves[l] : l;
+    if (p >= pStart && p < pEnd) --owned;
+  }
+  PetscCallMPI(MPI_Allreduce(&owned, n, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(0);
 }
 
