@@ -28,6 +28,7 @@ struct SurfaceFacet {
   PetscReal                    outward = 1;  // sign making the facet normal point out of its body
   std::array<PetscReal, 9>     Xref{};       // reference vertex coordinates (X = h_body(mu)(Xref))
   PetscInt                     body = -1;    // body of the facet's cell
+  std::array<PetscInt, 3>      row{{-1, -1, -1}}; // slave facets: multiplier row of each vertex
 };
 
 // Lagrange basis of the facet nodes at barycentric coordinates b (size nv).
@@ -53,6 +54,10 @@ class ClosestPoint {
 public:
   // deformed = true: vertices at X + U (vertex dofs); false: reference X.
   PetscErrorCode Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed);
+  // Only the deformed vertex positions (no bins): for FindAmong on small facet sets.
+  void SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed);
+  // Closest point of p among the facets cand[0..nc) (linear scan, same tie rule as Find).
+  void FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt nc, PetscInt *facet, PetscReal b[], PetscReal *dist) const;
   // Closest point of p: facet index, barycentric coordinates, distance.
   void Find(const PetscReal p[], PetscInt *facet, PetscReal b[], PetscReal *dist) const;
   // Deformed vertex positions of facet f.
@@ -83,7 +88,9 @@ struct ContactSystem {
   PetscErrorCode Destroy();
 };
 
-enum class ContactQuadrature { Gauss, Nodal };
+// Gauss: segment-based (mortar) in 2D; Composite: nsub equal pieces per slave facet, Gauss on each (fixed
+// points, used by the reduced model); Nodal: collocation at the slave nodes.
+enum class ContactQuadrature { Gauss, Composite, Nodal };
 
 // The contact map: slave/master surfaces of a scene and the assembly of K(u), g(u).
 class ContactMap {
@@ -98,8 +105,14 @@ public:
   // The free global dofs the constraint rows can touch (slave and master facet closures), sorted,
   // the same on every rank.
   PetscErrorCode SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const;
+  const ContactSurface &Slave() const { return slave_; }
+  const ContactSurface &Master() const { return master_; }
+  // Reference facet rule: barycentric points (dim per point) and weights summing to 1.
+  const std::vector<PetscReal> &QuadraturePoints() const { return quadPoints_; }
+  const std::vector<PetscReal> &QuadratureWeights() const { return quadWeights_; }
   ContactQuadrature quadrature = ContactQuadrature::Gauss;
   PetscInt          nquad      = 4;
+  PetscInt          nsub       = 4;
   bool              smoothNormal = true;
 
 private:

@@ -34,13 +34,18 @@ public:
   virtual ~AffineBlock() = default;
   virtual Affine      Evaluate(const std::vector<PetscReal> &mu) const = 0;
   virtual std::string Describe() const = 0;
+  // Serialization (ROM file): {type (0 dilation, 1 stretch, 2 translation), param, ref, v0, v1, v2, axis}.
+  virtual std::array<PetscReal, 7> Record() const = 0;
 };
+// The block of a record (nullptr for an unknown type).
+std::unique_ptr<AffineBlock> AffineBlockFromRecord(const std::array<PetscReal, 7> &r);
 
 class Dilation : public AffineBlock {
 public:
   Dilation(PetscInt param, PetscReal ref, std::array<PetscReal, 3> center) : p_(param), ref_(ref), c_(center) {}
   Affine      Evaluate(const std::vector<PetscReal> &mu) const override;
   std::string Describe() const override;
+  std::array<PetscReal, 7> Record() const override;
 private:
   PetscInt p_; PetscReal ref_; std::array<PetscReal, 3> c_;
 };
@@ -50,6 +55,7 @@ public:
   Stretch(PetscInt param, PetscReal ref, PetscInt axis, PetscReal center) : p_(param), ref_(ref), axis_(axis), c_(center) {}
   Affine      Evaluate(const std::vector<PetscReal> &mu) const override;
   std::string Describe() const override;
+  std::array<PetscReal, 7> Record() const override;
 private:
   PetscInt p_; PetscReal ref_; PetscInt axis_; PetscReal c_;
 };
@@ -59,6 +65,7 @@ public:
   Translation(PetscInt param, PetscReal ref, std::array<PetscReal, 3> dir) : p_(param), ref_(ref), d_(dir) {}
   Affine      Evaluate(const std::vector<PetscReal> &mu) const override;
   std::string Describe() const override;
+  std::array<PetscReal, 7> Record() const override;
 private:
   PetscInt p_; PetscReal ref_; std::array<PetscReal, 3> d_;
 };
@@ -76,6 +83,9 @@ public:
   Affine Evaluate(PetscInt body, const std::vector<PetscReal> &mu) const;
   bool   IsIdentity() const; // no block on any body
   std::string Describe(const SceneSpec &scene) const;
+  // Serialization: one row {body, Record()} per block (8 values), and back.
+  std::vector<PetscReal> Records() const;
+  PetscErrorCode         FromRecords(PetscInt nbodies, const std::vector<PetscReal> &rec);
   std::vector<BodyMap> bodies;
 };
 

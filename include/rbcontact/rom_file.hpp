@@ -15,6 +15,9 @@ public:
   void Attr(const std::string &name, const std::string &value) { attrs_.emplace_back(name, value); }
   // path like "/pod/modes"; dims row-major (the last index fastest), data.size() = prod(dims)
   void Dataset(const std::string &path, const std::vector<unsigned long long> &dims, const std::vector<double> &data);
+  // Largest dataset written so far: its path and number of entries.
+  std::pair<std::string, unsigned long long> Largest() const;
+  int version = 1; // format_version: 1 = bases only (-offline_stop bases), 2 = online ROM
   // Collective: rank 0 writes path (temp file + rename), errors reach every rank.
   PetscErrorCode Write(MPI_Comm comm, const std::string &path) const;
 
@@ -31,5 +34,7 @@ private:
 // Reads a dataset (any rank, independent); errors name the file and the dataset.
 PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, std::vector<unsigned long long> *dims, std::vector<double> *data);
 PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value);
+// The integer format_version attribute.
+PetscErrorCode RomReadVersion(const std::string &path, int *version);
 
 } // namespace rbc

@@ -10,9 +10,11 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "Usage: rbcontact <stage> [PETSc options]\n"
                            "Stages:\n"
                            "  fom       solve the full-order model of a scene (-options_file runs/<scene>.opts)\n"
-                           "  offline   snapshots over a training set (-offline_stop snapshots|bases -snapshots s.h5 -rom rom.h5)\n"
+                           "  offline   snapshots, bases, EIM -> the ROM file (-rom rom.h5; -offline_stop snapshots|bases)\n"
+                           "  online    reduced solve at a parameter (-rom rom.h5 -mu v; -rom_reconstruct fields.h5)\n"
+                           "  validate  ROM against FOM on a test set, speed against error (-rom rom.h5 -test_size n; -validate_sweep)\n"
                            "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
-                           "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md).\n";
+                           "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md, eim.md, online.md).\n";
 
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
 // names the option, file or value at fault (every check in rbcontact says which).
@@ -46,8 +48,10 @@ int main(int argc, char **argv)
   if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
   else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
   else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
+  else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);
+  else if (stage == "validate") ierr = rbc::StageValidate(PETSC_COMM_WORLD);
   else {
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom, offline, dualbasis)\n", stage.c_str()));
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom, offline, online, validate, dualbasis)\n", stage.c_str()));
     ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
   }
   if (ierr) {

@@ -4,6 +4,7 @@
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
+#include "offline_rom.hpp"
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -35,20 +36,20 @@ PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Repor
   PetscFunctionReturn(0);
 }
 
-void WriteDualBasis(const DualBasisResult &dual, RomWriter *w)
+void WriteDualBasis(const DualBasisResult &dual, RomWriter *w, bool withBasis)
 {
   const PetscInt      r = dual.W.cols, R = dual.W.rows;
   std::vector<double> wt((size_t)r * R);
   for (PetscInt k = 0; k < r; ++k)
     for (PetscInt i = 0; i < R; ++i) wt[(size_t)k * R + i] = dual.W(i, k);
   w->Attr("dual_type", dual.type);
-  w->Dataset("/dual/basis", {(unsigned long long)r, (unsigned long long)R}, wt);
+  if (withBasis) w->Dataset("/dual/basis", {(unsigned long long)r, (unsigned long long)R}, wt);
   w->Dataset("/dual/history", {dual.history.size()}, dual.history);
   w->Dataset("/dual/gram_cond", {dual.gramCond.size()}, dual.gramCond);
   w->Dataset("/dual/selected", {dual.selected.size()}, std::vector<double>(dual.selected.begin(), dual.selected.end()));
 }
 
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep)
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, const std::string &basisPath)
 {
   PetscMPIInt    wrank;
   PetscLogDouble t0, t1, t2;
@@ -182,25 +183,60 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
     modes.insert(modes.end(), c.begin(), c.end());
   }
 
-  // --- ROM file
-  RomWriter w;
-  if (wrank == 0) {
+  // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
+  const std::string &bpath = cmap ? basisPath : romPath;
+  RomWriter          w, wr;
+  auto               provenance = [&](RomWriter *x) {
     std::ostringstream hs;
     hs << std::hex << header.sceneHash;
-    w.Attr("scene", header.scene);
-    w.Attr("scene_hash", hs.str());
-    w.Attr("code_version", header.codeVersion);
-    w.Attr("snapshots", snapPath);
-    w.Attr("options", header.optionsText);
-    w.Attr("pod_inner", inner);
+    x->Attr("scene", header.scene);
+    x->Attr("scene_hash", hs.str());
+    x->Attr("code_version", header.codeVersion);
+    x->Attr("snapshots", snapPath);
+    x->Attr("options", header.optionsText);
+    x->Attr("pod_inner", inner);
+    x->Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
+  };
+  if (wrank == 0) {
+    provenance(&w);
     std::vector<double> box;
     for (size_t i = 0; i < header.paramMin.size(); ++i) { box.push_back(header.paramMin[i]); box.push_back(header.paramMax[i]); }
     w.Dataset("/params/box", {header.paramMin.size(), 2}, box);
     w.Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
-    w.Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
-    if (R > 0) WriteDualBasis(dual, &w);
+    if (R > 0) WriteDualBasis(dual, &w, true);
   }
-  PetscCall(w.Write(world, romPath));
+  PetscCall(w.Write(world, bpath));
+  if (cmap) {
+    // the online ROM: everything the online stage needs, nothing of the size of the mesh
+    MPI_Comm    fcomm = PetscObjectComm((PetscObject)fom.dm);
+    PetscMPIInt frank;
+    PetscCallMPI(MPI_Comm_rank(fcomm, &frank));
+    unsigned long long nm = modes.size();
+    PetscCallMPI(MPI_Bcast(&nm, 1, MPI_UNSIGNED_LONG_LONG, 0, fcomm));
+    modes.resize(nm);
+    PetscCallMPI(MPI_Bcast(modes.data(), (int)nm, MPI_DOUBLE, 0, fcomm));
+    PetscCheck(R > 0, world, PETSC_ERR_SUP, "offline: no multipliers (R = 0): nothing to reduce for contact");
+    wr.version = 2;
+    if (wrank == 0) {
+      provenance(&wr);
+      wr.Attr("basis_file", basisPath);
+      WriteDualBasis(dual, &wr, false);
+    }
+    PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep));
+    PetscCall(wr.Write(world, romPath));
+    unsigned long long big[2] = {0, 0};
+    std::string        bigName;
+    if (wrank == 0) {
+      const auto l = wr.Largest();
+      bigName      = l.first;
+      big[0]       = l.second;
+    }
+    PetscCallMPI(MPI_Bcast(big, 2, MPI_UNSIGNED_LONG_LONG, 0, world));
+    PetscCall(BcastString(world, &bigName));
+    rep->root["rom_largest_array"]["name"]    = bigName;
+    rep->root["rom_largest_array"]["entries"] = (long long)big[0];
+    rep->root["basis_file"]                   = basisPath;
+  }
 
   JsonValue &p = rep->root["pod"];
   p["n"]               = (long long)pod.N;

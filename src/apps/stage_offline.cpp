@@ -82,7 +82,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
 {
   SceneSpec      scene;
   Report         rep;
-  char           reportPath[PETSC_MAX_PATH_LEN] = "", snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "snapshots";
+  char           reportPath[PETSC_MAX_PATH_LEN] = "", snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom";
   PetscBool      restart = PETSC_FALSE, monitor = PETSC_FALSE, set;
   PetscMPIInt    wrank, wsize;
   PetscLogDouble t0, t1, tSnap0;
@@ -94,13 +94,22 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCallMPI(MPI_Comm_size(world, &wsize));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, NULL));
-  PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases"), world, PETSC_ERR_SUP, "-offline_stop %s: 'snapshots' and 'bases' are implemented so far (the EIM and the online data come with the next stage)", stop);
-  const PetscBool bases = strcmp(stop, "bases") ? PETSC_FALSE : PETSC_TRUE;
-  char            romPath[PETSC_MAX_PATH_LEN] = "";
+  PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), world, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
+  const PetscBool full  = strcmp(stop, "rom") ? PETSC_FALSE : PETSC_TRUE;
+  const PetscBool bases = (PetscBool)(full || !strcmp(stop, "bases"));
+  char            romPath[PETSC_MAX_PATH_LEN] = "", basisPath[PETSC_MAX_PATH_LEN] = "";
   PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
-  PetscCheck(!bases || romPath[0], world, PETSC_ERR_USER_INPUT, "-offline_stop bases writes the bases to the ROM file: give -rom <file.h5>");
+  PetscCheck(!bases || romPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
+  // companion files of the ROM: <stem>.snapshots.h5 and <stem>.basis.h5 unless given
+  std::string stem = romPath;
+  if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
+  if (full) {
+    PetscCall(PetscStrncpy(snapPath, (stem + ".snapshots.h5").c_str(), sizeof snapPath));
+    PetscCall(PetscStrncpy(basisPath, (stem + ".basis.h5").c_str(), sizeof basisPath));
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", basisPath, sizeof basisPath, NULL));
+  }
   PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", snapPath, sizeof snapPath, &set));
-  PetscCheck(set && snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  PetscCheck(snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
   // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
   restart = bases;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_restart", &restart, NULL));
@@ -320,11 +329,11 @@ PetscErrorCode StageOffline(MPI_Comm world)
     rep.root["snapshots"]             = snapPath;
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
-      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep));
+      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep, full ? &cmap : nullptr, basisPath));
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }
-    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), snapPath));
+    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), bases ? romPath : snapPath));
   }
   PetscCall(PetscSubcommDestroy(&psub));
   PetscCall(rep.Write(world, reportPath));

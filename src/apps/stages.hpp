@@ -6,4 +6,6 @@ namespace rbc {
 PetscErrorCode StageFom(MPI_Comm comm);
 PetscErrorCode StageOffline(MPI_Comm comm);
 PetscErrorCode StageDualBasis(MPI_Comm comm);
+PetscErrorCode StageOnline(MPI_Comm comm);
+PetscErrorCode StageValidate(MPI_Comm comm);
 } // namespace rbc

@@ -7,27 +7,52 @@
 
 namespace rbc {
 
-PetscErrorCode ClosestPoint::Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
+void ClosestPoint::SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
 {
-  PetscFunctionBeginUser;
   dim_ = dim;
   nv_  = dim;
   const PetscInt nf = (PetscInt)facets.size();
   xdef_.assign(9 * nf, 0.0);
-  PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL}, hsum = 0;
   for (PetscInt f = 0; f < nf; ++f) {
     const SurfaceFacet &F = facets[f];
     for (PetscInt k = 0; k < nv_; ++k) {
       // vertex node i with nodeKind k
       PetscInt node = -1;
       for (PetscInt i = 0; i < F.nnodes; ++i) if (F.nodeKind[i] == k) node = i;
+      for (PetscInt d = 0; d < dim; ++d) xdef_[9 * f + k * dim + d] = F.X[k * dim + d] + (deformed && node >= 0 ? F.U[node * dim + d] : 0.0);
+    }
+  }
+}
+
+void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt nc, PetscInt *facet, PetscReal b[], PetscReal *dist) const
+{
+  *facet = -1;
+  *dist  = PETSC_MAX_REAL;
+  for (PetscInt i = 0; i < nc; ++i) {
+    const PetscInt  f = cand[i];
+    PetscReal       bb[3];
+    const PetscReal dd = DistToFacet(f, p, bb);
+    if (dd < *dist || (dd == *dist && f < *facet)) {
+      *dist  = dd;
+      *facet = f;
+      for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
+    }
+  }
+}
+
+PetscErrorCode ClosestPoint::Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
+{
+  PetscFunctionBeginUser;
+  SetVertices(facets, dim, deformed);
+  const PetscInt nf = (PetscInt)facets.size();
+  PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL}, hsum = 0;
+  for (PetscInt f = 0; f < nf; ++f) {
+    for (PetscInt k = 0; k < nv_; ++k)
       for (PetscInt d = 0; d < dim; ++d) {
-        const PetscReal x = F.X[k * dim + d] + (deformed && node >= 0 ? F.U[node * dim + d] : 0.0);
-        xdef_[9 * f + k * dim + d] = x;
+        const PetscReal x = xdef_[9 * f + k * dim + d];
         lo[d] = std::min(lo[d], x);
         hi[d] = std::max(hi[d], x);
       }
-    }
     PetscReal len = 0;
     for (PetscInt d = 0; d < dim; ++d) len += PetscSqr(xdef_[9 * f + dim + d] - xdef_[9 * f + d]);
     hsum += std::sqrt(len);

@@ -5,6 +5,7 @@
 // rho(z) the closest point of the deformed master surface to the deformed slave point z + u_1(z),
 // n2 the master's outward unit normal there (facet normal or interpolated nodal normals).
 #include "rbcontact/contact.hpp"
+#include "contact_point.hpp"
 #include <petscsf.h>
 #include <petscdt.h>
 #include <algorithm>
@@ -91,7 +92,10 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_quadrature", quad, sizeof quad, NULL));
   if (!strcmp(quad, "gauss")) quadrature = ContactQuadrature::Gauss;
   else if (!strcmp(quad, "nodal")) quadrature = ContactQuadrature::Nodal;
-  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_quadrature: unknown value '%s' (gauss or nodal)", quad);
+  else if (!strcmp(quad, "composite")) quadrature = ContactQuadrature::Composite;
+  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_quadrature: unknown value '%s' (gauss, composite or nodal)", quad);
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-contact_quadrature_subdivisions", &nsub, NULL));
+  PetscCheck(nsub >= 1 && nsub <= 64, comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-contact_quadrature_points", &nquad, &flg));
   PetscCheck(nquad >= 1 && nquad <= 12, comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_quadrature_points %" PetscInt_FMT " out of range [1, 12]", nquad);
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_normal", nrm, sizeof nrm, NULL));
@@ -102,6 +106,15 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));
   PetscCall(NumberMultipliers(elas));
+  for (size_t s = 0; s < slave_.facets.size(); ++s) {
+    PetscInt *closure = NULL, ncl, k = 0;
+    PetscCall(DMPlexGetTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
+    for (PetscInt c = 0; c < ncl; ++c) {
+      const PetscInt pt = closure[2 * c];
+      if (pt >= vStart_ && pt < vStart_ + (PetscInt)vertexRow_.size() && k < elas.dim) slave_.facets[s].row[k++] = vertexRow_[pt - vStart_];
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
+  }
   PetscCheck(R_ > 0, comm, PETSC_ERR_USER_INPUT, "Contact slave surface '%s' (-contact_slave) has no facets", slave.c_str());
   {
     PetscInt nm = (PetscInt)master_.facets.size();
@@ -128,29 +141,6 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   }
   PetscCall(PetscQuadratureDestroy(&q));
   PetscFunctionReturn(0);
-}
-
-static PetscReal FacetMeasure(const PetscReal *x, PetscInt dim)
-{
-  if (dim == 2) return std::hypot(x[2] - x[0], x[3] - x[1]);
-  const PetscReal a[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, b[3] = {x[6] - x[0], x[7] - x[1], x[8] - x[2]};
-  const PetscReal c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-  return 0.5 * std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-}
-
-// Unnormalized outward normal of a facet with vertices x (length / area weighted).
-static void FacetNormal(const PetscReal *x, PetscInt dim, PetscReal outward, PetscReal n[])
-{
-  if (dim == 2) {
-    n[0] = outward * (x[3] - x[1]);
-    n[1] = -outward * (x[2] - x[0]);
-    n[2] = 0;
-  } else {
-    const PetscReal a[3] = {x[3] - x[0], x[4] - x[1], x[5] - x[2]}, b[3] = {x[6] - x[0], x[7] - x[1], x[8] - x[2]};
-    n[0] = outward * 0.5 * (a[1] * b[2] - a[2] * b[1]);
-    n[1] = outward * 0.5 * (a[2] * b[0] - a[0] * b[2]);
-    n[2] = outward * 0.5 * (a[0] * b[1] - a[1] * b[0]);
-  }
 }
 
 void ContactMap::SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu)
@@ -279,16 +269,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   for (size_t s = 0; s < slave_.facets.size(); ++s) {
     const SurfaceFacet &F    = slave_.facets[s];
     const PetscReal     meas = FacetMeasure(F.X.data(), dim);
-    PetscInt            rows[3];
-    {
-      PetscInt *closure = NULL, ncl, k = 0;
-      PetscCall(DMPlexGetTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
-      for (PetscInt c = 0; c < ncl; ++c) {
-        const PetscInt pt = closure[2 * c];
-        if (pt >= vStart_ && pt < vStart_ + (PetscInt)vertexRow_.size() && k < nv) rows[k++] = vertexRow_[pt - vStart_];
-      }
-      PetscCall(DMPlexRestoreTransitiveClosure(elas.dm, slave_.points[s], PETSC_TRUE, &ncl, &closure));
-    }
+    const PetscInt     *rows = F.row.data();
     // Integration points of this slave facet (barycentric b, weight w)
     std::vector<std::array<PetscReal, 4>> ipts;
     if (quadrature == ContactQuadrature::Nodal) {
@@ -297,7 +278,15 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
         q[k] = 1.0;
         ipts.push_back(q);
       }
-    } else if (dim == 2) {
+    } else if (quadrature == ContactQuadrature::Composite && dim == 2) {
+      // Fixed composite rule (nsub equal pieces, Gauss on each): the points do not depend on u (the
+      // rule the reduced model's empirical interpolation uses, docs/eim.md).
+      for (PetscInt k = 0; k < nsub; ++k)
+        for (PetscInt qp = 0; qp < (PetscInt)quadWeights_.size(); ++qp) {
+          const PetscReal t = (k + quadPoints_[qp * nv + 1]) / nsub;
+          ipts.push_back({1 - t, t, 0, quadWeights_[qp] * meas / nsub});
+        }
+    } else if (dim == 2 && quadrature == ContactQuadrature::Gauss) {
       // Segment-based (mortar) integration: split [0, 1] where the projection changes master facet,
       // so that every piece sees one smooth master facet; Gauss on each piece.
       std::vector<std::pair<PetscReal, PetscReal>> segs;
@@ -311,37 +300,13 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       for (PetscInt qp = 0; qp < nq; ++qp) ipts.push_back({quadPoints_[qp * nv], quadPoints_[qp * nv + 1], quadPoints_[qp * nv + 2], quadWeights_[qp] * meas});
     }
     for (const auto &ip : ipts) {
-      const PetscReal b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
-      PetscReal Ns[6], z[3] = {0, 0, 0}, zdef[3];
-      FacetBasis(F, b, Ns);
-      for (PetscInt k = 0; k < nv; ++k)
-        for (PetscInt d = 0; d < dim; ++d) z[d] += b[k] * F.X[k * dim + d];
-      for (PetscInt d = 0; d < dim; ++d) {
-        zdef[d] = z[d];
-        for (PetscInt a = 0; a < F.nnodes; ++a) zdef[d] += Ns[a] * F.U[a * dim + d];
-      }
-      PetscInt  m;
-      PetscReal bm[3] = {0, 0, 0}, dist;
-      cp.Find(zdef, &m, bm, &dist);
-      const SurfaceFacet &M = masterAll_[m];
-      PetscReal           Nm[6], rho[3] = {0, 0, 0}, n2[3] = {0, 0, 0};
-      FacetBasis(M, bm, Nm);
-      for (PetscInt k = 0; k < nv; ++k)
-        for (PetscInt d = 0; d < dim; ++d) rho[d] += bm[k] * M.X[k * dim + d];
-      if (smoothNormal) {
-        for (PetscInt k = 0; k < nv; ++k) {
-          const auto &a = vnormal[M.vglobal[k]];
-          const PetscReal an = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-          for (PetscInt d = 0; d < dim; ++d) n2[d] += bm[k] * a[d] / an;
-        }
-      } else FacetNormal(cp.Vertices(m), dim, M.outward, n2);
-      PetscReal nn = 0;
-      for (PetscInt d = 0; d < dim; ++d) nn += n2[d] * n2[d];
-      nn = std::sqrt(nn);
-      for (PetscInt d = 0; d < dim; ++d) n2[d] /= nn;
-      PetscReal gap = 0;
-      for (PetscInt d = 0; d < dim; ++d) gap += (z[d] - rho[d]) * n2[d];
-
+      const PetscReal  b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
+      ContactPointEval e;
+      EvaluateContactPoint(
+        F, dim, b, masterAll_, cp.Vertices(0), smoothNormal, [&](const PetscReal *p, PetscInt *m, PetscReal *bm, PetscReal *dist) { cp.Find(p, m, bm, dist); },
+        [&](const SurfaceFacet &M, PetscInt k) { return vnormal[M.vglobal[k]].data(); }, &e);
+      const SurfaceFacet &M = masterAll_[e.m];
+      const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2, gap = e.gap;
       for (PetscInt k = 0; k < nv; ++k) {
         const PetscReal psi = b[k];
         if (psi == 0.0) continue;

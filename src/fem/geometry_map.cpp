@@ -87,6 +87,51 @@ std::string Translation::Describe() const
   return o.str();
 }
 
+std::array<PetscReal, 7> Dilation::Record() const { return {0, (PetscReal)p_, ref_, c_[0], c_[1], c_[2], 0}; }
+std::array<PetscReal, 7> Stretch::Record() const { return {1, (PetscReal)p_, ref_, c_, 0, 0, (PetscReal)axis_}; }
+std::array<PetscReal, 7> Translation::Record() const { return {2, (PetscReal)p_, ref_, d_[0], d_[1], d_[2], 0}; }
+
+std::unique_ptr<AffineBlock> AffineBlockFromRecord(const std::array<PetscReal, 7> &r)
+{
+  const PetscInt p = (PetscInt)r[1];
+  switch ((int)r[0]) {
+  case 0: return std::make_unique<Dilation>(p, r[2], std::array<PetscReal, 3>{r[3], r[4], r[5]});
+  case 1: return std::make_unique<Stretch>(p, r[2], (PetscInt)r[6], r[3]);
+  case 2: return std::make_unique<Translation>(p, r[2], std::array<PetscReal, 3>{r[3], r[4], r[5]});
+  default: return nullptr;
+  }
+}
+
+std::vector<PetscReal> GeometryMap::Records() const
+{
+  std::vector<PetscReal> rec;
+  for (size_t b = 0; b < bodies.size(); ++b)
+    for (const auto &blk : bodies[b].blocks) {
+      const auto r = blk->Record();
+      rec.push_back((PetscReal)b);
+      rec.insert(rec.end(), r.begin(), r.end());
+    }
+  return rec;
+}
+
+PetscErrorCode GeometryMap::FromRecords(PetscInt nbodies, const std::vector<PetscReal> &rec)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(rec.size() % 8 == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "geometry map: %zu values is not a multiple of 8", rec.size());
+  bodies.clear();
+  bodies.resize(nbodies);
+  for (size_t i = 0; i < rec.size(); i += 8) {
+    const PetscInt b = (PetscInt)rec[i];
+    PetscCheck(b >= 0 && b < nbodies, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "geometry map: block of body %" PetscInt_FMT " (%" PetscInt_FMT " bodies)", b, nbodies);
+    std::array<PetscReal, 7> r;
+    for (int k = 0; k < 7; ++k) r[k] = rec[i + 1 + k];
+    auto blk = AffineBlockFromRecord(r);
+    PetscCheck(blk, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "geometry map: unknown block type %g", (double)r[0]);
+    bodies[b].blocks.push_back(std::move(blk));
+  }
+  PetscFunctionReturn(0);
+}
+
 Affine BodyMap::Evaluate(const std::vector<PetscReal> &mu) const
 {
   Affine a;

@@ -62,9 +62,47 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
     tmp = h5file + ".tmp." + std::to_string(pid);
   }
   PetscCall(elas.VonMises(u, &vm));
+  // The mesh is the reference one: write it in the physical configuration at mu (x = h_b(mu)(xr) on
+  // the vertices of body b), then restore the reference coordinates.
+  Vec xref = nullptr;
+  if (!map.IsIdentity() && !mu.empty()) {
+    Vec          xl, xphys;
+    PetscScalar *a;
+    PetscInt     cStart, cEnd, vStart, vEnd;
+    PetscCall(DMGetCoordinatesLocal(dm, &xl));
+    PetscCall(VecDuplicate(xl, &xref));
+    PetscCall(VecCopy(xl, xref));
+    PetscCall(VecDuplicate(xl, &xphys));
+    PetscCall(VecCopy(xl, xphys));
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+    PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+    std::vector<PetscInt> vbody(vEnd - vStart, -1);
+    for (PetscInt c = cStart; c < cEnd; ++c) {
+      PetscInt *cl = NULL, ncl;
+      PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+      for (PetscInt i = 0; i < ncl; ++i)
+        if (cl[2 * i] >= vStart && cl[2 * i] < vEnd) vbody[cl[2 * i] - vStart] = elas.CellBody()[c - cStart];
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    }
+    PetscCall(VecGetArray(xphys, &a));
+    const PetscInt d = elas.dim;
+    for (PetscInt vtx = vStart; vtx < vEnd; ++vtx) {
+      PetscReal x[3] = {0, 0, 0}, y[3];
+      for (PetscInt k = 0; k < d; ++k) x[k] = PetscRealPart(a[(vtx - vStart) * d + k]);
+      map.Evaluate(vbody[vtx - vStart], mu).Apply(d, x, y);
+      for (PetscInt k = 0; k < d; ++k) a[(vtx - vStart) * d + k] = y[k];
+    }
+    PetscCall(VecRestoreArray(xphys, &a));
+    PetscCall(DMSetCoordinatesLocal(dm, xphys));
+    PetscCall(VecDestroy(&xphys));
+  }
   PetscCall(PetscViewerHDF5Open(comm, tmp.c_str(), FILE_MODE_WRITE, &v));
   PetscCall(PetscViewerPushFormat(v, PETSC_VIEWER_HDF5_VIZ));
   PetscCall(DMView(dm, v));
+  if (xref) {
+    PetscCall(DMSetCoordinatesLocal(dm, xref));
+    PetscCall(VecDestroy(&xref));
+  }
   PetscCall(VecView(u, v));
   PetscCall(VecView(vm, v));
   PetscCall(PetscViewerPopFormat(v));

@@ -14,6 +14,14 @@ void RomWriter::Dataset(const std::string &path, const std::vector<unsigned long
   items_.push_back({path, dims, data});
 }
 
+std::pair<std::string, unsigned long long> RomWriter::Largest() const
+{
+  std::pair<std::string, unsigned long long> best("", 0);
+  for (const auto &it : items_)
+    if (it.data.size() > best.second) best = {it.path, (unsigned long long)it.data.size()};
+  return best;
+}
+
 PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
 {
   PetscMPIInt rank;
@@ -31,7 +39,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
       if (!f.ok()) ok = c.Fail("cannot create the file (directory missing or not writable?)");
       if (ok) ok = WriteStringAttr(c, f.get(), "format", kRomFormat);
       if (ok) {
-        const int v = 1;
+        const int v = version;
         ok          = WriteAttr(c, f.get(), "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &v);
       }
       for (const auto &a : attrs_)
@@ -93,6 +101,18 @@ PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std
 
   PetscFunctionBeginUser;
   bool ok = OpenRom(c, path, &f) && ReadStringAttr(c, f.get(), name.c_str(), value);
+  PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", c.err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RomReadVersion(const std::string &path, int *version)
+{
+  H5Quiet quiet;
+  Ctx     c{"ROM file '" + path + "'", std::string()};
+  H5Id    f;
+
+  PetscFunctionBeginUser;
+  bool ok = OpenRom(c, path, &f) && ReadAttr(c, f.get(), "format_version", H5T_NATIVE_INT, version);
   PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", c.err.c_str());
   PetscFunctionReturn(0);
 }

@@ -1,0 +1,133 @@
+// rbcontact/reduced_model.hpp: the online stage, as a C++ API. ReducedModel holds everything the
+// online solve needs, read once from a ROM file (docs/rom_file.md): the parameter box, the coefficient
+// functions of the affine terms A^(mu) = sum_q thetaA_q(mu) A^_q, f^(mu) = sum_q thetaF_q(mu) f^_q
+// (materials and geometric map serialized), the EIM of the contact map kappa and of the gap gamma
+// (interpolation points, B, C_j, D^gamma) with the local contact data around the points (a
+// ContactPatch), and warm starts. Solve(mu) runs the reduced Kacanov loop: at each iterate the small
+// saddle-point QP with v in R^N, eta in R^R_+ (ReducedQP), stopping rules as the full-order model
+// (-rom_kacanov_rtol_primal, -rom_kacanov_rtol_dual, -rom_kacanov_max_it, -rom_kacanov_relaxation,
+// -rom_kacanov_monitor), KKT check -rom_kkt_tol. Nothing in it grows with the mesh.
+// Usage: share/examples/online_loop.cpp.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+#include "rbcontact/affine_decomposition.hpp"
+#include "rbcontact/eim.hpp"
+#include "rbcontact/reduced_contact.hpp"
+#include "rbcontact/reduced_qp.hpp"
+#include "rbcontact/rom_file.hpp"
+
+namespace rbc {
+
+// The parameter dependence of A and f: parameter box, materials, geometric map, coefficients.
+class ReducedParametrization {
+public:
+  PetscErrorCode FromFOM(const Elasticity &elas, const GeometryMap &map, const AffineDecomposition &aff);
+  void           Write(RomWriter *w) const;
+  PetscErrorCode Read(const std::string &file);
+  void           ThetaA(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
+  void           ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
+  // A clear error naming the parameter, the value and the box when mu is outside it (or has the wrong size).
+  PetscErrorCode CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const;
+  PetscInt       NumA() const { return (PetscInt)thetaA.size(); }
+  PetscInt       NumF() const { return (PetscInt)thetaF.size(); }
+
+  PetscInt                 dim = 2;
+  std::vector<ParamSpec>   params;
+  std::vector<BodySpec>    bodies;
+  GeometryMap              map;
+  std::vector<Coefficient> thetaA, thetaF;
+
+private:
+  void Light(); // the parameter-only Elasticity the coefficients evaluate with
+  std::shared_ptr<Elasticity> light_;
+};
+
+struct ReducedSolution {
+  std::vector<PetscReal> v, lambda; // reduced coordinates: u ~ sum_n v_n theta_n, lambda ~ sum_r lambda_r xi_r
+  PetscInt               iterations = 0;
+  bool                   converged  = false;
+  std::vector<PetscReal> du, dl;      // Kacanov relative changes per iteration
+  std::vector<PetscInt>  nactive;     // active reduced multipliers per iteration
+  ReducedQPInfo          qp;          // last QP (status, KKT)
+  PetscInt               outOfRange = 0; // contact projections at the edge of the stored patch (EIM range)
+  std::string            message;     // why it failed (empty on success)
+  std::vector<PetscReal> iterates;    // with recordIterates: the v (N each) the contact terms were evaluated at
+};
+
+class ReducedModel {
+public:
+  enum class ContactMode { EIM, Exact };
+
+  // Reads a ROM file (any rank; no collective call). Errors name the file and the dataset.
+  PetscErrorCode Open(const std::string &file);
+  // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation).
+  PetscErrorCode SetFromOptions();
+  // Uses the leading n POD modes (and the supremizers of the leading r dual vectors), r dual vectors,
+  // mk and mg EIM terms (-1: all). Rebuilds the active operators.
+  PetscErrorCode Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg);
+  // The reduced solution at mu (inside the box). Never throws on a numerical failure: converged =
+  // false and message set (the stages turn that into an error); PETSc errors only for bad input.
+  PetscErrorCode Solve(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  // Exact contact terms (no EIM): K^ = P kappa, g^ = P gamma on the full patch (offline, validation);
+  // P = W' Psi (Rfull x Q, row-major). Call Truncate afterwards.
+  void SetExactContact(std::shared_ptr<ContactPatch> full, const std::vector<PetscReal> &P);
+  void SetContactMode(ContactMode m)
+  {
+    mode_ = m;
+    geomMu_.clear();
+  }
+
+  // Sizes in use, and of the file.
+  PetscInt N() const { return (PetscInt)cols_.size(); }
+  PetscInt R() const { return r_; }
+  PetscInt Mk() const { return mk_; }
+  PetscInt Mg() const { return mg_; }
+  // POD column (index into the stored primal basis) of each active reduced coordinate.
+  const std::vector<PetscInt> &Columns() const { return cols_; }
+  // Reduced A^(mu) (N x N, column-major) and f^(mu).
+  void Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
+  // Reduced contact terms at (mu, v) in the current mode: K (R x N column-major), g (R). Returns the out-of-range count.
+  PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g);
+
+  // --- stored data (file sizes; public so that the offline stage can fill it in memory) ---
+  std::string            file;
+  ReducedParametrization par;
+  PetscInt               dim = 2, Nfull = 0, Npod = 0, nsup = 0, Rfull = 0;
+  std::vector<PetscReal> Aq, fq;                     // QA x Nfull x Nfull, QF x Nfull
+  bool                   kappaConst = false, gapConst = false;
+  PetscInt               MkFull = 0, MgFull = 0;
+  std::vector<PetscInt>  kPoint, kMode, gPoint;      // EIM points: patch point (and mode for kappa)
+  std::vector<PetscReal> kB, kC, gB, gC;             // B (M x M, column-major); C_j: Mk x Nfull x Rfull, Mg x Rfull
+  std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull
+  ContactPatch           patch;                      // local data around the EIM points
+  std::vector<PetscReal> warmMu, warmV, warmL;       // training parameters and their reduced solutions
+  // options
+  PetscInt  maxIt = 30;
+  PetscReal rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
+  PetscBool monitor = PETSC_FALSE, warmStart = PETSC_TRUE;
+  bool      recordIterates = false;
+  ReducedQP qp;
+
+private:
+  PetscErrorCode Evaluate(const std::vector<PetscReal> &mu, const PetscReal *v);
+  ContactMode            mode_ = ContactMode::EIM;
+  std::vector<PetscInt>  cols_;
+  PetscInt               r_ = 0, mk_ = 0, mg_ = 0;
+  ContactPatch           active_;                     // patch with the active basis columns
+  std::vector<PetscInt>  evalPoints_, kPos_, gPos_;   // unique patch points evaluated, positions
+  std::vector<PetscReal> A_, f_, Kc_, Gc_, KB_, GB_;  // active operators
+  std::vector<PetscReal> kap_, gam_, phi_, vals_, K_, g_, Ath_, fth_;
+  std::vector<PetscReal> thA_, thF_;
+  std::shared_ptr<ContactPatch> full_;
+  ContactPatch           fullActive_;
+  std::vector<PetscReal> P_, Pact_;
+  std::vector<PetscInt>  allPoints_;
+  std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
+};
+
+// Writes the online part of a model (everything Open reads) to w.
+void WriteReducedModel(const ReducedModel &m, RomWriter *w);
+
+} // namespace rbc

@@ -1,0 +1,336 @@
+// src/apps/offline_rom.cpp: the last offline step: from the snapshots and the bases, the online data
+// of the ROM file (docs/eim.md, docs/rom_file.md): reduced affine terms A^_q = V'A_qV, f^_q = V'f_q;
+// the full contact patch on the support of the dual basis and P = W' Psi; snapshots of the contact map
+// kappa and the gap gamma at the training solutions and at the iterates of the reduced Kacanov loop
+// with exact contact terms; their EIM (or their exact constant form when they do not vary); the patch
+// restricted to the facets around the EIM points; warm starts. Every rank of the group computes the
+// same (deterministic) data; world rank 0 writes it.
+#include "offline_rom.hpp"
+#include "rbcontact/eim.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include <slepcbv.h>
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace rbc {
+
+static PetscLogEvent OFF_EIM = 0, OFF_Affine = 0;
+
+// kappa/gamma of one evaluation appended as snapshot columns; hits recorded per point.
+static void Append(const ContactPatch &P, std::vector<PetscReal> *Sk, std::vector<PetscReal> *Sg, std::vector<std::set<PetscInt>> *hits, std::vector<PetscInt> *all, std::vector<PetscReal> *kap, std::vector<PetscReal> *gam, std::vector<PetscInt> *hit)
+{
+  const PetscInt Q = P.NumPoints();
+  (void)P.Evaluate(all->data(), Q, kap->data(), gam->data(), hit->data());
+  Sk->insert(Sk->end(), kap->begin(), kap->end());
+  Sg->insert(Sg->end(), gam->begin(), gam->end());
+  for (PetscInt p = 0; p < Q; ++p) (*hits)[p].insert((*hit)[p]);
+}
+
+// Is every snapshot (n x m, column-major) equal to the first one (to round-off)?
+static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscReal *spread)
+{
+  PetscReal scale = 0, d = 0;
+  for (size_t i = 0; i < n * m; ++i) scale = std::max(scale, std::abs(S[i]));
+  for (size_t j = 1; j < m; ++j)
+    for (size_t i = 0; i < n; ++i) d = std::max(d, std::abs(S[i + j * n] - S[i]));
+  *spread = scale > 0 ? d / scale : 0;
+  return *spread <= 1e-13;
+}
+
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, const CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)fom.dm);
+  PetscLogDouble t0, t1, t2;
+  PetscMPIInt    wrank;
+  ReducedModel   rm;
+
+  PetscFunctionBeginUser;
+  if (!OFF_EIM) PetscCall(PetscLogEventRegister("RBCEIM", DM_CLASSID, &OFF_EIM));
+  if (!OFF_Affine) PetscCall(PetscLogEventRegister("RBCReducedAffine", DM_CLASSID, &OFF_Affine));
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  PetscCheck(fom.scene.contact, world, PETSC_ERR_SUP, "offline: the online ROM needs a contact scene (-contact_slave, -contact_master); use -offline_stop bases for the bases only");
+  PetscCheck(fom.useAffine, world, PETSC_ERR_SUP, "offline: the scene has no affine decomposition (see the fom report's affine_terms)");
+  const PetscInt N = Npod + nsup, R = dual.W.cols, Rfom = dual.W.rows, m = (PetscInt)snaps.size();
+  PetscCall(PetscTime(&t0));
+
+  // --- reduced affine terms
+  PetscCall(PetscLogEventBegin(OFF_Affine, 0, 0, 0, 0));
+  rm.dim   = fom.elas.dim;
+  rm.Nfull = N;
+  rm.Npod  = Npod;
+  rm.nsup  = nsup;
+  rm.Rfull = R;
+  PetscCall(rm.par.FromFOM(fom.elas, fom.map, fom.affine));
+  rm.Aq.assign(fom.affine.Aq.size() * N * N, 0.0);
+  rm.fq.assign(fom.affine.fq.size() * N, 0.0);
+  {
+    // explicit products (the BV carries the POD inner product: its BVDot would include it)
+    std::vector<Vec> cols(N);
+    Vec              Av;
+    for (PetscInt i = 0; i < N; ++i) {
+      Vec c;
+      PetscCall(BVGetColumn(V, i, &c));
+      PetscCall(VecDuplicate(c, &cols[i]));
+      PetscCall(VecCopy(c, cols[i]));
+      PetscCall(BVRestoreColumn(V, i, &c));
+    }
+    PetscCall(VecDuplicate(cols[0], &Av));
+    std::vector<PetscScalar> dots(N);
+    for (size_t q = 0; q < fom.affine.Aq.size(); ++q)
+      for (PetscInt j = 0; j < N; ++j) {
+        PetscCall(MatMult(fom.affine.Aq[q], cols[j], Av));
+        PetscCall(VecMDot(Av, N, cols.data(), dots.data()));
+        for (PetscInt i = 0; i < N; ++i) rm.Aq[(q * N + i) * N + j] = PetscRealPart(dots[i]);
+      }
+    for (size_t q = 0; q < fom.affine.Aq.size(); ++q) // exact symmetry
+      for (PetscInt i = 0; i < N; ++i)
+        for (PetscInt j = 0; j < i; ++j) {
+          const PetscReal a = 0.5 * (rm.Aq[(q * N + i) * N + j] + rm.Aq[(q * N + j) * N + i]);
+          rm.Aq[(q * N + i) * N + j] = rm.Aq[(q * N + j) * N + i] = a;
+        }
+    for (size_t q = 0; q < fom.affine.fq.size(); ++q) {
+      PetscCall(VecMDot(fom.affine.fq[q], N, cols.data(), dots.data()));
+      for (PetscInt i = 0; i < N; ++i) rm.fq[q * N + i] = PetscRealPart(dots[i]);
+    }
+    PetscCall(VecDestroy(&Av));
+    for (auto &c : cols) PetscCall(VecDestroy(&c));
+  }
+  PetscCall(PetscLogEventEnd(OFF_Affine, 0, 0, 0, 0));
+
+  // --- the full contact patch on the support of the dual basis (Dirichlet values at the default mu)
+  PetscCall(PetscLogEventBegin(OFF_EIM, 0, 0, 0, 0));
+  PetscInt nsub = 4;
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &nsub, NULL));
+  PetscCheck(nsub >= 1 && nsub <= 64, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
+  {
+    ContactSystem sys;
+    Vec           uloc;
+    PetscCall(fom.SetMu(ParamValues(fom.scene)));
+    cmap.SetGeometry(&fom.map, fom.mu);
+    Vec zero;
+    PetscCall(DMGetGlobalVector(fom.dm, &zero));
+    PetscCall(VecSet(zero, 0.0));
+    PetscCall(DMGetLocalVector(fom.dm, &uloc));
+    PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
+    PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
+    PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
+    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+    // a resumed run that solved nothing has not numbered the multipliers yet
+    if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(const_cast<CanonicalOrder &>(order).BuildMultipliers(sys.coord, fom.elas.dim));
+  }
+  std::vector<char> support(Rfom, 0);
+  for (PetscInt i = 0; i < Rfom; ++i)
+    for (PetscInt k = 0; k < R; ++k)
+      if (dual.W(i, k) > 0) support[i] = 1;
+  auto full = std::make_shared<ContactPatch>();
+  PetscCall(full->BuildFull(comm, cmap, order, modes, N, support, nsub));
+  {
+    bool bcParam = false, uDnonzero = false;
+    for (const auto &d : fom.scene.dirichlet) bcParam = bcParam || d.param >= 0;
+    for (PetscReal v : full->uD) uDnonzero = uDnonzero || v != 0;
+    PetscCheck(!(bcParam && uDnonzero), world, PETSC_ERR_SUP, "offline: a parametrized Dirichlet condition (-param_bc_*) acts on the contact surfaces; the reduced contact map does not support it yet");
+  }
+  const PetscInt Q = full->NumPoints();
+  // P = W' Psi (R x Q, row-major)
+  std::vector<PetscReal> P((size_t)R * Q, 0.0);
+  for (PetscInt p = 0; p < Q; ++p)
+    for (PetscInt k = 0; k < rm.dim; ++k) {
+      const PetscInt row = full->points[p].row[k];
+      const PetscReal b  = full->points[p].b[k];
+      if (row < 0 || b == 0) continue;
+      for (PetscInt r = 0; r < R; ++r) P[(size_t)r * Q + p] += b * dual.W(row, r);
+    }
+  rm.SetExactContact(full, P);
+  rm.SetContactMode(ReducedModel::ContactMode::Exact);
+  PetscCall(rm.SetFromOptions()); // rom_kacanov_*, rom_qp_* (the truncation options are not for this step)
+  PetscCall(rm.Truncate(-1, -1, -1, -1));
+  rm.warmStart      = PETSC_FALSE;
+  rm.monitor        = PETSC_FALSE;
+  rm.recordIterates = true;
+
+  // --- snapshots of kappa (Q x N per evaluation) and gamma (Q): training solutions and the iterates
+  // of the reduced Kacanov loop with the exact reduced contact terms
+  std::vector<PetscReal>            Sk, Sg, kap((size_t)Q * N), gam(Q), U;
+  std::vector<PetscInt>             all(Q), hit(Q);
+  std::vector<std::set<PetscInt>>   hits(Q);
+  PetscInt                          nRomIts = 0, maxRomIts = 0;
+  PetscReal                         uDep = 0;
+  for (PetscInt p = 0; p < Q; ++p) all[p] = p;
+  for (PetscInt j = 0; j < m; ++j) {
+    const auto &mu = snaps[j].mu;
+    full->SetGeometry(&fom.map, mu);
+    full->NodalFromCanonical(snaps[j].u, &U);
+    full->SetNodal(U);
+    Append(*full, &Sk, &Sg, &hits, &all, &kap, &gam, &hit);
+    if (j == 0) { // does kappa depend on the displacement? (compare with u = 0)
+      std::vector<PetscReal> k0((size_t)Q * N), g0(Q), Z(U.size(), 0.0);
+      full->NodalFromCanonical(std::vector<PetscReal>(snaps[j].u.size(), 0.0), &Z);
+      full->SetNodal(Z);
+      (void)full->Evaluate(all.data(), Q, k0.data(), g0.data(), nullptr);
+      PetscReal sc = 0;
+      for (size_t i = 0; i < k0.size(); ++i) {
+        uDep = std::max(uDep, std::abs(k0[i] - kap[i]));
+        sc   = std::max(sc, std::abs(kap[i]));
+      }
+      uDep = sc > 0 ? uDep / sc : 0;
+    }
+    ReducedSolution sol;
+    PetscCall(rm.Solve(mu, &sol));
+    PetscCheck(sol.converged, world, PETSC_ERR_NOT_CONVERGED, "offline: the reduced model with exact contact terms fails at training parameter %" PetscInt_FMT ": %s", j, sol.message.c_str());
+    nRomIts += sol.iterations;
+    maxRomIts = std::max(maxRomIts, sol.iterations);
+    for (PetscInt it = 0; it < sol.iterations; ++it) {
+      full->SetReduced(&sol.iterates[(size_t)it * N]);
+      Append(*full, &Sk, &Sg, &hits, &all, &kap, &gam, &hit);
+    }
+    rm.warmMu.insert(rm.warmMu.end(), mu.begin(), mu.end());
+    rm.warmV.insert(rm.warmV.end(), sol.v.begin(), sol.v.end());
+    rm.warmL.insert(rm.warmL.end(), sol.lambda.begin(), sol.lambda.end());
+  }
+  const PetscInt ms = (PetscInt)(Sg.size() / Q);
+  PetscCall(PetscTime(&t1));
+
+  // --- EIM of kappa and gamma (or their exact constant form)
+  EIMOptions ok, og;
+  ok.name = "kappa";
+  og.name = "gap";
+  PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &ok));
+  PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &og));
+  EIMResult  ek, eg;
+  PetscReal  spreadK, spreadG;
+  rm.kappaConst = Constant(Sk, (size_t)Q * N, ms, &spreadK);
+  rm.gapConst   = Constant(Sg, Q, ms, &spreadG);
+  std::vector<PetscInt> keep; // restricted patch points
+  auto keepPoint = [&](PetscInt p) {
+    auto it = std::find(keep.begin(), keep.end(), p);
+    if (it != keep.end()) return (PetscInt)(it - keep.begin());
+    keep.push_back(p);
+    return (PetscInt)keep.size() - 1;
+  };
+  if (rm.kappaConst) {
+    rm.kConstant.assign((size_t)N * R, 0.0);
+    for (PetscInt n = 0; n < N; ++n)
+      for (PetscInt r = 0; r < R; ++r) {
+        PetscReal s = 0;
+        for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * Sk[(size_t)p * N + n];
+        rm.kConstant[(size_t)n * R + r] = s;
+      }
+  } else {
+    PetscCall(EIMGreedy(Sk, Q * N, ms, ok, &ek));
+    rm.MkFull = ek.M;
+    rm.kB     = ek.B;
+    rm.kC.assign((size_t)ek.M * N * R, 0.0);
+    for (PetscInt j = 0; j < ek.M; ++j) {
+      rm.kPoint.push_back(keepPoint(ek.points[j] / N));
+      rm.kMode.push_back(ek.points[j] % N);
+      for (PetscInt n = 0; n < N; ++n)
+        for (PetscInt r = 0; r < R; ++r) {
+          PetscReal s = 0;
+          for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * ek.Q[(size_t)j * Q * N + (size_t)p * N + n];
+          rm.kC[((size_t)j * N + n) * R + r] = s;
+        }
+    }
+  }
+  if (rm.gapConst) {
+    rm.gConstant.assign(R, 0.0);
+    for (PetscInt r = 0; r < R; ++r)
+      for (PetscInt p = 0; p < Q; ++p) rm.gConstant[r] += P[(size_t)r * Q + p] * Sg[p];
+  } else {
+    PetscCall(EIMGreedy(Sg, Q, ms, og, &eg));
+    rm.MgFull = eg.M;
+    rm.gB     = eg.B;
+    rm.gC.assign((size_t)eg.M * R, 0.0);
+    for (PetscInt j = 0; j < eg.M; ++j) {
+      rm.gPoint.push_back(keepPoint(eg.points[j]));
+      for (PetscInt r = 0; r < R; ++r) {
+        PetscReal s = 0;
+        for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * eg.Q[(size_t)j * Q + p];
+        rm.gC[(size_t)j * R + r] = s;
+      }
+    }
+  }
+  // --- the local data: slave facets of the points, master facets they projected onto (+ 2 rings)
+  PetscInt rings = 2;
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_patch_rings", &rings, NULL));
+  PetscCheck(rings >= 0 && rings <= 20, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", rings);
+  std::vector<std::vector<PetscInt>> hitv(Q);
+  for (PetscInt p = 0; p < Q; ++p) hitv[p].assign(hits[p].begin(), hits[p].end());
+  full->Restrict(keep, hitv, rings, &rm.patch);
+  // self-check: the restricted patch reproduces the full one at its points on every stored evaluation
+  // state of the last training parameter
+  PetscReal patchDiff = 0;
+  if (!keep.empty()) {
+    const PetscInt         nk = (PetscInt)keep.size();
+    std::vector<PetscInt>  idx(nk);
+    std::vector<PetscReal> k1((size_t)nk * N), g1(nk);
+    for (PetscInt i = 0; i < nk; ++i) idx[i] = i;
+    const auto &mu = snaps[m - 1].mu;
+    full->SetGeometry(&fom.map, mu);
+    rm.patch.SetGeometry(&fom.map, mu);
+    full->SetReduced(&rm.warmV[(size_t)(m - 1) * N]);
+    rm.patch.SetReduced(&rm.warmV[(size_t)(m - 1) * N]);
+    (void)full->Evaluate(keep.data(), nk, kap.data(), gam.data(), nullptr);
+    const PetscInt outside = rm.patch.Evaluate(idx.data(), nk, k1.data(), g1.data(), nullptr);
+    for (PetscInt i = 0; i < nk; ++i) {
+      patchDiff = std::max(patchDiff, std::abs(g1[i] - gam[i]));
+      for (PetscInt n = 0; n < N; ++n) patchDiff = std::max(patchDiff, std::abs(k1[(size_t)i * N + n] - kap[(size_t)i * N + n]));
+    }
+    PetscCheck(patchDiff <= 1e-12 && outside == 0, world, PETSC_ERR_PLIB, "offline: the local contact data differs from the full contact map by %g (%" PetscInt_FMT " projections outside): increase -eim_patch_rings", (double)patchDiff, outside);
+  }
+  PetscCall(PetscLogEventEnd(OFF_EIM, 0, 0, 0, 0));
+  PetscCall(PetscTime(&t2));
+  if (wrank == 0) {
+    WriteReducedModel(rm, w);
+    w->Dataset("/online/eim_quadrature", {1}, {(double)nsub}); // the contact quadrature of kappa, gamma (validation)
+  }
+
+  // --- report
+  JsonValue &e = rep->root["eim"];
+  e["quadrature_points"]    = (long long)Q;
+  e["quadrature_subdivisions"] = (long long)nsub;
+  e["snapshots"]            = (long long)ms;
+  e["rom_kacanov_iterations"]["total"] = (long long)nRomIts;
+  e["rom_kacanov_iterations"]["max"]   = (long long)maxRomIts;
+  JsonValue &k = e["kappa"];
+  k["kind"]            = rm.kappaConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
+  k["M"]               = (long long)rm.MkFull;
+  k["depends_on_u"]    = uDep > 1e-13;
+  k["u_sensitivity"]   = (double)uDep;
+  k["snapshot_spread"] = (double)spreadK;
+  if (!rm.kappaConst) {
+    k["history"] = ek.history;
+    k["tol_abs"] = (double)ek.tolAbs;
+    k["scale"]   = (double)ek.scale;
+  }
+  JsonValue &g = e["gap"];
+  g["kind"]            = rm.gapConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
+  g["M"]               = (long long)rm.MgFull;
+  g["snapshot_spread"] = (double)spreadG;
+  if (!rm.gapConst) {
+    g["history"] = eg.history;
+    g["tol_abs"] = (double)eg.tolAbs;
+    g["scale"]   = (double)eg.scale;
+  }
+  JsonValue &pt = e["patch"];
+  pt["points"]           = (long long)rm.patch.NumPoints();
+  pt["slave_facets"]     = (long long)rm.patch.slave.size();
+  pt["master_facets"]    = (long long)rm.patch.master.size();
+  pt["nodes"]            = (long long)rm.patch.nnode;
+  pt["rings"]            = (long long)rings;
+  pt["check_max_diff"]   = (double)patchDiff;
+  JsonValue &ro = rep->root["rom"];
+  ro["N"]    = (long long)N;
+  ro["Npod"] = (long long)Npod;
+  ro["supremizers"] = (long long)nsup;
+  ro["R"]    = (long long)R;
+  ro["Mk"]   = (long long)rm.MkFull;
+  ro["Mg"]   = (long long)rm.MgFull;
+  ro["affine_A"] = (long long)rm.par.NumA();
+  ro["affine_f"] = (long long)rm.par.NumF();
+  rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);
+  rep->root["time_s"]["eim"]           = (double)(t2 - t1);
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

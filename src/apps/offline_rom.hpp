@@ -1,0 +1,19 @@
+// src/apps/offline_rom.hpp: the online data step of the offline stage (reduced affine terms, EIM of
+// the contact map and gap, local contact data, warm starts), written into the ROM file.
+#pragma once
+#include <slepcbv.h>
+#include "rbcontact/canonical_order.hpp"
+#include "rbcontact/contact.hpp"
+#include "rbcontact/dual_basis.hpp"
+#include "rbcontact/fom.hpp"
+#include "rbcontact/report.hpp"
+#include "rbcontact/rom_file.hpp"
+#include "rbcontact/snapshot_file.hpp"
+
+namespace rbc {
+
+// V: the primal basis (Npod POD modes then nsup supremizers) on fom's DM; modes: the same, N x ndofs
+// row-major in canonical order, on every rank of fom's communicator. Report keys eim {...}, rom {...}.
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, const CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep);
+
+} // namespace rbc

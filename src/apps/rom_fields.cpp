@@ -1,0 +1,122 @@
+// src/apps/rom_fields.cpp: full-order fields of reduced solutions (validation, -rom_reconstruct).
+#include "rom_fields.hpp"
+#include "rbcontact/kacanov.hpp"
+#include "rbcontact/rom_file.hpp"
+
+namespace rbc {
+
+PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt nd)
+{
+  std::vector<unsigned long long> dims;
+  char                            buf[PETSC_MAX_PATH_LEN] = "";
+  PetscBool                       set;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", buf, sizeof buf, &set));
+  if (set) path = buf;
+  else PetscCall(RomReadAttr(romPath, "basis_file", &path));
+  PetscCall(RomReadDataset(path, "/pod/modes", &dims, &modes));
+  PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Nfull && (PetscInt)dims[1] == nd, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /pod/modes is %llu x %llu, the ROM %s has N = %" PetscInt_FMT " and the scene %" PetscInt_FMT " dofs (another scene or mesh?)", path.c_str(), dims.size() > 0 ? dims[0] : 0ULL, dims.size() > 1 ? dims[1] : 0ULL, romPath.c_str(), model.Nfull, nd);
+  N     = model.Nfull;
+  ndofs = nd;
+  PetscCall(RomReadDataset(path, "/dual/basis", &dims, &W));
+  PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Rfull, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /dual/basis has %llu vectors, the ROM R = %" PetscInt_FMT, path.c_str(), dims.empty() ? 0ULL : dims[0], model.Rfull);
+  r = (PetscInt)dims[0];
+  R = (PetscInt)dims[1];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RomBases::Displacement(const ReducedModel &model, const CanonicalOrder &order, const std::vector<PetscReal> &v, Vec u) const
+{
+  PetscInt     lo, hi;
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  const auto &cols = model.Columns();
+  PetscCall(VecGetOwnershipRange(u, &lo, &hi));
+  PetscCall(VecGetArray(u, &a));
+  for (PetscInt i = lo; i < hi; ++i) {
+    const PetscInt c = order.CanonicalDof(i);
+    PetscReal      s = 0;
+    for (size_t n = 0; n < cols.size(); ++n) s += v[n] * modes[(size_t)cols[n] * ndofs + c];
+    a[i - lo] = s;
+  }
+  PetscCall(VecRestoreArray(u, &a));
+  PetscFunctionReturn(0);
+}
+
+void RomBases::Multipliers(const ReducedModel &model, const std::vector<PetscReal> &lhat, std::vector<PetscReal> *lambda) const
+{
+  lambda->assign(R, 0.0);
+  for (PetscInt k = 0; k < model.R(); ++k)
+    for (PetscInt i = 0; i < R; ++i) (*lambda)[i] += lhat[k] * W[(size_t)k * R + i];
+}
+
+PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep)
+{
+  SceneSpec      scene;
+  ElasticFOM     fom;
+  ContactMap     cmap;
+  CanonicalOrder order;
+  RomBases       bases;
+  ContactSystem  sys;
+  std::string    romScene;
+
+  PetscFunctionBeginUser;
+  PetscCall(SceneSpecFromOptions(comm, &scene));
+  PetscCall(RomReadAttr(model.file, "scene", &romScene));
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "-rom_reconstruct: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), model.file.c_str(), romScene.c_str(), romScene.c_str());
+  PetscCall(fom.Create(comm, scene));
+  PetscCall(fom.SetupAffine());
+  PetscCall(fom.SetMu(mu));
+  PetscCall(order.BuildDofs(fom.elas));
+  PetscCall(bases.Read(comm, model, model.file, order.NumDofs()));
+  if (!fom.u) PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
+  PetscCall(bases.Displacement(model, order, sol.v, fom.u));
+  // the contact system at the reconstructed displacement: multiplier layout, weights, normals
+  PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+  cmap.SetGeometry(&fom.map, mu);
+  {
+    Vec uloc;
+    PetscCall(DMGetLocalVector(fom.dm, &uloc));
+    PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+    PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
+    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+  }
+  PetscCall(order.BuildMultipliers(sys.coord, fom.elas.dim));
+  std::vector<PetscReal> lam;
+  bases.Multipliers(model, sol.lambda, &lam);
+  Vec lambda;
+  PetscCall(VecDuplicate(sys.g, &lambda));
+  {
+    PetscInt     lo, hi;
+    PetscScalar *a;
+    PetscCall(VecGetOwnershipRange(lambda, &lo, &hi));
+    PetscCall(VecGetArray(lambda, &a));
+    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = lam[order.CanonicalMultiplier(i)];
+    PetscCall(VecRestoreArray(lambda, &a));
+  }
+  ContactSummary cs;
+  PetscCall(SummarizeContact(sys, lambda, fom.elas.dim, &cs));
+  rep->root["contact_force"] = (double)cs.force;
+  rep->root["max_pressure"]  = (double)cs.maxPressure;
+  rep->root["nactive"]       = (long long)cs.nactive;
+  PetscReal energy;
+  PetscCall(fom.elas.Energy(fom.u, &energy));
+  rep->root["energy"] = (double)energy;
+  const char      *names[] = {"x", "y", "z"}, *nn[] = {"normal_x", "normal_y", "normal_z"};
+  std::vector<Vec> cv      = {lambda, sys.weight};
+  PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
+  PetscCall(PetscObjectSetName((PetscObject)sys.weight, "weight"));
+  for (PetscInt d = 0; d < fom.elas.dim; ++d) {
+    PetscCall(PetscObjectSetName((PetscObject)sys.coord[d], names[d]));
+    PetscCall(PetscObjectSetName((PetscObject)sys.normal[d], nn[d]));
+    cv.push_back(sys.coord[d]);
+    cv.push_back(sys.normal[d]);
+  }
+  PetscCall(fom.WriteOutput(path, cv));
+  PetscCall(VecDestroy(&lambda));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,29 @@
+// src/apps/rom_fields.hpp: full-order fields of a reduced solution on the scene's mesh: the primal and
+// dual bases read from the ROM's basis file, the displacement u = sum_n v_n theta_n and the
+// multipliers lambda = sum_r lambda_r xi_r (canonical order), and -rom_reconstruct's output file.
+#pragma once
+#include "rbcontact/canonical_order.hpp"
+#include "rbcontact/fom.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include "rbcontact/report.hpp"
+
+namespace rbc {
+
+class RomBases {
+public:
+  // The basis file named by the ROM (attribute basis_file; -rom_basis overrides); checks its sizes
+  // against the model and ndofs (the scene's free dofs).
+  PetscErrorCode Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt ndofs);
+  // u (global vector of order's DM) from the active reduced coordinates v of model.
+  PetscErrorCode Displacement(const ReducedModel &model, const CanonicalOrder &order, const std::vector<PetscReal> &v, Vec u) const;
+  // lambda in canonical multiplier order from the active reduced multipliers.
+  void Multipliers(const ReducedModel &model, const std::vector<PetscReal> &lhat, std::vector<PetscReal> *lambda) const;
+  std::string            path;
+  PetscInt               N = 0, ndofs = 0, r = 0, R = 0;
+  std::vector<double>    modes, W; // N x ndofs, r x R (row-major, canonical)
+};
+
+// -rom_reconstruct: the scene from the options (must match the ROM's), fields at mu written to path.
+PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep);
+
+} // namespace rbc

@@ -1,0 +1,96 @@
+// src/apps/stage_online.cpp: `rbcontact online -rom rom.h5 -mu v1[,v2] -report r.json`: opens the ROM
+// file, solves the reduced contact problem at mu (ReducedModel, the C++ API), reports the reduced
+// solution, its KKT residuals and timings (-online_repeat n: median of n timed solves after one
+// warm-up). -rom_reconstruct out.h5 (with the scene, -options_file runs/<scene>.opts) writes the full
+// fields: displacement and contact pressure, with XDMF (src/apps/rom_fields.cpp).
+#include "stages.hpp"
+#include "rom_fields.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include "rbcontact/report.hpp"
+#include <algorithm>
+
+namespace rbc {
+
+PetscErrorCode StageOnline(MPI_Comm comm)
+{
+  char           romPath[PETSC_MAX_PATH_LEN] = "", reportPath[PETSC_MAX_PATH_LEN] = "", recPath[PETSC_MAX_PATH_LEN] = "";
+  PetscBool      set;
+  PetscInt       repeat = 1;
+  PetscLogDouble t0, t1;
+  Report         rep;
+  ReducedModel   model;
+  ReducedSolution sol;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, &set));
+  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "online: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_reconstruct", recPath, sizeof recPath, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-online_repeat", &repeat, NULL));
+  PetscCheck(repeat >= 1 && repeat <= 10000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-online_repeat %" PetscInt_FMT " out of range [1, 1e7]", repeat);
+  PetscCall(PetscTime(&t0));
+  PetscCall(model.Open(romPath));
+  PetscCall(model.SetFromOptions());
+  PetscCall(PetscTime(&t1));
+  const double tOpen = t1 - t0;
+  // mu: -mu values, default the parameters' defaults
+  std::vector<PetscReal> mu;
+  for (const auto &p : model.par.params) mu.push_back(p.def);
+  {
+    PetscInt  n = (PetscInt)mu.size() + 8;
+    std::vector<PetscReal> buf(n);
+    PetscCall(PetscOptionsGetRealArray(NULL, NULL, "-mu", buf.data(), &n, &set));
+    if (set) mu.assign(buf.begin(), buf.begin() + n);
+  }
+  PetscCall(model.par.CheckBox(comm, mu));
+  // one warm-up solve, then the timed ones (the online time: operators + EIM + Kacanov + QP, no I/O)
+  PetscCall(model.Solve(mu, &sol));
+  std::vector<double> times;
+  for (PetscInt k = 0; k < repeat; ++k) {
+    PetscCall(PetscTime(&t0));
+    PetscCall(model.Solve(mu, &sol));
+    PetscCall(PetscTime(&t1));
+    times.push_back(t1 - t0);
+  }
+  std::sort(times.begin(), times.end());
+  PetscCheck(sol.converged, comm, PETSC_ERR_NOT_CONVERGED, "online: %s", sol.message.c_str());
+  if (sol.outOfRange) PetscCall(PetscPrintf(comm, "rbcontact online: warning: %" PetscInt_FMT " contact projections fell at the edge of the stored contact data (outside the EIM's training range)\n", sol.outOfRange));
+
+  rep.root["stage"] = "online";
+  rep.root["rom"]   = romPath;
+  JsonValue &m      = rep.root["mu"];
+  for (size_t i = 0; i < mu.size(); ++i) m[model.par.params[i].name] = (double)mu[i];
+  rep.root["converged"]          = sol.converged;
+  rep.root["kacanov_iterations"] = (long long)sol.iterations;
+  rep.root["kacanov_history"]["du"] = sol.du;
+  rep.root["kacanov_history"]["dlambda"] = sol.dl;
+  rep.root["u_hat"]              = sol.v;
+  rep.root["lambda_hat"]         = sol.lambda;
+  rep.root["nactive_hat"]        = (long long)(sol.nactive.empty() ? 0 : sol.nactive.back());
+  rep.root["out_of_range"]       = (long long)sol.outOfRange;
+  JsonValue &k                   = rep.root["kkt"];
+  k["primal_infeas"]             = (double)sol.qp.primal;
+  k["dual_infeas"]               = (double)sol.qp.dual;
+  k["complementarity"]           = (double)sol.qp.complementarity;
+  k["stationarity"]              = (double)sol.qp.stationarity;
+  JsonValue &r                   = rep.root["rom"];
+  r["file"]                      = romPath;
+  r["N"]                         = (long long)model.N();
+  r["R"]                         = (long long)model.R();
+  r["Mk"]                        = (long long)model.Mk();
+  r["Mg"]                        = (long long)model.Mg();
+  rep.root["time_s"]["open"]     = tOpen;
+  rep.root["time_s"]["solve_median"] = times[times.size() / 2];
+  rep.root["time_s"]["solve_min"]    = times.front();
+  rep.root["time_s"]["solve_max"]    = times.back();
+  rep.root["repeat"]             = (long long)repeat;
+  if (recPath[0]) {
+    PetscCall(ReconstructFields(comm, model, sol, mu, recPath, &rep));
+    rep.root["reconstruct"] = recPath;
+  }
+  PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " Mk %" PetscInt_FMT " Mg %" PetscInt_FMT ", %" PetscInt_FMT " Kacanov iterations, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.Mk(), model.Mg(), sol.iterations, times[times.size() / 2], repeat));
+  PetscCall(rep.Write(comm, reportPath));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

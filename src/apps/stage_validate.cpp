@@ -1,0 +1,383 @@
+// src/apps/stage_validate.cpp: `rbcontact validate -options_file runs/<scene>.opts -rom rom.h5
+// -test_type random -test_size 20 -test_seed 7 -report v.json`: the ROM against the FOM on a test set.
+// For each test parameter: the FOM solve (timed), the ROM solve (median of -validate_repeat timed solves
+// after a warm-up; operators + EIM + Kacanov + QP, no I/O) and the ROM with exact reduced contact terms
+// (no EIM: the full contact patch, same quadrature), and their errors: u in the energy norm of A(mu),
+// lambda in the l2 norm weighted by the slave mass (int psi_i), the resultant contact force.
+// -validate_sweep: the same for a series of truncations (N, R, Mk, Mg) of the ROM (fractions
+// -validate_sweep_fractions), a table of online median time against max error (CSV and JSON,
+// -validate_sweep_output <stem>); share/plot_speed_error.py draws it. The FOM is distributed over the
+// ranks, the ROM runs redundantly on every rank (identical data, identical answers).
+#include "stages.hpp"
+#include "rom_fields.hpp"
+#include "rbcontact/kacanov.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include "rbcontact/rom_file.hpp"
+#include "rbcontact/training_set.hpp"
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace rbc {
+
+static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
+
+namespace {
+struct Errors {
+  std::vector<double> u, lambda, force;
+  PetscInt            failed = 0;
+  std::string         firstFailure;
+  void Fill(JsonValue *j) const
+  {
+    auto mx   = [](const std::vector<double> &v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+    auto mean = [](const std::vector<double> &v) {
+      double s = 0;
+      for (double x : v) s += x;
+      return v.empty() ? 0.0 : s / v.size();
+    };
+    (*j)["n"]                   = (long long)u.size();
+    (*j)["max_rel_err_u"]       = mx(u);
+    (*j)["mean_rel_err_u"]      = mean(u);
+    (*j)["max_rel_err_lambda"]  = mx(lambda);
+    (*j)["mean_rel_err_lambda"] = mean(lambda);
+    (*j)["max_rel_err_force"]   = mx(force);
+    (*j)["rel_err_u"]           = u;
+    (*j)["rel_err_lambda"]      = lambda;
+    (*j)["rel_err_force"]       = force;
+    (*j)["failed"]              = (long long)failed;
+    if (failed) (*j)["first_failure"] = firstFailure;
+  }
+};
+
+// One test parameter's FOM solution.
+struct FomSolution {
+  std::vector<PetscReal> mu;
+  Vec                    u = nullptr, lambda = nullptr;
+  PetscReal              energyNorm = 0, lambdaNorm = 0, force[3] = {0, 0, 0};
+};
+
+double Median(std::vector<double> v)
+{
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+} // namespace
+
+// Relative errors of a reduced solution against the FOM solution F (A: the FOM matrix at F.mu).
+static PetscErrorCode Compare(const ReducedModel &model, const RomBases &bases, const CanonicalOrder &order, const ContactSystem &sys, PetscInt dim, Mat A, const FomSolution &F, const ReducedSolution &sol, Vec work, Vec work2, Vec lwork, double *eu, double *el, double *ef)
+{
+  PetscFunctionBeginUser;
+  PetscCall(bases.Displacement(model, order, sol.v, work));
+  PetscCall(VecAYPX(work, -1.0, F.u)); // u_fom - u_rom
+  PetscCall(MatMult(A, work, work2));
+  PetscScalar e2;
+  PetscCall(VecDot(work, work2, &e2));
+  *eu = std::sqrt(std::max<PetscReal>(PetscRealPart(e2), 0)) / F.energyNorm;
+  std::vector<PetscReal> lam;
+  bases.Multipliers(model, sol.lambda, &lam);
+  {
+    PetscInt     lo, hi;
+    PetscScalar *a;
+    PetscCall(VecGetOwnershipRange(lwork, &lo, &hi));
+    PetscCall(VecGetArray(lwork, &a));
+    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = lam[order.CanonicalMultiplier(i)];
+    PetscCall(VecRestoreArray(lwork, &a));
+  }
+  ContactSummary cs;
+  PetscCall(SummarizeContact(sys, lwork, dim, &cs));
+  PetscReal df = 0, nf = 0;
+  for (PetscInt d = 0; d < dim; ++d) {
+    df += PetscSqr(cs.forceVec[d] - F.force[d]);
+    nf += PetscSqr(F.force[d]);
+  }
+  *ef = nf > 0 ? std::sqrt(df / nf) : std::sqrt(df);
+  // weighted l2: sum_i w_i (lambda_i - lambda_rom_i)^2
+  PetscCall(VecAYPX(lwork, -1.0, F.lambda));
+  PetscCall(VecPointwiseMult(lwork, lwork, lwork));
+  PetscScalar wl;
+  PetscCall(VecDot(lwork, sys.weight, &wl));
+  *el = F.lambdaNorm > 0 ? std::sqrt(std::max<PetscReal>(PetscRealPart(wl), 0)) / F.lambdaNorm : std::sqrt(std::max<PetscReal>(PetscRealPart(wl), 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode StageValidate(MPI_Comm comm)
+{
+  char           romPath[PETSC_MAX_PATH_LEN] = "", reportPath[PETSC_MAX_PATH_LEN] = "", sweepOut[PETSC_MAX_PATH_LEN] = "";
+  PetscBool      set, sweep = PETSC_FALSE;
+  PetscInt       repeat = 100;
+  SceneSpec      scene;
+  Report         rep;
+  ReducedModel   model, exact;
+  ElasticFOM     fom;
+  ContactMap     cmap;
+  KacanovSolver  kac;
+  CanonicalOrder order;
+  RomBases       bases;
+  std::string    romScene;
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  if (!VAL_FOM) {
+    PetscCall(PetscLogEventRegister("RBCValidateFOM", DM_CLASSID, &VAL_FOM));
+    PetscCall(PetscLogEventRegister("RBCValidateROM", DM_CLASSID, &VAL_ROM));
+  }
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, &set));
+  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-validate_repeat", &repeat, NULL));
+  PetscCheck(repeat >= 1 && repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", repeat);
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-validate_sweep", &sweep, NULL));
+  std::vector<PetscReal> fractions = {0.2, 0.4, 0.6, 0.8, 1.0};
+  {
+    PetscInt               n = 32;
+    std::vector<PetscReal> buf(n);
+    PetscCall(PetscOptionsGetRealArray(NULL, NULL, "-validate_sweep_fractions", buf.data(), &n, &set));
+    if (set) fractions.assign(buf.begin(), buf.begin() + n);
+    for (PetscReal f : fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
+  }
+  {
+    std::string stem = reportPath[0] ? reportPath : "validate.json";
+    if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
+    PetscCall(PetscStrncpy(sweepOut, (stem + "_sweep").c_str(), sizeof sweepOut));
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-validate_sweep_output", sweepOut, sizeof sweepOut, NULL));
+  }
+  PetscCall(SceneSpecFromOptions(comm, &scene));
+  PetscCall(model.Open(romPath));
+  PetscCall(model.SetFromOptions());
+  PetscCall(RomReadAttr(romPath, "scene", &romScene));
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s'", scene.name.c_str(), romPath, romScene.c_str());
+  ParameterSet test;
+  PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
+  for (const auto &mu : test.points) PetscCall(model.par.CheckBox(comm, mu));
+
+  // the FOM of the scene (reference configuration, affine terms) and the bases
+  PetscCall(fom.Create(comm, scene));
+  PetscCall(fom.SetupAffine());
+  PetscCall(order.BuildDofs(fom.elas));
+  PetscCall(bases.Read(comm, model, romPath, order.NumDofs()));
+  PetscCall(kac.SetFromOptions(comm));
+  PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+  const PetscInt dim = fom.elas.dim;
+
+  // the ROM without EIM: exact reduced contact terms on the full patch (the ROM's contact quadrature)
+  {
+    std::vector<unsigned long long> dims;
+    std::vector<double>             q;
+    PetscCall(RomReadDataset(romPath, "/online/eim_quadrature", &dims, &q));
+    ContactSystem sys0;
+    Vec           uloc;
+    PetscCall(fom.SetMu(ParamValues(fom.scene)));
+    cmap.SetGeometry(&fom.map, fom.mu);
+    Vec zero;
+    PetscCall(DMGetGlobalVector(fom.dm, &zero));
+    PetscCall(VecSet(zero, 0.0));
+    PetscCall(DMGetLocalVector(fom.dm, &uloc));
+    PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
+    PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
+    PetscCall(cmap.Assemble(fom.elas, uloc, &sys0));
+    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+    PetscCall(order.BuildMultipliers(sys0.coord, dim));
+    std::vector<char> support(bases.R, 0);
+    for (PetscInt k = 0; k < bases.r; ++k)
+      for (PetscInt i = 0; i < bases.R; ++i)
+        if (bases.W[(size_t)k * bases.R + i] > 0) support[i] = 1;
+    auto full = std::make_shared<ContactPatch>();
+    PetscCall(full->BuildFull(comm, cmap, order, bases.modes, bases.N, support, (PetscInt)q[0]));
+    const PetscInt         Q = full->NumPoints();
+    std::vector<PetscReal> P((size_t)bases.r * Q, 0.0);
+    for (PetscInt p = 0; p < Q; ++p)
+      for (PetscInt k = 0; k < dim; ++k) {
+        const PetscInt  row = full->points[p].row[k];
+        const PetscReal b   = full->points[p].b[k];
+        if (row < 0 || b == 0) continue;
+        for (PetscInt r = 0; r < bases.r; ++r) P[(size_t)r * Q + p] += b * bases.W[(size_t)r * bases.R + row];
+      }
+    PetscCall(exact.Open(romPath));
+    PetscCall(exact.SetFromOptions());
+    exact.SetExactContact(full, P);
+    exact.SetContactMode(ReducedModel::ContactMode::Exact);
+    PetscCall(exact.Truncate((PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; }), model.R(), -1, -1));
+  }
+
+  // FOM solutions of the test set (kept for the sweep)
+  const PetscInt           nt = (PetscInt)test.points.size();
+  std::vector<FomSolution> F(nt);
+  std::vector<double>      fomTimes;
+  std::vector<Mat>         Amu(nt, nullptr);
+  ContactSystem            sysLast;
+  std::vector<std::shared_ptr<ContactSystem>> sysAt(nt);
+  for (PetscInt j = 0; j < nt; ++j) {
+    F[j].mu = test.points[j];
+    PetscCall(PetscLogEventBegin(VAL_FOM, 0, 0, 0, 0));
+    PetscCall(PetscTime(&t0));
+    PetscCall(fom.SetMu(F[j].mu));
+    PetscCall(fom.AssembleAndFactor());
+    cmap.SetGeometry(&fom.map, F[j].mu);
+    PetscCall(kac.Solve(fom, cmap));
+    PetscCall(PetscTime(&t1));
+    PetscCall(PetscLogEventEnd(VAL_FOM, 0, 0, 0, 0));
+    fomTimes.push_back(t1 - t0);
+    PetscCall(VecDuplicate(fom.u, &F[j].u));
+    PetscCall(VecCopy(fom.u, F[j].u));
+    PetscCall(VecDuplicate(kac.lambda, &F[j].lambda));
+    PetscCall(VecCopy(kac.lambda, F[j].lambda));
+    PetscCall(MatDuplicate(fom.A, MAT_COPY_VALUES, &Amu[j]));
+    Vec         Au;
+    PetscScalar uAu;
+    PetscCall(VecDuplicate(fom.u, &Au));
+    PetscCall(MatMult(fom.A, fom.u, Au));
+    PetscCall(VecDot(fom.u, Au, &uAu));
+    PetscCall(VecDestroy(&Au));
+    F[j].energyNorm = std::sqrt(PetscRealPart(uAu));
+    Vec l2;
+    PetscCall(VecDuplicate(kac.lambda, &l2));
+    PetscCall(VecPointwiseMult(l2, kac.lambda, kac.lambda));
+    PetscScalar wl;
+    PetscCall(VecDot(l2, kac.sys.weight, &wl));
+    PetscCall(VecDestroy(&l2));
+    F[j].lambdaNorm = std::sqrt(PetscRealPart(wl));
+    ContactSummary cs;
+    PetscCall(SummarizeContact(kac.sys, kac.lambda, dim, &cs));
+    for (PetscInt d = 0; d < 3; ++d) F[j].force[d] = cs.forceVec[d];
+    // keep the contact system (weights, normals) of this solution
+    auto s = std::make_shared<ContactSystem>();
+    PetscCall(VecDuplicate(kac.sys.weight, &s->weight));
+    PetscCall(VecCopy(kac.sys.weight, s->weight));
+    for (PetscInt d = 0; d < dim; ++d) {
+      PetscCall(VecDuplicate(kac.sys.normal[d], &s->normal[d]));
+      PetscCall(VecCopy(kac.sys.normal[d], s->normal[d]));
+      PetscCall(VecDuplicate(kac.sys.coord[d], &s->coord[d]));
+      PetscCall(VecCopy(kac.sys.coord[d], s->coord[d]));
+    }
+    PetscCall(VecDuplicate(kac.sys.g, &s->g));
+    s->R   = kac.sys.R;
+    sysAt[j] = s;
+  }
+  Vec work, work2, lwork;
+  PetscCall(VecDuplicate(fom.u, &work));
+  PetscCall(VecDuplicate(fom.u, &work2));
+  PetscCall(VecDuplicate(kac.lambda, &lwork));
+
+  // ROM (timed) and ROM without EIM on the test set, for one truncation of the model
+  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    for (PetscInt j = 0; j < nt; ++j) {
+      ReducedSolution sol;
+      PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
+      PetscCall(m.Solve(F[j].mu, &sol)); // warm-up
+      if (timed) {
+        std::vector<double> ts;
+        for (PetscInt k = 0; k < repeat; ++k) {
+          PetscLogDouble a, b;
+          PetscCall(PetscTime(&a));
+          PetscCall(m.Solve(F[j].mu, &sol));
+          PetscCall(PetscTime(&b));
+          ts.push_back(b - a);
+        }
+        medians->push_back(Median(ts));
+      }
+      PetscCall(PetscLogEventEnd(VAL_ROM, 0, 0, 0, 0));
+      if (!sol.converged) {
+        if (!E->failed) E->firstFailure = sol.message;
+        ++E->failed;
+        continue;
+      }
+      if (its) its->push_back(sol.iterations);
+      double eu, el, ef;
+      PetscCall(Compare(m, bases, order, *sysAt[j], dim, Amu[j], F[j], sol, work, work2, lwork, &eu, &el, &ef));
+      E->u.push_back(eu);
+      E->lambda.push_back(el);
+      E->force.push_back(ef);
+    }
+    PetscFunctionReturn(0);
+  };
+  Errors                E, E0;
+  std::vector<double>   medians;
+  std::vector<PetscInt> romIts;
+  PetscCall(evaluate(model, true, &E, &medians, &romIts));
+  PetscCall(evaluate(exact, false, &E0, nullptr, nullptr));
+  PetscCheck(!E.failed, comm, PETSC_ERR_NOT_CONVERGED, "validate: the ROM failed on %" PetscInt_FMT " of %" PetscInt_FMT " test parameters; first: %s", E.failed, nt, E.firstFailure.c_str());
+
+  rep.root["stage"] = "validate";
+  rep.root["scene"] = scene.name;
+  rep.root["rom_file"] = romPath;
+  rep.root["nranks"] = [&] { PetscMPIInt s; MPI_Comm_size(comm, &s); return (long long)s; }();
+  E.Fill(&rep.root["test"]);
+  E0.Fill(&rep.root["test_no_eim"]);
+  {
+    std::vector<double> mus;
+    for (const auto &mu : test.points) mus.insert(mus.end(), mu.begin(), mu.end());
+    rep.root["test"]["mu"] = mus;
+  }
+  const double onlineMedian = Median(medians), fomMedian = Median(fomTimes);
+  rep.root["online_time_s"]["median"] = onlineMedian;
+  rep.root["online_time_s"]["max"]    = medians.empty() ? 0.0 : *std::max_element(medians.begin(), medians.end());
+  rep.root["online_time_s"]["per_parameter_median"] = medians;
+  rep.root["online_time_s"]["repeat"] = (long long)repeat;
+  rep.root["fom_time_s"]["median"]    = fomMedian;
+  rep.root["fom_time_s"]["all"]       = fomTimes;
+  rep.root["speedup_median"]          = onlineMedian > 0 ? fomMedian / onlineMedian : 0.0;
+  rep.root["rom_kacanov_iterations"]["max"] = (long long)(romIts.empty() ? 0 : *std::max_element(romIts.begin(), romIts.end()));
+  JsonValue &ro = rep.root["rom"];
+  ro["N"]  = (long long)model.N();
+  ro["R"]  = (long long)model.R();
+  ro["Mk"] = (long long)model.Mk();
+  ro["Mg"] = (long long)model.Mg();
+  ro["ndofs"] = (long long)order.NumDofs();
+
+  // speed against error over truncations of the same ROM
+  if (sweep) {
+    JsonValue         &rows = rep.root["sweep"];
+    std::ostringstream csv;
+    csv << "N,R,Mk,Mg,online_median_s,max_rel_err_u,max_rel_err_lambda,max_rel_err_force,failed\n";
+    const PetscInt Npod = (PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; });
+    const PetscInt R0 = model.R(), Mk0 = model.Mk(), Mg0 = model.Mg();
+    for (PetscReal fr : fractions) {
+      const PetscInt n = std::max<PetscInt>(1, (PetscInt)std::ceil(fr * Npod - 1e-9)), r = std::max<PetscInt>(1, (PetscInt)std::ceil(fr * R0 - 1e-9));
+      const PetscInt mk = (PetscInt)std::ceil(fr * Mk0 - 1e-9), mg = (PetscInt)std::ceil(fr * Mg0 - 1e-9);
+      PetscCall(model.Truncate(n, r, mk, mg));
+      Errors              Es;
+      std::vector<double> meds;
+      PetscCall(evaluate(model, true, &Es, &meds, nullptr));
+      JsonValue row;
+      auto      mx = [](const std::vector<double> &v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); };
+      row["N"] = (long long)model.N();
+      row["R"] = (long long)r;
+      row["Mk"] = (long long)mk;
+      row["Mg"] = (long long)mg;
+      row["online_median_s"] = Median(meds);
+      row["max_rel_err_u"] = Es.failed ? NAN : mx(Es.u);
+      row["max_rel_err_lambda"] = Es.failed ? NAN : mx(Es.lambda);
+      row["max_rel_err_force"] = Es.failed ? NAN : mx(Es.force);
+      row["failed"] = (long long)Es.failed;
+      if (Es.failed) row["first_failure"] = Es.firstFailure;
+      csv.precision(6);
+      csv << model.N() << "," << r << "," << mk << "," << mg << "," << Median(meds) << "," << row["max_rel_err_u"].AsNumber() << "," << row["max_rel_err_lambda"].AsNumber() << "," << row["max_rel_err_force"].AsNumber() << "," << Es.failed << "\n";
+      rows.Push(row);
+    }
+    PetscCall(model.Truncate(Npod, R0, Mk0, Mg0));
+    csv << "# FOM median " << fomMedian << " s\n";
+    JsonValue table;
+    table["rows"]            = rows;
+    table["fom_median_s"]    = fomMedian;
+    table["scene"]           = scene.name;
+    table["ndofs"]           = (long long)order.NumDofs();
+    PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".csv", csv.str()));
+    PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".json", table.Dump()));
+    rep.root["sweep_files"] = std::string(sweepOut) + ".{csv,json}";
+  }
+  PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " Mk %" PetscInt_FMT " Mg %" PetscInt_FMT ": max rel err u %.3e lambda %.3e force %.3e (no EIM: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), model.Mk(), model.Mg(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
+  PetscCall(rep.Write(comm, reportPath));
+  for (auto &s : F) {
+    PetscCall(VecDestroy(&s.u));
+    PetscCall(VecDestroy(&s.lambda));
+  }
+  for (auto &A : Amu) PetscCall(MatDestroy(&A));
+  PetscCall(VecDestroy(&work));
+  PetscCall(VecDestroy(&work2));
+  PetscCall(VecDestroy(&lwork));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,486 @@
+// src/rom/reduced_contact.cpp: ContactPatch, the pointwise contact map of the reduced model: built
+// from the full-order contact surfaces, restricted to the facets around the EIM points, serialized into
+// the ROM file, evaluated with the full-order kernel (src/contact/contact_point.hpp).
+#include "rbcontact/reduced_contact.hpp"
+#include "rbcontact/rom_file.hpp"
+#include "../contact/contact_point.hpp"
+#include <algorithm>
+#include <array>
+#include <map>
+#include <set>
+
+namespace rbc {
+
+namespace {
+using Key = std::array<PetscReal, 4>;
+
+Key NodeKey(const SurfaceFacet &F, PetscInt a, PetscInt dim)
+{
+  static const PetscInt edge[3][2] = {{0, 1}, {1, 2}, {0, 2}};
+  Key                   k        = {(PetscReal)F.body, 0, 0, 0};
+  const PetscInt        kind     = F.nodeKind[a];
+  for (PetscInt d = 0; d < dim; ++d) k[1 + d] = kind < 3 ? F.Xref[kind * dim + d] : 0.5 * (F.Xref[edge[kind - 3][0] * dim + d] + F.Xref[edge[kind - 3][1] * dim + d]);
+  return k;
+}
+
+// Partition-independent facet order: body, then the vertices' reference coordinates sorted.
+std::vector<PetscReal> FacetKey(const SurfaceFacet &F, PetscInt dim)
+{
+  std::vector<std::array<PetscReal, 3>> v(F.nv);
+  for (PetscInt k = 0; k < F.nv; ++k)
+    for (PetscInt d = 0; d < 3; ++d) v[k][d] = d < dim ? F.Xref[k * dim + d] : 0;
+  std::sort(v.begin(), v.end());
+  std::vector<PetscReal> key = {(PetscReal)F.body};
+  for (auto &x : v) key.insert(key.end(), x.begin(), x.end());
+  return key;
+}
+
+void SortFacets(std::vector<SurfaceFacet> *f, PetscInt dim)
+{
+  std::vector<std::pair<std::vector<PetscReal>, PetscInt>> keys;
+  for (PetscInt i = 0; i < (PetscInt)f->size(); ++i) keys.emplace_back(FacetKey((*f)[i], dim), i);
+  std::sort(keys.begin(), keys.end());
+  std::vector<SurfaceFacet> out;
+  for (auto &k : keys) out.push_back((*f)[k.second]);
+  f->swap(out);
+}
+} // namespace
+
+PetscErrorCode ContactPatch::BuildFull(MPI_Comm comm, const ContactMap &map, const CanonicalOrder &order, const std::vector<PetscReal> &modes, PetscInt Nb, const std::vector<char> &support, PetscInt nsub)
+{
+  std::vector<SurfaceFacet> S, M;
+
+  PetscFunctionBeginUser;
+  dim          = map.Slave().dim;
+  N            = Nb;
+  smoothNormal = map.smoothNormal;
+  PetscCall(map.Slave().Gather(comm, &S));
+  PetscCall(map.Master().Gather(comm, &M));
+  SortFacets(&S, dim);
+  SortFacets(&M, dim);
+  const PetscInt ndofs = order.NumDofs();
+  PetscCheck((PetscInt)modes.size() == N * ndofs, comm, PETSC_ERR_ARG_SIZ, "ContactPatch: %zu mode entries for N = %" PetscInt_FMT " x %" PetscInt_FMT " dofs", modes.size(), N, ndofs);
+
+  // Slave facets touching the support; canonical rows
+  std::vector<SurfaceFacet> Skeep;
+  for (auto F : S) {
+    bool in = support.empty();
+    for (PetscInt k = 0; k < F.nv; ++k) {
+      F.row[k] = F.row[k] >= 0 ? order.CanonicalMultiplier(F.row[k]) : -1;
+      if (!in && F.row[k] >= 0 && F.row[k] < (PetscInt)support.size() && support[F.row[k]]) in = true;
+    }
+    if (in) Skeep.push_back(F);
+  }
+  // Nodes (by body and reference position) with theta, uD, canonical dofs
+  std::map<Key, PetscInt> nodes;
+  theta.clear();
+  uD.clear();
+  canon.clear();
+  auto addNodes = [&](std::vector<SurfaceFacet> &fs) {
+    for (auto &F : fs)
+      for (PetscInt a = 0; a < F.nnodes; ++a) {
+        const Key k  = NodeKey(F, a, dim);
+        auto      it = nodes.find(k);
+        PetscInt  id;
+        if (it == nodes.end()) {
+          id = (PetscInt)nodes.size();
+          nodes.emplace(k, id);
+          theta.resize((id + 1) * dim * N, 0.0);
+          uD.resize((id + 1) * dim, 0.0);
+          canon.resize((id + 1) * dim, -1);
+          for (PetscInt d = 0; d < dim; ++d) {
+            const PetscInt g = F.dof[a * dim + d];
+            if (g >= 0) {
+              const PetscInt c = order.CanonicalDof(g);
+              canon[id * dim + d] = c;
+              for (PetscInt n = 0; n < N; ++n) theta[(id * dim + d) * N + n] = modes[n * ndofs + c];
+            } else uD[id * dim + d] = F.Ubc[a * dim + d];
+          }
+        } else id = it->second;
+        for (PetscInt d = 0; d < dim; ++d) F.dof[a * dim + d] = id * dim + d;
+      }
+  };
+  addNodes(Skeep);
+  addNodes(M);
+  nnode = (PetscInt)nodes.size();
+  // Master vertices: compact ids, ends of the master surface
+  std::map<Key, PetscInt> verts;
+  std::vector<PetscInt>   degree;
+  for (auto &F : M)
+    for (PetscInt k = 0; k < F.nv; ++k) {
+      Key key = {(PetscReal)F.body, 0, 0, 0};
+      for (PetscInt d = 0; d < dim; ++d) key[1 + d] = F.Xref[k * dim + d];
+      auto it = verts.find(key);
+      if (it == verts.end()) {
+        it = verts.emplace(key, (PetscInt)verts.size()).first;
+        degree.push_back(0);
+      }
+      F.vglobal[k] = it->second;
+      ++degree[it->second];
+    }
+  nvertex = (PetscInt)verts.size();
+  vertexEnd.assign(nvertex, 0);
+  for (PetscInt v = 0; v < nvertex; ++v) vertexEnd[v] = degree[v] < (dim == 2 ? 2 : 0) ? 1 : 0;
+  slave  = Skeep;
+  master = M;
+  searchable.assign(master.size(), 1);
+  // Integration points: nsub pieces x the map's Gauss rule (2D); the plain rule in 3D
+  const auto    &qp = map.QuadraturePoints();
+  const auto    &qw = map.QuadratureWeights();
+  const PetscInt nq = (PetscInt)qw.size(), nv = dim;
+  points.clear();
+  for (PetscInt s = 0; s < (PetscInt)slave.size(); ++s) {
+    const PetscInt pieces = dim == 2 ? nsub : 1;
+    for (PetscInt piece = 0; piece < pieces; ++piece)
+      for (PetscInt q = 0; q < nq; ++q) {
+        Point P;
+        P.facet = s;
+        if (dim == 2) {
+          const PetscReal t = (piece + qp[q * nv + 1]) / pieces;
+          P.b[0] = 1 - t;
+          P.b[1] = t;
+        } else
+          for (PetscInt k = 0; k < nv; ++k) P.b[k] = qp[q * nv + k];
+        P.wfrac = qw[q] / pieces;
+        for (PetscInt k = 0; k < nv; ++k) P.row[k] = slave[s].row[k];
+        points.push_back(P);
+      }
+  }
+  candStart.clear();
+  cand.clear();
+  PetscFunctionReturn(0);
+}
+
+void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector<std::vector<PetscInt>> &hits, PetscInt rings, ContactPatch *out) const
+{
+  // master adjacency through shared vertices
+  std::vector<std::vector<PetscInt>> vfacets(nvertex);
+  for (PetscInt m = 0; m < (PetscInt)master.size(); ++m)
+    for (PetscInt k = 0; k < master[m].nv; ++k) vfacets[master[m].vglobal[k]].push_back(m);
+  auto grow = [&](std::set<PetscInt> &s) {
+    std::set<PetscInt> add;
+    for (PetscInt m : s)
+      for (PetscInt k = 0; k < master[m].nv; ++k)
+        for (PetscInt f : vfacets[master[m].vglobal[k]]) add.insert(f);
+    s.insert(add.begin(), add.end());
+  };
+  std::vector<std::set<PetscInt>> candSets(keep.size());
+  std::set<PetscInt>              search, normal, slaves;
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const PetscInt p = keep[i];
+    for (PetscInt m : hits[p]) candSets[i].insert(m);
+    for (PetscInt r = 0; r < rings; ++r) grow(candSets[i]);
+    search.insert(candSets[i].begin(), candSets[i].end());
+    slaves.insert(points[p].facet);
+  }
+  normal = search;
+  grow(normal);
+  // new numbering (old order kept: the closest-point tie rule is by index)
+  std::map<PetscInt, PetscInt> snew, mnew, nodeNew, vnew;
+  for (PetscInt s : slaves) snew.emplace(s, (PetscInt)snew.size());
+  for (PetscInt m : normal) mnew.emplace(m, (PetscInt)mnew.size());
+  out->dim          = dim;
+  out->N            = N;
+  out->smoothNormal = smoothNormal;
+  out->slave.clear();
+  out->master.clear();
+  out->searchable.clear();
+  auto renode = [&](SurfaceFacet F) {
+    for (PetscInt a = 0; a < F.nnodes; ++a) {
+      const PetscInt old = F.dof[a * dim] / dim;
+      auto           it  = nodeNew.find(old);
+      if (it == nodeNew.end()) it = nodeNew.emplace(old, (PetscInt)nodeNew.size()).first;
+      for (PetscInt d = 0; d < dim; ++d) F.dof[a * dim + d] = it->second * dim + d;
+    }
+    return F;
+  };
+  for (auto &s : snew) out->slave.push_back(renode(slave[s.first]));
+  for (auto &m : mnew) {
+    SurfaceFacet F = renode(master[m.first]);
+    for (PetscInt k = 0; k < F.nv; ++k) {
+      auto it = vnew.find(F.vglobal[k]);
+      if (it == vnew.end()) it = vnew.emplace(F.vglobal[k], (PetscInt)vnew.size()).first;
+      F.vglobal[k] = it->second;
+    }
+    out->master.push_back(F);
+    out->searchable.push_back(search.count(m.first) ? 1 : 0);
+  }
+  out->nnode   = (PetscInt)nodeNew.size();
+  out->nvertex = (PetscInt)vnew.size();
+  out->theta.assign(out->nnode * dim * N, 0.0);
+  out->uD.assign(out->nnode * dim, 0.0);
+  out->canon.assign(canon.empty() ? 0 : out->nnode * dim, -1);
+  for (auto &nn : nodeNew) {
+    for (PetscInt d = 0; d < dim; ++d) {
+      out->uD[nn.second * dim + d] = uD[nn.first * dim + d];
+      if (!canon.empty()) out->canon[nn.second * dim + d] = canon[nn.first * dim + d];
+      for (PetscInt n = 0; n < N; ++n) out->theta[(nn.second * dim + d) * N + n] = theta[(nn.first * dim + d) * N + n];
+    }
+  }
+  out->vertexEnd.assign(out->nvertex, 0);
+  for (auto &v : vnew) out->vertexEnd[v.second] = vertexEnd[v.first];
+  out->points.clear();
+  out->candStart.assign(1, 0);
+  out->cand.clear();
+  for (size_t i = 0; i < keep.size(); ++i) {
+    Point P = points[keep[i]];
+    P.facet = snew[P.facet];
+    out->points.push_back(P);
+    for (PetscInt m : candSets[i]) out->cand.push_back(mnew[m]);
+    out->candStart.push_back((PetscInt)out->cand.size());
+  }
+}
+
+void ContactPatch::SelectBasis(const std::vector<PetscInt> &cols, ContactPatch *out) const
+{
+  *out         = *this;
+  const PetscInt n = (PetscInt)cols.size();
+  out->N       = n;
+  out->theta.assign(nnode * dim * n, 0.0);
+  for (PetscInt r = 0; r < nnode * dim; ++r)
+    for (PetscInt j = 0; j < n; ++j) out->theta[r * n + j] = theta[r * N + cols[j]];
+}
+
+void ContactPatch::SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu)
+{
+  // one affine map per body
+  std::array<Affine, 8>    cache;
+  std::array<bool, 8>      have{};
+  for (auto *fs : {&slave, &master})
+    for (auto &F : *fs) {
+      Affine a;
+      if (map && F.body >= 0 && F.body < 8) {
+        if (!have[F.body]) {
+          cache[F.body] = map->Evaluate(F.body, mu);
+          have[F.body]  = true;
+        }
+        a = cache[F.body];
+      } else if (map) a = map->Evaluate(F.body, mu);
+      for (PetscInt k = 0; k < F.nv; ++k) a.Apply(dim, &F.Xref[k * dim], &F.X[k * dim]);
+    }
+  meas_.resize(slave.size());
+  for (size_t s = 0; s < slave.size(); ++s) meas_[s] = FacetMeasure(slave[s].X.data(), dim);
+}
+
+void ContactPatch::SetNodal(const std::vector<PetscReal> &U)
+{
+  for (auto *fs : {&slave, &master})
+    for (auto &F : *fs)
+      for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = U[F.dof[i]];
+  PrepareMaster();
+}
+
+void ContactPatch::SetReduced(const PetscReal *v)
+{
+  thread_local std::vector<PetscReal> U;
+  U.resize(nnode * dim);
+  for (PetscInt r = 0; r < nnode * dim; ++r) {
+    const PetscReal *t = &theta[r * N];
+    PetscReal        s = uD[r];
+    for (PetscInt n = 0; n < N; ++n) s += t[n] * v[n];
+    U[r] = s;
+  }
+  SetNodal(U);
+}
+
+void ContactPatch::NodalFromCanonical(const std::vector<PetscReal> &u, std::vector<PetscReal> *U) const
+{
+  U->resize(nnode * dim);
+  for (PetscInt r = 0; r < nnode * dim; ++r) (*U)[r] = r < (PetscInt)canon.size() && canon[r] >= 0 ? u[canon[r]] : uD[r];
+}
+
+void ContactPatch::PrepareMaster()
+{
+  binned_ = candStart.size() <= 1;
+  if (binned_) (void)cp_.Build(master, dim, true);
+  else cp_.SetVertices(master, dim, true);
+  vnormal_.assign(3 * nvertex, 0.0);
+  if (smoothNormal)
+    for (PetscInt m = 0; m < (PetscInt)master.size(); ++m) {
+      PetscReal n[3];
+      FacetNormal(cp_.Vertices(m), dim, master[m].outward, n);
+      for (PetscInt k = 0; k < master[m].nv; ++k)
+        for (PetscInt d = 0; d < 3; ++d) vnormal_[3 * master[m].vglobal[k] + d] += n[d];
+    }
+}
+
+PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit) const
+{
+  PetscInt outside = 0;
+  for (PetscInt i = 0; i < np; ++i) {
+    const PetscInt      p = idx[i];
+    const Point        &P = points[p];
+    const SurfaceFacet &F = slave[P.facet];
+    const PetscReal     w = P.wfrac * meas_[P.facet];
+    const PetscInt     *c = nullptr;
+    PetscInt            nc = 0;
+    if (!binned_) {
+      c  = &cand[candStart[p]];
+      nc = candStart[p + 1] - candStart[p];
+    }
+    ContactPointEval e;
+    EvaluateContactPoint(
+      F, dim, P.b, master, cp_.Vertices(0), smoothNormal,
+      [&](const PetscReal *z, PetscInt *m, PetscReal *bm, PetscReal *dist) {
+        if (binned_) cp_.Find(z, m, bm, dist);
+        else cp_.FindAmong(z, c, nc, m, bm, dist);
+      },
+      [&](const SurfaceFacet &Mf, PetscInt k) { return &vnormal_[3 * Mf.vglobal[k]]; }, &e);
+    const SurfaceFacet &M = master[e.m];
+    if (hit) hit[i] = e.m;
+    // A projection clamped to a vertex that no other candidate shares (and that does not end the
+    // master surface) may have a closer point outside the patch: out of the EIM's range.
+    if (!binned_)
+      for (PetscInt k = 0; k < M.nv; ++k)
+        if (e.bm[k] == 1.0 && !vertexEnd[M.vglobal[k]]) {
+          PetscInt shared = 0;
+          for (PetscInt j = 0; j < nc; ++j)
+            for (PetscInt kk = 0; kk < master[c[j]].nv; ++kk) shared += master[c[j]].vglobal[kk] == M.vglobal[k];
+          if (shared < 2) ++outside;
+        }
+    PetscReal *kp = kappa ? kappa + i * N : nullptr;
+    if (kp)
+      for (PetscInt n = 0; n < N; ++n) kp[n] = 0;
+    PetscReal g = e.gap;
+    for (PetscInt side = 0; side < 2; ++side) {
+      const SurfaceFacet &G  = side ? M : F;
+      const PetscReal    *Nb = side ? e.Nm : e.Ns;
+      const PetscReal     sg = side ? 1.0 : -1.0;
+      for (PetscInt a = 0; a < G.nnodes; ++a)
+        for (PetscInt d = 0; d < dim; ++d) {
+          const PetscReal coef = sg * Nb[a] * e.n2[d];
+          if (coef == 0.0) continue;
+          const PetscInt r = G.dof[a * dim + d];
+          g -= coef * uD[r];
+          if (kp) {
+            const PetscReal *t = &theta[r * N];
+            for (PetscInt n = 0; n < N; ++n) kp[n] += coef * t[n];
+          }
+        }
+    }
+    if (kp)
+      for (PetscInt n = 0; n < N; ++n) kp[n] *= w;
+    if (gamma) gamma[i] = w * g;
+  }
+  return outside;
+}
+
+void ContactPatch::Serialize(std::vector<std::pair<std::string, std::pair<std::vector<unsigned long long>, std::vector<double>>>> *out) const
+{
+  auto put = [&](const std::string &name, std::vector<unsigned long long> dims, std::vector<double> data) { out->emplace_back(name, std::make_pair(dims, data)); };
+  put("meta", {8}, {(double)dim, (double)N, (double)nnode, (double)nvertex, smoothNormal ? 1.0 : 0.0, (double)slave.size(), (double)master.size(), (double)points.size()});
+  put("theta", {(unsigned long long)(nnode * dim), (unsigned long long)std::max<PetscInt>(N, 1)}, N ? std::vector<double>(theta.begin(), theta.end()) : std::vector<double>(nnode * dim, 0.0));
+  put("uD", {(unsigned long long)nnode, (unsigned long long)dim}, std::vector<double>(uD.begin(), uD.end()));
+  for (PetscInt side = 0; side < 2; ++side) {
+    const auto         &fs = side ? master : slave;
+    std::vector<double> rec;
+    for (size_t f = 0; f < fs.size(); ++f) {
+      const SurfaceFacet &F = fs[f];
+      std::vector<double> r(32, -1.0);
+      r[0] = F.body;
+      r[1] = F.nv;
+      r[2] = F.nnodes;
+      r[3] = F.outward;
+      for (int i = 0; i < 9; ++i) r[4 + i] = F.Xref[i];
+      for (int a = 0; a < 6; ++a) r[13 + a] = a < F.nnodes ? F.nodeKind[a] : -1;
+      for (int a = 0; a < 6; ++a) r[19 + a] = a < F.nnodes ? F.dof[a * dim] / dim : -1;
+      for (int k = 0; k < 3; ++k) r[25 + k] = F.vglobal[k];
+      for (int k = 0; k < 3; ++k) r[28 + k] = F.row[k];
+      r[31] = side ? searchable[f] : 1;
+      rec.insert(rec.end(), r.begin(), r.end());
+    }
+    put(side ? "master" : "slave", {(unsigned long long)fs.size(), 32}, rec);
+  }
+  put("vertex_end", {(unsigned long long)std::max<PetscInt>(nvertex, 1)}, nvertex ? std::vector<double>(vertexEnd.begin(), vertexEnd.end()) : std::vector<double>{0});
+  std::vector<double> pts;
+  for (const auto &P : points) pts.insert(pts.end(), {(double)P.facet, P.b[0], P.b[1], P.b[2], P.wfrac, (double)P.row[0], (double)P.row[1], (double)P.row[2]});
+  put("points", {(unsigned long long)points.size(), 8}, pts);
+  std::vector<double> cs(candStart.begin(), candStart.end()), cc(cand.begin(), cand.end());
+  if (cs.empty()) cs.push_back(0);
+  if (cc.empty()) cc.push_back(-1);
+  put("cand_start", {(unsigned long long)cs.size()}, cs);
+  put("cand", {(unsigned long long)cc.size()}, cc);
+}
+
+PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::string &group)
+{
+  std::vector<unsigned long long> dims;
+  std::vector<double>             meta, data;
+
+  PetscFunctionBeginUser;
+  PetscCall(RomReadDataset(file, group + "/meta", &dims, &meta));
+  PetscCheck(meta.size() == 8, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta has %zu entries (8 expected)", file.c_str(), group.c_str(), meta.size());
+  dim          = (PetscInt)meta[0];
+  N            = (PetscInt)meta[1];
+  nnode        = (PetscInt)meta[2];
+  nvertex      = (PetscInt)meta[3];
+  smoothNormal = meta[4] != 0;
+  const size_t ns = (size_t)meta[5], nm = (size_t)meta[6], np = (size_t)meta[7];
+  PetscCheck(dim == 2 || dim == 3, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta: dimension %" PetscInt_FMT, file.c_str(), group.c_str(), dim);
+  auto need = [&](const std::string &name, size_t n) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    PetscCall(RomReadDataset(file, group + "/" + name, &dims, &data));
+    PetscCheck(data.size() == n, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s has %zu entries (%zu expected)", file.c_str(), group.c_str(), name.c_str(), data.size(), n);
+    PetscFunctionReturn(0);
+  };
+  PetscCall(need("theta", nnode * dim * std::max<PetscInt>(N, 1)));
+  theta.assign(data.begin(), data.end());
+  if (!N) theta.clear();
+  PetscCall(need("uD", nnode * dim));
+  uD.assign(data.begin(), data.end());
+  for (PetscInt side = 0; side < 2; ++side) {
+    const size_t n = side ? nm : ns;
+    PetscCall(need(side ? "master" : "slave", n * 32));
+    auto &fs = side ? master : slave;
+    fs.assign(n, SurfaceFacet());
+    if (side) searchable.assign(n, 1);
+    for (size_t f = 0; f < n; ++f) {
+      const double *r = &data[32 * f];
+      SurfaceFacet &F = fs[f];
+      F.body          = (PetscInt)r[0];
+      F.nv            = (PetscInt)r[1];
+      F.nnodes        = (PetscInt)r[2];
+      F.outward       = r[3];
+      PetscCheck(F.nv == dim && F.nnodes >= F.nv && F.nnodes <= 6, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s facet %zu is malformed", file.c_str(), group.c_str(), f);
+      for (int i = 0; i < 9; ++i) F.Xref[i] = r[4 + i];
+      for (int a = 0; a < F.nnodes; ++a) {
+        F.nodeKind[a] = (PetscInt)r[13 + a];
+        const PetscInt node = (PetscInt)r[19 + a];
+        PetscCheck(node >= 0 && node < nnode, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s facet %zu: node %" PetscInt_FMT " out of range", file.c_str(), group.c_str(), f, node);
+        for (PetscInt d = 0; d < dim; ++d) F.dof[a * dim + d] = node * dim + d;
+      }
+      for (int k = 0; k < 3; ++k) F.vglobal[k] = (PetscInt)r[25 + k];
+      for (int k = 0; k < 3; ++k) F.row[k] = (PetscInt)r[28 + k];
+      if (side) {
+        searchable[f] = r[31] != 0;
+        for (int k = 0; k < F.nv; ++k) PetscCheck(F.vglobal[k] >= 0 && F.vglobal[k] < nvertex, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s facet %zu: vertex out of range", file.c_str(), group.c_str(), f);
+      }
+      F.X = F.Xref;
+    }
+  }
+  PetscCall(need("vertex_end", std::max<PetscInt>(nvertex, 1)));
+  vertexEnd.assign(nvertex, 0);
+  for (PetscInt v = 0; v < nvertex; ++v) vertexEnd[v] = data[v] != 0;
+  PetscCall(need("points", np * 8));
+  points.assign(np, Point());
+  for (size_t p = 0; p < np; ++p) {
+    const double *r = &data[8 * p];
+    points[p].facet = (PetscInt)r[0];
+    PetscCheck(points[p].facet >= 0 && points[p].facet < (PetscInt)ns, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s point %zu: facet out of range", file.c_str(), group.c_str(), p);
+    for (int k = 0; k < 3; ++k) points[p].b[k] = r[1 + k];
+    points[p].wfrac = r[4];
+    for (int k = 0; k < 3; ++k) points[p].row[k] = (PetscInt)r[5 + k];
+  }
+  PetscCall(RomReadDataset(file, group + "/cand_start", &dims, &data));
+  candStart.assign(data.begin(), data.end());
+  PetscCall(RomReadDataset(file, group + "/cand", &dims, &data));
+  cand.assign(data.begin(), data.end());
+  if (candStart.size() > 1) {
+    PetscCheck(candStart.size() == np + 1 && candStart.back() == (PetscInt)cand.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s candidate lists are inconsistent", file.c_str(), group.c_str());
+    for (PetscInt m : cand) PetscCheck(m >= 0 && m < (PetscInt)nm, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s candidate facet out of range", file.c_str(), group.c_str());
+  } else cand.clear();
+  meas_.assign(ns, 0.0);
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,541 @@
+// src/rom/reduced_model.cpp: the online stage's model: reading/writing its data (ROM file, format 2,
+// docs/rom_file.md), truncation, the EIM (or exact) reduced contact terms and the reduced Kacanov loop.
+#include "rbcontact/reduced_model.hpp"
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace rbc {
+
+namespace {
+std::vector<double> CoefRecords(const std::vector<Coefficient> &c)
+{
+  std::vector<double> r;
+  for (const auto &k : c) r.insert(r.end(), {(double)k.tensorBody, (double)k.tensorEntry, (double)k.detBody, (double)k.surfBody, (double)k.param, k.scale});
+  return r;
+}
+
+std::vector<Coefficient> CoefFromRecords(const std::vector<double> &r)
+{
+  std::vector<Coefficient> c(r.size() / 6);
+  for (size_t i = 0; i < c.size(); ++i) {
+    const double *x = &r[6 * i];
+    c[i].tensorBody  = (PetscInt)x[0];
+    c[i].tensorEntry = (PetscInt)x[1];
+    c[i].detBody     = (PetscInt)x[2];
+    c[i].surfBody    = (PetscInt)x[3];
+    c[i].param       = (PetscInt)x[4];
+    c[i].scale       = x[5];
+  }
+  return c;
+}
+
+using U64 = unsigned long long;
+
+PetscErrorCode ReadChecked(const std::string &file, const std::string &name, size_t expect, std::vector<double> *data)
+{
+  std::vector<U64> dims;
+  PetscFunctionBeginUser;
+  PetscCall(RomReadDataset(file, name, &dims, data));
+  PetscCheck(expect == (size_t)-1 || data->size() == expect, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s has %zu entries, %zu expected (corrupt or mismatched file)", file.c_str(), name.c_str(), data->size(), expect);
+  for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
+  PetscFunctionReturn(0);
+}
+
+std::vector<PetscInt> ToInt(const std::vector<double> &d) { return std::vector<PetscInt>(d.begin(), d.end()); }
+} // namespace
+
+// ------------------------------------------------------------------ parametrization
+PetscErrorCode ReducedParametrization::FromFOM(const Elasticity &elas, const GeometryMap &m, const AffineDecomposition &aff)
+{
+  PetscFunctionBeginUser;
+  dim    = elas.dim;
+  params = elas.scene.params;
+  bodies = elas.scene.bodies;
+  PetscCall(map.FromRecords((PetscInt)bodies.size(), m.Records()));
+  thetaA = aff.thetaA;
+  thetaF = aff.thetaF;
+  light_.reset();
+  PetscFunctionReturn(0);
+}
+
+void ReducedParametrization::Light()
+{
+  if (light_) return;
+  light_               = std::make_shared<Elasticity>();
+  light_->dim          = dim;
+  light_->scene.bodies = bodies;
+  light_->scene.params = params;
+}
+
+void ReducedParametrization::Write(RomWriter *w) const
+{
+  std::vector<double> box, def, bod;
+  std::string         names;
+  for (const auto &p : params) {
+    box.insert(box.end(), {p.min, p.max});
+    def.push_back(p.def);
+    names += (names.empty() ? "" : ",") + p.name;
+  }
+  for (const auto &b : bodies) bod.insert(bod.end(), {b.E, b.nu, (double)b.paramE, (double)b.paramNu});
+  w->Attr("param_names", names);
+  w->Dataset("/params/box", {params.size(), 2}, box);
+  w->Dataset("/params/default", {params.size()}, def);
+  w->Dataset("/online/dim", {1}, {(double)dim});
+  w->Dataset("/online/bodies", {bodies.size(), 4}, bod);
+  std::vector<double> rec = map.Records();
+  rec.insert(rec.begin(), (double)(rec.size() / 8));
+  w->Dataset("/online/map", {rec.size()}, rec);
+  w->Dataset("/online/affine/thetaA", {thetaA.size(), 6}, CoefRecords(thetaA));
+  w->Dataset("/online/affine/thetaF", {thetaF.size(), 6}, CoefRecords(thetaF));
+}
+
+PetscErrorCode ReducedParametrization::Read(const std::string &file)
+{
+  std::vector<double> box, def, d, bod, rec;
+  std::string         names;
+
+  PetscFunctionBeginUser;
+  PetscCall(RomReadAttr(file, "param_names", &names));
+  PetscCall(ReadChecked(file, "/params/box", (size_t)-1, &box));
+  PetscCall(ReadChecked(file, "/params/default", box.size() / 2, &def));
+  params.assign(def.size(), ParamSpec());
+  std::stringstream ss(names);
+  for (size_t i = 0; i < params.size(); ++i) {
+    std::getline(ss, params[i].name, ',');
+    params[i].min = params[i].value = box[2 * i];
+    params[i].max = box[2 * i + 1];
+    params[i].def = params[i].value = def[i];
+  }
+  PetscCall(ReadChecked(file, "/online/dim", 1, &d));
+  dim = (PetscInt)d[0];
+  PetscCall(ReadChecked(file, "/online/bodies", (size_t)-1, &bod));
+  PetscCheck(bod.size() % 4 == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/bodies is malformed", file.c_str());
+  bodies.assign(bod.size() / 4, BodySpec());
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b].E       = bod[4 * b];
+    bodies[b].nu      = bod[4 * b + 1];
+    bodies[b].paramE  = (PetscInt)bod[4 * b + 2];
+    bodies[b].paramNu = (PetscInt)bod[4 * b + 3];
+  }
+  PetscCall(ReadChecked(file, "/online/map", (size_t)-1, &rec));
+  PetscCheck(!rec.empty() && rec.size() == 1 + 8 * (size_t)rec[0], PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/map is malformed", file.c_str());
+  rec.erase(rec.begin());
+  PetscCall(map.FromRecords((PetscInt)bodies.size(), rec));
+  PetscCall(ReadChecked(file, "/online/affine/thetaA", (size_t)-1, &d));
+  thetaA = CoefFromRecords(d);
+  PetscCall(ReadChecked(file, "/online/affine/thetaF", (size_t)-1, &d));
+  thetaF = CoefFromRecords(d);
+  for (const auto *cs : {&thetaA, &thetaF})
+    for (const auto &c : *cs)
+      PetscCheck(c.tensorBody < (PetscInt)bodies.size() && c.detBody < (PetscInt)bodies.size() && c.surfBody < (PetscInt)bodies.size() && c.param < (PetscInt)params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: a coefficient function refers to an unknown body or parameter", file.c_str());
+  light_.reset();
+  PetscFunctionReturn(0);
+}
+
+void ReducedParametrization::ThetaA(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const
+{
+  const_cast<ReducedParametrization *>(this)->Light();
+  th->resize(thetaA.size());
+  for (size_t q = 0; q < thetaA.size(); ++q) (*th)[q] = thetaA[q].Evaluate(*light_, &map, mu);
+}
+
+void ReducedParametrization::ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const
+{
+  const_cast<ReducedParametrization *>(this)->Light();
+  th->resize(thetaF.size());
+  for (size_t q = 0; q < thetaF.size(); ++q) (*th)[q] = thetaF[q].Evaluate(*light_, &map, mu);
+}
+
+PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const
+{
+  PetscFunctionBeginUser;
+  PetscCheck(mu.size() == params.size(), comm, PETSC_ERR_ARG_SIZ, "-mu: %zu values given, the model has %zu parameters", mu.size(), params.size());
+  for (size_t i = 0; i < mu.size(); ++i) {
+    PetscCheck(std::isfinite(mu[i]), comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' is not a finite number", params[i].name.c_str());
+    const PetscReal tol = 1e-12 * std::max<PetscReal>(1.0, std::abs(params[i].max - params[i].min));
+    PetscCheck(mu[i] >= params[i].min - tol && mu[i] <= params[i].max + tol, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' = %g is outside its box [%g, %g] (the reduced model is trained there only)", params[i].name.c_str(), (double)mu[i], (double)params[i].min, (double)params[i].max);
+  }
+  PetscFunctionReturn(0);
+}
+
+// ------------------------------------------------------------------ model I/O
+void WriteReducedModel(const ReducedModel &m, RomWriter *w)
+{
+  const U64 N = m.Nfull, R = m.Rfull;
+  m.par.Write(w);
+  w->Dataset("/online/sizes", {6}, {(double)m.dim, (double)m.Nfull, (double)m.Npod, (double)m.nsup, (double)m.Rfull, 0.0});
+  w->Dataset("/online/affine/A", {(U64)m.par.NumA(), N, N}, m.Aq);
+  w->Dataset("/online/affine/f", {(U64)m.par.NumF(), N}, m.fq);
+  w->Dataset("/online/kappa/meta", {2}, {m.kappaConst ? 1.0 : 0.0, (double)m.MkFull});
+  w->Dataset("/online/gap/meta", {2}, {m.gapConst ? 1.0 : 0.0, (double)m.MgFull});
+  if (m.kappaConst) w->Dataset("/online/kappa/constant", {N, R}, m.kConstant);
+  else if (m.MkFull > 0) {
+    std::vector<double> pts;
+    for (PetscInt j = 0; j < m.MkFull; ++j) pts.insert(pts.end(), {(double)m.kPoint[j], (double)m.kMode[j]});
+    w->Dataset("/online/kappa/points", {(U64)m.MkFull, 2}, pts);
+    w->Dataset("/online/kappa/B", {(U64)m.MkFull, (U64)m.MkFull}, m.kB);
+    w->Dataset("/online/kappa/C", {(U64)m.MkFull, N, R}, m.kC);
+  }
+  if (m.gapConst) w->Dataset("/online/gap/constant", {R}, m.gConstant);
+  else if (m.MgFull > 0) {
+    w->Dataset("/online/gap/points", {(U64)m.MgFull}, std::vector<double>(m.gPoint.begin(), m.gPoint.end()));
+    w->Dataset("/online/gap/B", {(U64)m.MgFull, (U64)m.MgFull}, m.gB);
+    w->Dataset("/online/gap/C", {(U64)m.MgFull, R}, m.gC);
+  }
+  std::vector<std::pair<std::string, std::pair<std::vector<U64>, std::vector<double>>>> items;
+  m.patch.Serialize(&items);
+  for (auto &it : items) w->Dataset("/online/contact/" + it.first, it.second.first, it.second.second);
+  const U64 nw = m.par.params.empty() ? 0 : m.warmMu.size() / m.par.params.size();
+  if (nw > 0) {
+    w->Dataset("/online/warm/mu", {nw, (U64)m.par.params.size()}, m.warmMu);
+    w->Dataset("/online/warm/v", {nw, N}, m.warmV);
+    w->Dataset("/online/warm/lambda", {nw, R}, m.warmL);
+  }
+}
+
+PetscErrorCode ReducedModel::Open(const std::string &path)
+{
+  std::string         fmt;
+  int                 ver = 0;
+  std::vector<double> d;
+
+  PetscFunctionBeginUser;
+  file = path;
+  PetscCall(RomReadAttr(path, "format", &fmt));
+  PetscCheck(fmt == "rbcontact-rom", PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s is not a ROM file (format '%s')", path.c_str(), fmt.c_str());
+  PetscCall(RomReadVersion(path, &ver));
+  PetscCheck(ver == 2, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s has format_version %d; the online stage reads version 2 (a file of 'offline -offline_stop bases' holds bases only: run offline without -offline_stop)", path.c_str(), ver);
+  PetscCall(par.Read(path));
+  PetscCall(ReadChecked(path, "/online/sizes", 6, &d));
+  dim   = (PetscInt)d[0];
+  Nfull = (PetscInt)d[1];
+  Npod  = (PetscInt)d[2];
+  nsup  = (PetscInt)d[3];
+  Rfull = (PetscInt)d[4];
+  PetscCheck(Nfull > 0 && Rfull > 0 && Npod + nsup == Nfull && nsup <= Rfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: inconsistent sizes N %" PetscInt_FMT " (POD %" PetscInt_FMT " + supremizers %" PetscInt_FMT "), R %" PetscInt_FMT, path.c_str(), Nfull, Npod, nsup, Rfull);
+  const size_t N = Nfull, R = Rfull;
+  PetscCall(ReadChecked(path, "/online/affine/A", par.NumA() * N * N, &Aq));
+  PetscCall(ReadChecked(path, "/online/affine/f", par.NumF() * N, &fq));
+  PetscCall(ReadChecked(path, "/online/kappa/meta", 2, &d));
+  kappaConst = d[0] != 0;
+  MkFull     = kappaConst ? 0 : (PetscInt)d[1];
+  PetscCall(ReadChecked(path, "/online/gap/meta", 2, &d));
+  gapConst = d[0] != 0;
+  MgFull   = gapConst ? 0 : (PetscInt)d[1];
+  PetscCall(patch.Deserialize(path, "/online/contact"));
+  PetscCheck(patch.N == Nfull && patch.dim == dim, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: the contact data has %" PetscInt_FMT " basis functions, the model %" PetscInt_FMT, path.c_str(), patch.N, Nfull);
+  if (kappaConst) PetscCall(ReadChecked(path, "/online/kappa/constant", N * R, &kConstant));
+  else if (MkFull > 0) {
+    PetscCall(ReadChecked(path, "/online/kappa/points", 2 * MkFull, &d));
+    kPoint.resize(MkFull);
+    kMode.resize(MkFull);
+    for (PetscInt j = 0; j < MkFull; ++j) {
+      kPoint[j] = (PetscInt)d[2 * j];
+      kMode[j]  = (PetscInt)d[2 * j + 1];
+      PetscCheck(kPoint[j] >= 0 && kPoint[j] < patch.NumPoints() && kMode[j] >= 0 && kMode[j] < Nfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/kappa/points: entry %" PetscInt_FMT " out of range", path.c_str(), j);
+    }
+    PetscCall(ReadChecked(path, "/online/kappa/B", MkFull * MkFull, &kB));
+    PetscCall(ReadChecked(path, "/online/kappa/C", MkFull * N * R, &kC));
+  }
+  if (gapConst) PetscCall(ReadChecked(path, "/online/gap/constant", R, &gConstant));
+  else if (MgFull > 0) {
+    PetscCall(ReadChecked(path, "/online/gap/points", MgFull, &d));
+    gPoint = ToInt(d);
+    for (PetscInt p : gPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/gap/points out of range", path.c_str());
+    PetscCall(ReadChecked(path, "/online/gap/B", MgFull * MgFull, &gB));
+    PetscCall(ReadChecked(path, "/online/gap/C", MgFull * R, &gC));
+  }
+  warmMu.clear();
+  warmV.clear();
+  warmL.clear();
+  {
+    std::vector<U64> dims;
+    PetscErrorCode   ierr;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = RomReadDataset(path, "/online/warm/mu", &dims, &warmMu);
+    PetscCall(PetscPopErrorHandler());
+    if (ierr) warmMu.clear();
+    else {
+      const size_t nw = warmMu.size() / std::max<size_t>(1, par.params.size());
+      PetscCall(ReadChecked(path, "/online/warm/v", nw * N, &warmV));
+      PetscCall(ReadChecked(path, "/online/warm/lambda", nw * R, &warmL));
+    }
+  }
+  PetscCall(Truncate(-1, -1, -1, -1));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedModel::SetFromOptions()
+{
+  PetscInt n = -1, r = -1, mk = -1, mg = -1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_kacanov_max_it", &maxIt, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_primal", &rtolPrimal, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_dual", &rtolDual, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_relaxation", &relaxation, NULL));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_kacanov_monitor", &monitor, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kkt_tol", &kktTol, NULL));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_warm_start", &warmStart, NULL));
+  PetscCheck(maxIt >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
+  PetscCheck(rtolPrimal > 0 && rtolDual > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_rtol_primal/-rom_kacanov_rtol_dual must be > 0");
+  PetscCheck(relaxation > 0 && relaxation <= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
+  PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCall(qp.SetFromOptions("rom_"));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_N", &n, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_R", &r, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mk", &mk, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mg", &mg, NULL));
+  PetscCall(Truncate(n, r, mk, mg));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg)
+{
+  PetscFunctionBeginUser;
+  if (n < 0) n = Npod;
+  if (r < 0) r = Rfull;
+  if (mk < 0) mk = MkFull;
+  if (mg < 0) mg = MgFull;
+  PetscCheck(n >= 1 && n <= Npod, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_N %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "] (POD modes in %s)", n, Npod, file.c_str());
+  PetscCheck(r >= 1 && r <= Rfull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_R %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "]", r, Rfull);
+  PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mk, MkFull);
+  PetscCheck(mg >= 0 && mg <= MgFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mg, MgFull);
+  geomMu_.clear();
+  cols_.clear();
+  for (PetscInt i = 0; i < n; ++i) cols_.push_back(i);
+  for (PetscInt i = 0; i < std::min(nsup, r); ++i) cols_.push_back(Npod + i);
+  r_  = r;
+  mk_ = mk;
+  mg_ = mg;
+  const PetscInt Na = (PetscInt)cols_.size();
+  // kappa terms restricted to the active rows/columns: Kc_[j] = C_j(0:r, cols) (R x N column-major)
+  Kc_.assign((size_t)mk * r * Na, 0.0);
+  for (PetscInt j = 0; j < mk; ++j)
+    for (PetscInt c = 0; c < Na; ++c)
+      for (PetscInt i = 0; i < r; ++i) Kc_[(size_t)j * r * Na + i + (size_t)r * c] = kC[((size_t)j * Nfull + cols_[c]) * Rfull + i];
+  KB_.assign((size_t)mk * mk, 0.0);
+  for (PetscInt i = 0; i < mk; ++i)
+    for (PetscInt j = 0; j < mk; ++j) KB_[i + (size_t)mk * j] = kB[i + (size_t)MkFull * j];
+  Gc_.assign((size_t)mg * r, 0.0);
+  for (PetscInt j = 0; j < mg; ++j)
+    for (PetscInt i = 0; i < r; ++i) Gc_[(size_t)j * r + i] = gC[(size_t)j * Rfull + i];
+  GB_.assign((size_t)mg * mg, 0.0);
+  for (PetscInt i = 0; i < mg; ++i)
+    for (PetscInt j = 0; j < mg; ++j) GB_[i + (size_t)mg * j] = gB[i + (size_t)MgFull * j];
+  // the patch points to evaluate (each gives kappa for every mode and gamma)
+  evalPoints_.clear();
+  kPos_.assign(mk, 0);
+  gPos_.assign(mg, 0);
+  auto pos = [&](PetscInt p) {
+    auto it = std::find(evalPoints_.begin(), evalPoints_.end(), p);
+    if (it != evalPoints_.end()) return (PetscInt)(it - evalPoints_.begin());
+    evalPoints_.push_back(p);
+    return (PetscInt)evalPoints_.size() - 1;
+  };
+  for (PetscInt j = 0; j < mk; ++j) kPos_[j] = pos(kPoint[j]);
+  for (PetscInt j = 0; j < mg; ++j) gPos_[j] = pos(gPoint[j]);
+  if (!P_.empty()) {
+    const size_t Q = P_.size() / Rfull;
+    Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
+  }
+  const size_t np = std::max<size_t>(evalPoints_.size(), full_ ? full_->points.size() : 0);
+  kap_.assign(np * Nfull, 0.0);
+  gam_.assign(np, 0.0);
+  phi_.assign(std::max(mk, mg) + 1, 0.0);
+  vals_.assign(std::max(mk, mg) + 1, 0.0);
+  K_.assign((size_t)r * Na, 0.0);
+  g_.assign(r, 0.0);
+  A_.assign((size_t)Na * Na, 0.0);
+  f_.assign(Na, 0.0);
+  qp.Reserve(Na, r);
+  PetscFunctionReturn(0);
+}
+
+void ReducedModel::SetExactContact(std::shared_ptr<ContactPatch> full, const std::vector<PetscReal> &P)
+{
+  geomMu_.clear();
+  full_ = full;
+  P_    = P;
+}
+
+void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
+{
+  std::vector<PetscReal> thA, thF;
+  par.ThetaA(mu, &thA);
+  par.ThetaF(mu, &thF);
+  const PetscInt Na = (PetscInt)cols_.size();
+  A->assign((size_t)Na * Na, 0.0);
+  f->assign(Na, 0.0);
+  for (size_t q = 0; q < thA.size(); ++q)
+    for (PetscInt j = 0; j < Na; ++j)
+      for (PetscInt i = 0; i < Na; ++i) (*A)[i + (size_t)Na * j] += thA[q] * Aq[(q * Nfull + cols_[i]) * Nfull + cols_[j]];
+  for (size_t q = 0; q < thF.size(); ++q)
+    for (PetscInt i = 0; i < Na; ++i) (*f)[i] += thF[q] * fq[q * Nfull + cols_[i]];
+}
+
+// Forward substitution with the unit lower triangular B (M x M, column-major).
+static void Forward(PetscInt M, const PetscReal *B, const PetscReal *b, PetscReal *x)
+{
+  for (PetscInt i = 0; i < M; ++i) {
+    PetscReal s = b[i];
+    for (PetscInt j = 0; j < i; ++j) s -= B[i + (size_t)M * j] * x[j];
+    x[i] = s / B[i + (size_t)M * i];
+  }
+}
+
+PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
+{
+  const PetscInt Na = (PetscInt)cols_.size(), r = r_;
+  thread_local std::vector<PetscReal> vfull;
+  vfull.assign(Nfull, 0.0);
+  for (PetscInt i = 0; i < Na; ++i) vfull[cols_[i]] = v[i];
+  PetscInt out = 0;
+  if (mode_ == ContactMode::Exact && full_) {
+    ContactPatch  &P = *full_;
+    const PetscInt Q = P.NumPoints();
+    if (geomMu_ != mu) {
+      P.SetGeometry(&par.map, mu);
+      geomMu_ = mu;
+    }
+    P.SetReduced(vfull.data());
+    allPoints_.resize(Q);
+    for (PetscInt p = 0; p < Q; ++p) allPoints_[p] = p;
+    out = P.Evaluate(allPoints_.data(), Q, kap_.data(), gam_.data(), nullptr);
+    for (PetscInt i = 0; i < r; ++i) {
+      const PetscReal *pr = &Pact_[(size_t)i * Q];
+      PetscReal        gs = 0;
+      for (PetscInt p = 0; p < Q; ++p) gs += pr[p] * gam_[p];
+      g[i] = gs;
+      for (PetscInt c = 0; c < Na; ++c) {
+        PetscReal s = 0;
+        for (PetscInt p = 0; p < Q; ++p) s += pr[p] * kap_[(size_t)p * Nfull + cols_[c]];
+        K[i + (size_t)r * c] = s;
+      }
+    }
+    return out;
+  }
+  const PetscInt np = (PetscInt)evalPoints_.size();
+  if (np > 0) {
+    if (geomMu_ != mu) {
+      patch.SetGeometry(&par.map, mu);
+      geomMu_ = mu;
+    }
+    patch.SetReduced(vfull.data());
+    out = patch.Evaluate(evalPoints_.data(), np, kap_.data(), gam_.data(), nullptr);
+  }
+  if (kappaConst) {
+    for (PetscInt c = 0; c < Na; ++c)
+      for (PetscInt i = 0; i < r; ++i) K[i + (size_t)r * c] = kConstant[(size_t)cols_[c] * Rfull + i];
+  } else {
+    for (PetscInt j = 0; j < mk_; ++j) vals_[j] = kap_[(size_t)kPos_[j] * Nfull + kMode[j]];
+    Forward(mk_, KB_.data(), vals_.data(), phi_.data());
+    std::fill(K, K + (size_t)r * Na, 0.0);
+    for (PetscInt j = 0; j < mk_; ++j) {
+      const PetscReal  ph = phi_[j];
+      const PetscReal *C  = &Kc_[(size_t)j * r * Na];
+      for (size_t e = 0; e < (size_t)r * Na; ++e) K[e] += ph * C[e];
+    }
+  }
+  if (gapConst) {
+    for (PetscInt i = 0; i < r; ++i) g[i] = gConstant[i];
+  } else {
+    for (PetscInt j = 0; j < mg_; ++j) vals_[j] = gam_[gPos_[j]];
+    Forward(mg_, GB_.data(), vals_.data(), phi_.data());
+    std::fill(g, g + r, 0.0);
+    for (PetscInt j = 0; j < mg_; ++j)
+      for (PetscInt i = 0; i < r; ++i) g[i] += phi_[j] * Gc_[(size_t)j * r + i];
+  }
+  return out;
+}
+
+PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolution *sol)
+{
+  const PetscInt Na = (PetscInt)cols_.size(), r = r_;
+
+  PetscFunctionBeginUser;
+  PetscCall(par.CheckBox(PETSC_COMM_SELF, mu));
+  sol->converged  = false;
+  sol->iterations = 0;
+  sol->outOfRange = 0;
+  sol->message.clear();
+  sol->du.clear();
+  sol->dl.clear();
+  sol->nactive.clear();
+  sol->iterates.clear();
+  sol->v.assign(Na, 0.0);
+  sol->lambda.assign(r, 0.0);
+  Operators(mu, &A_, &f_);
+  // warm start: the stored reduced solution of the nearest training parameter (box-scaled distance)
+  const size_t np = par.params.size(), nw = np ? warmMu.size() / np : 0;
+  if (warmStart && nw > 0) {
+    size_t    best = 0;
+    PetscReal bd   = PETSC_MAX_REAL;
+    for (size_t k = 0; k < nw; ++k) {
+      PetscReal d = 0;
+      for (size_t i = 0; i < np; ++i) {
+        const PetscReal w = std::max<PetscReal>(par.params[i].max - par.params[i].min, 1e-300);
+        d += PetscSqr((warmMu[k * np + i] - mu[i]) / w);
+      }
+      if (d < bd) { bd = d; best = k; }
+    }
+    for (PetscInt i = 0; i < Na; ++i) sol->v[i] = warmV[best * Nfull + cols_[i]];
+    for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = warmL[best * Rfull + i];
+  }
+  thread_local std::vector<PetscReal> vprev, lprev, vnew;
+  for (PetscInt it = 1; it <= maxIt; ++it) {
+    vprev = sol->v;
+    lprev = sol->lambda;
+    if (recordIterates) sol->iterates.insert(sol->iterates.end(), vprev.begin(), vprev.end());
+    sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data());
+    vnew.resize(Na);
+    PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
+    sol->iterations = it;
+    if (sol->qp.status != ReducedQPStatus::Ok) {
+      sol->message = std::string("reduced QP failed at Kacanov iteration ") + std::to_string(it) + " (" + ReducedQPStatusName(sol->qp.status) + "): " + sol->qp.message;
+      sol->v.assign(Na, 0.0);
+      sol->lambda.assign(r, 0.0);
+      PetscFunctionReturn(0);
+    }
+    PetscReal nv = 0, dv = 0, nl = 0, dln = 0;
+    for (PetscInt i = 0; i < Na; ++i) {
+      sol->v[i] = vprev[i] + relaxation * (vnew[i] - vprev[i]);
+      nv += PetscSqr(sol->v[i]);
+      dv += PetscSqr(sol->v[i] - vprev[i]);
+    }
+    PetscInt nact = 0;
+    for (PetscInt i = 0; i < r; ++i) {
+      sol->lambda[i] = lprev[i] + relaxation * (sol->lambda[i] - lprev[i]);
+      nl += PetscSqr(sol->lambda[i]);
+      dln += PetscSqr(sol->lambda[i] - lprev[i]);
+      nact += sol->lambda[i] > 0;
+    }
+    const PetscReal du = nv > 0 ? std::sqrt(dv / nv) : std::sqrt(dv), dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
+    sol->du.push_back(du);
+    sol->dl.push_back(dl);
+    sol->nactive.push_back(nact);
+    if (monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  ROM Kacanov %2" PetscInt_FMT "  du %.3e  dlambda %.3e  active %" PetscInt_FMT "/%" PetscInt_FMT "  QP its %" PetscInt_FMT "\n", it, (double)du, (double)dl, nact, r, sol->qp.iterations));
+    if (du <= rtolPrimal && dl <= rtolDual) {
+      sol->converged = true;
+      break;
+    }
+  }
+  if (!sol->converged) {
+    std::ostringstream o;
+    o << "reduced Kacanov loop did not converge in " << maxIt << " iterations (-rom_kacanov_max_it); last changes du " << sol->du.back() << ", dlambda " << sol->dl.back() << " (-rom_kacanov_rtol_primal " << rtolPrimal << ", -rom_kacanov_rtol_dual " << rtolDual << ")";
+    sol->message = o.str();
+    PetscFunctionReturn(0);
+  }
+  const PetscReal kkt = std::max(std::max(sol->qp.primal, sol->qp.dual), std::max(sol->qp.complementarity, sol->qp.stationarity));
+  if (!(kkt <= kktTol)) {
+    std::ostringstream o;
+    o << "reduced KKT residual " << kkt << " exceeds -rom_kkt_tol " << kktTol << " (primal " << sol->qp.primal << ", dual " << sol->qp.dual << ", complementarity " << sol->qp.complementarity << ", stationarity " << sol->qp.stationarity << ")";
+    sol->message   = o.str();
+    sol->converged = false;
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,425 @@
+// tests/test_reduced_qp.cpp: the online reduced QP (rbc::ReducedQP): active set vs TAO BQPIP on random
+// problems (also with badly scaled constraint rows), an analytic case, warm starts (iterations, bitwise
+// reuse of the cached factorization), dependent constraints (R > N, S singular), infeasible
+// constraints, a non-SPD A, the iteration limit, the options, and no heap allocation in Solve after Reserve.
+#include "rbcontact/reduced_qp.hpp"
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <random>
+
+// Counts C++ heap allocations (the active-set path must not allocate after Reserve).
+static std::atomic<long> gAllocs{0};
+void *operator new(std::size_t n)
+{
+  ++gAllocs;
+  if (void *p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void *p) noexcept { std::free(p); }
+void operator delete(void *p, std::size_t) noexcept { std::free(p); }
+
+using namespace rbc;
+using Vecd = std::vector<PetscReal>;
+
+static int failures = 0;
+static void Check(bool ok, const char *what, double v, double bound)
+{
+  std::printf("  %-6s %-72s %.3e (bound %.1e)\n", ok ? "ok" : "FAIL", what, v, bound);
+  if (!ok) ++failures;
+}
+static void CheckTrue(bool ok, const char *what)
+{
+  std::printf("  %-6s %s\n", ok ? "ok" : "FAIL", what);
+  if (!ok) ++failures;
+}
+
+struct Problem {
+  PetscInt N = 0, R = 0;
+  Vecd     A, f, D, c;
+};
+
+static bool AllFinite(const Vecd &x)
+{
+  for (double v : x)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+static double NormInf(const Vecd &x)
+{
+  double m = 0;
+  for (double v : x) m = std::max(m, std::abs(v));
+  return m;
+}
+
+// Independent KKT check (same scaling as ReducedQPInfo), plain loops.
+static double WorstKKT(const Problem &p, const Vecd &v, const Vecd &l)
+{
+  double Dn = 0, An = 0, cn = NormInf(p.c), fn = NormInf(p.f), vn = NormInf(v), ln = NormInf(l);
+  double rmax = 0, neg = 0, lr = 0, st = 0;
+  for (PetscInt i = 0; i < p.R; ++i) {
+    double row = 0, r = -p.c[i];
+    for (PetscInt j = 0; j < p.N; ++j) { row += std::abs(p.D[i + j * p.R]); r += p.D[i + j * p.R] * v[j]; }
+    Dn   = std::max(Dn, row);
+    rmax = std::max(rmax, r);
+    lr += l[i] * r;
+    neg = std::max(neg, -l[i]);
+  }
+  for (PetscInt i = 0; i < p.N; ++i) {
+    double row = 0, g = -p.f[i];
+    for (PetscInt j = 0; j < p.N; ++j) { row += std::abs(p.A[i + j * p.N]); g += p.A[i + j * p.N] * v[j]; }
+    for (PetscInt k = 0; k < p.R; ++k) g += p.D[k + i * p.R] * l[k];
+    An = std::max(An, row);
+    st = std::max(st, std::abs(g));
+  }
+  const double tiny = 1e-300, sc = cn + Dn * vn;
+  return std::max(std::max(rmax / (sc + tiny), neg / (ln + tiny)), std::max(std::abs(lr) / (ln * sc + tiny), st / (fn + An * vn + tiny)));
+}
+
+static double InfoWorst(const ReducedQPInfo &in) { return std::max(std::max(in.primal, in.dual), std::max(in.complementarity, in.stationarity)); }
+
+// Random SPD A = M'M/N + 0.1 I, f random; D random R x N (rows scaled by 10^rowScale[i] if asked);
+// c = D A^{-1}f - gap with gap of both signs: about half of the constraints are active.
+static Problem RandomProblem(PetscInt N, PetscInt R, unsigned seed, bool badRows)
+{
+  std::mt19937                     gen(seed);
+  std::normal_distribution<double> G(0, 1);
+  Problem                          p;
+  p.N = N;
+  p.R = R;
+  Vecd M(N * N);
+  for (auto &x : M) x = G(gen);
+  p.A.assign(N * N, 0.0);
+  for (PetscInt i = 0; i < N; ++i)
+    for (PetscInt j = 0; j < N; ++j) {
+      for (PetscInt k = 0; k < N; ++k) p.A[i + j * N] += M[k + i * N] * M[k + j * N] / N;
+      if (i == j) p.A[i + j * N] += 0.1;
+    }
+  p.f.resize(N);
+  for (auto &x : p.f) x = G(gen);
+  p.D.resize(R * N);
+  for (auto &x : p.D) x = G(gen);
+  if (badRows)
+    for (PetscInt i = 0; i < R; ++i)
+      for (PetscInt j = 0; j < N; ++j) p.D[i + j * R] *= std::pow(10.0, (double)(i % 7) - 3);
+  // v0 = A^{-1} f by Gaussian elimination (A SPD, small)
+  Vecd a = p.A, v0 = p.f;
+  for (PetscInt k = 0; k < N; ++k)
+    for (PetscInt i = k + 1; i < N; ++i) {
+      const double m = a[i + k * N] / a[k + k * N];
+      for (PetscInt j = k; j < N; ++j) a[i + j * N] -= m * a[k + j * N];
+      v0[i] -= m * v0[k];
+    }
+  for (PetscInt i = N - 1; i >= 0; --i) {
+    for (PetscInt j = i + 1; j < N; ++j) v0[i] -= a[i + j * N] * v0[j];
+    v0[i] /= a[i + i * N];
+  }
+  p.c.resize(R);
+  for (PetscInt i = 0; i < R; ++i) {
+    double dv = 0, rn = 0;
+    for (PetscInt j = 0; j < N; ++j) { dv += p.D[i + j * R] * v0[j]; rn += std::abs(p.D[i + j * R]); }
+    p.c[i] = dv + rn * 0.5 * G(gen);
+  }
+  return p;
+}
+
+static PetscErrorCode Run(ReducedQP &qp, const Problem &p, Vecd *v, Vecd *l, ReducedQPInfo *info)
+{
+  PetscFunctionBeginUser;
+  v->assign(p.N, 0.0);
+  l->resize(p.R, 0.0);
+  PetscCall(qp.Solve(p.N, p.R, p.A.data(), p.f.data(), p.D.data(), p.c.data(), v->data(), l->data(), info));
+  PetscFunctionReturn(0);
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PetscOptionsSetValue(NULL, "-t_qp_type", "tao"));
+  PetscCall(PetscOptionsSetValue(NULL, "-o_qp_max_it", "7"));
+  ReducedQP     as, tao;
+  ReducedQPInfo ia, it;
+  Vecd          va, la, vt, lt;
+  PetscCall(as.SetFromOptions("x_"));
+  PetscCall(tao.SetFromOptions("t_"));
+  CheckTrue(as.type == ReducedQPType::ActiveSet && as.maxIt == 200, "defaults: activeset, max_it 200");
+  CheckTrue(tao.type == ReducedQPType::Tao, "-t_qp_type tao selects the TAO cross-check");
+  {
+    ReducedQP o;
+    PetscCall(o.SetFromOptions("o_"));
+    CheckTrue(o.maxIt == 7, "-o_qp_max_it 7");
+  }
+
+  std::printf("1. random problems, R < N: active set vs TAO BQPIP\n");
+  struct Size { PetscInt N, R; bool bad; };
+  for (Size sz : {Size{8, 5, false}, Size{20, 12, false}, Size{40, 30, false}, Size{60, 50, false}, Size{20, 12, true}, Size{40, 30, true}}) {
+    for (unsigned seed : {1u, 2u, 3u}) {
+      const Problem p = RandomProblem(sz.N, sz.R, 100 * seed + sz.N + sz.R + sz.bad, sz.bad);
+      la.assign(p.R, 0.0);
+      lt.assign(p.R, 0.0);
+      PetscCall(Run(as, p, &va, &la, &ia));
+      PetscCall(Run(tao, p, &vt, &lt, &it));
+      double dv = 0;
+      for (PetscInt i = 0; i < p.N; ++i) dv = std::max(dv, std::abs(va[i] - vt[i]));
+      dv /= NormInf(va);
+      char what[160];
+      std::printf(" N = %d R = %d%s seed %u: active set %d its, %d active, KKT %.1e; TAO %d its, status %s, KKT %.1e (p %.1e d %.1e c %.1e s %.1e)\n", (int)p.N, (int)p.R, sz.bad ? " (rows scaled 1e-3..1e3)" : "", seed, (int)ia.iterations,
+                  (int)ia.nactive, InfoWorst(ia), (int)it.iterations, ReducedQPStatusName(it.status), InfoWorst(it), it.primal, it.dual, it.complementarity, it.stationarity);
+      CheckTrue(ia.status == ReducedQPStatus::Ok && ia.message.empty(), "active set: status ok, empty message");
+      CheckTrue(it.status == ReducedQPStatus::Ok, "TAO: status ok");
+      CheckTrue(ia.nactive > 0 && ia.nactive < p.R, "some but not all constraints active");
+      std::snprintf(what, sizeof what, "active set: reported scaled KKT residuals");
+      Check(InfoWorst(ia) <= 1e-12, what, InfoWorst(ia), 1e-12);
+      Check(WorstKKT(p, va, la) <= 1e-12, "active set: independently computed scaled KKT residuals", WorstKKT(p, va, la), 1e-12);
+      Check(std::abs(WorstKKT(p, vt, lt) - InfoWorst(it)) <= 1e-3 * InfoWorst(it) + 1e-15, "TAO: reported KKT equals the independent one", std::abs(WorstKKT(p, vt, lt) - InfoWorst(it)), 1e-3 * InfoWorst(it) + 1e-15);
+      Check(dv <= 1e-6, "v: active set vs TAO (relative, inf norm)", dv, 1e-6);
+      CheckTrue(AllFinite(va) && AllFinite(la) && AllFinite(vt) && AllFinite(lt), "no NaN/Inf");
+      double lmin = 0;
+      for (double x : la) lmin = std::min(lmin, x);
+      Check(lmin >= 0, "active set: lambda >= 0 exactly", -lmin, 0);
+
+      // 3. warm start: the same problem from the previous multipliers, then with a perturbed gap
+      Vecd          lw = la, vw;
+      ReducedQPInfo iw;
+      PetscCall(Run(as, p, &vw, &lw, &iw));
+      Check(iw.iterations == 1 && iw.status == ReducedQPStatus::Ok, "warm start, same problem: iterations", iw.iterations, 1);
+      double dl = 0;
+      for (PetscInt i = 0; i < p.R; ++i) dl = std::max(dl, std::abs(lw[i] - la[i]));
+      Check(dl <= 1e-13 * NormInf(la), "warm start, same problem: same multipliers", dl, 1e-13 * NormInf(la));
+      Problem q = p;
+      for (PetscInt i = 0; i < p.R; ++i) q.c[i] *= 1 + 1e-9;
+      lw = la;
+      PetscCall(Run(as, q, &vw, &lw, &iw));
+      Check(iw.iterations <= 2 && iw.status == ReducedQPStatus::Ok, "warm start, gap perturbed by 1e-9: iterations", iw.iterations, 2);
+      Check(WorstKKT(q, vw, lw) <= 1e-12, "warm start, gap perturbed: KKT", WorstKKT(q, vw, lw), 1e-12);
+      // the cached factorization gives the same bits as a fresh one
+      ReducedQP fresh;
+      fresh.reuseFactorization = false;
+      Vecd          vf, lf(p.R, 0.0);
+      ReducedQPInfo inf;
+      PetscCall(Run(fresh, p, &vf, &lf, &inf));
+      CheckTrue(vf == va && lf == la, "no reuse of the factorization: bitwise the same solution");
+    }
+  }
+
+  std::printf("2. analytic: A = diag(a), D = I: v = min(f/a, c), lambda = max(f - a c, 0)\n");
+  {
+    Problem p;
+    p.N = p.R = 4;
+    const double a[4] = {1.0, 2.0, 0.5, 3.0};
+    p.A.assign(16, 0.0);
+    p.D.assign(16, 0.0);
+    for (int i = 0; i < 4; ++i) { p.A[i + 4 * i] = a[i]; p.D[i + 4 * i] = 1.0; }
+    p.f = {1.0, -2.0, 3.0, 0.5};
+    p.c = {0.25, 5.0, 1.0, 0.1};
+    la.assign(4, 0.0);
+    PetscCall(Run(as, p, &va, &la, &ia));
+    double ev = 0, el = 0;
+    for (int i = 0; i < 4; ++i) {
+      ev = std::max(ev, std::abs(va[i] - std::min(p.f[i] / a[i], p.c[i])));
+      el = std::max(el, std::abs(la[i] - std::max(p.f[i] - a[i] * p.c[i], 0.0)));
+    }
+    CheckTrue(ia.status == ReducedQPStatus::Ok && ia.nactive == 3, "status ok, 3 active");
+    Check(ev <= 1e-14, "v = min(f/a, c)", ev, 1e-14);
+    Check(el <= 1e-14, "lambda = max(f - a c, 0)", el, 1e-14);
+    // the TAO cross-check on the same case: close, not exact
+    lt.assign(4, 0.0);
+    PetscCall(Run(tao, p, &vt, &lt, &it));
+    ev = 0;
+    for (int i = 0; i < 4; ++i) ev = std::max(ev, std::abs(vt[i] - std::min(p.f[i] / a[i], p.c[i])));
+    Check(ev <= 1e-6, "TAO: v close to min(f/a, c)", ev, 1e-6);
+    // R = 0: the unconstrained solution
+    Vecd          v0(4);
+    ReducedQPInfo i0;
+    PetscCall(as.Solve(4, 0, p.A.data(), p.f.data(), NULL, NULL, v0.data(), NULL, &i0));
+    double e0 = 0;
+    for (int i = 0; i < 4; ++i) e0 = std::max(e0, std::abs(v0[i] - p.f[i] / a[i]));
+    Check(e0 <= 1e-15 && i0.status == ReducedQPStatus::Ok, "R = 0: v = A^{-1} f", e0, 1e-15);
+  }
+
+  std::printf("4. R > N, dependent active constraints (S singular on the active set), unique v\n");
+  for (unsigned seed : {7u, 8u, 9u}) {
+    std::mt19937                     gen(seed);
+    std::normal_distribution<double> G(0, 1);
+    Problem                          p = RandomProblem(6, 15, seed, false);
+    // v* given; 10 > N constraints active at v* with positive multipliers (+ a duplicated active row)
+    Vecd vs(6), ls(15, 0.0);
+    for (auto &x : vs) x = G(gen);
+    for (PetscInt j = 0; j < 6; ++j) p.D[14 + j * 15] = p.D[0 + j * 15]; // row 14 duplicates row 0
+    for (PetscInt i = 0; i < 15; ++i) {
+      double dv = 0;
+      for (PetscInt j = 0; j < 6; ++j) dv += p.D[i + j * 15] * vs[j];
+      const bool active = i < 10 || i == 14;
+      p.c[i]            = active ? dv : dv + 0.5 + std::abs(G(gen));
+      if (active) ls[i] = 0.5 + std::abs(G(gen));
+    }
+    for (PetscInt i = 0; i < 6; ++i) {
+      double g = 0;
+      for (PetscInt j = 0; j < 6; ++j) g += p.A[i + j * 6] * vs[j];
+      for (PetscInt k = 0; k < 15; ++k) g += p.D[k + i * 15] * ls[k];
+      p.f[i] = g;
+    }
+    for (int warm = 0; warm < 3; ++warm) {
+      // cold; warm from the (dependent) generating multipliers; warm from all-positive multipliers
+      if (warm == 0) la.assign(15, 0.0);
+      else if (warm == 1) la = ls;
+      else la.assign(15, 1.0);
+      PetscCall(Run(as, p, &va, &la, &ia));
+      double dv = 0;
+      for (PetscInt i = 0; i < 6; ++i) dv = std::max(dv, std::abs(va[i] - vs[i]));
+      std::printf(" seed %u, %s: status %s, %d its, %d active\n", seed, warm == 0 ? "cold" : warm == 1 ? "warm (generating lambda)" : "warm (all positive)", ReducedQPStatusName(ia.status), (int)ia.iterations, (int)ia.nactive);
+      CheckTrue(ia.status == ReducedQPStatus::Ok, "solved (the free set is kept linearly independent)");
+      CheckTrue(ia.nactive <= 6, "at most N positive multipliers (independent free set)");
+      Check(dv <= 1e-10 * NormInf(vs), "v equals the unique v*", dv, 1e-10 * NormInf(vs));
+      Check(WorstKKT(p, va, la) <= 1e-12, "scaled KKT residuals", WorstKKT(p, va, la), 1e-12);
+      CheckTrue(AllFinite(va) && AllFinite(la), "no NaN/Inf");
+    }
+    lt.assign(15, 0.0);
+    PetscCall(Run(tao, p, &vt, &lt, &it));
+    double dv = 0;
+    for (PetscInt i = 0; i < 6; ++i) dv = std::max(dv, std::abs(vt[i] - vs[i]));
+    std::printf(" seed %u, TAO: status %s, %d its, |v - v*| = %.2e %s\n", seed, ReducedQPStatusName(it.status), (int)it.iterations, dv, it.message.c_str());
+    CheckTrue(AllFinite(vt) && AllFinite(lt), "TAO: no NaN/Inf");
+    CheckTrue(it.status != ReducedQPStatus::Ok || dv <= 1e-5 * NormInf(vs), "TAO: if ok, then v close to v*");
+  }
+
+  std::printf("4b. nearly parallel constraints (angle 1e-7: numerically dependent), the second one binding\n");
+  {
+    Problem p; // A = I, f = (10, 0): v1 <= 1 and v1 + 1e-7 v2 <= 1 - 1e-9 -> only the second active
+    p.N = 2;
+    p.R = 2;
+    p.A = {1.0, 0.0, 0.0, 1.0};
+    p.f = {10.0, 0.0};
+    p.D = {1.0, 1.0, 0.0, 1e-7};
+    p.c = {1.0, 1.0 - 1e-9};
+    for (int warm = 0; warm < 2; ++warm) {
+      la = warm ? Vecd{1.0, 0.0} : Vecd{0.0, 0.0};
+      PetscCall(Run(as, p, &va, &la, &ia));
+      // exact: lambda_2 = 9 (1 + 1e-9/9) / (1 + 1e-14), v = f - lambda_2 (1, 1e-7)
+      const double l2 = (9.0 + 1e-9) / (1.0 + 1e-14), e = std::max(std::abs(la[0]), std::abs(la[1] - l2) / l2);
+      std::printf(" %s: status %s, %d its, lambda = (%.3e, %.12g)\n", warm ? "warm from the first" : "cold", ReducedQPStatusName(ia.status), (int)ia.iterations, la[0], la[1]);
+      CheckTrue(ia.status == ReducedQPStatus::Ok, "status ok");
+      Check(e <= 1e-8, "lambda = (0, 9 + 1e-9) (relative)", e, 1e-8);
+      Check(WorstKKT(p, va, la) <= 1e-12, "scaled KKT residuals", WorstKKT(p, va, la), 1e-12);
+    }
+  }
+
+  std::printf("5. infeasible constraints\n");
+  {
+    Problem p; // v <= -1 and -v <= -1 (v >= 1)
+    p.N = 1;
+    p.R = 2;
+    p.A = {2.0};
+    p.f = {0.5};
+    p.D = {1.0, -1.0};
+    p.c = {-1.0, -1.0};
+    for (int warm = 0; warm < 2; ++warm) {
+      la.assign(2, warm ? 1.0 : 0.0);
+      PetscCall(Run(as, p, &va, &la, &ia));
+      std::printf(" 1D, %s: %s: %s\n", warm ? "warm" : "cold", ReducedQPStatusName(ia.status), ia.message.c_str());
+      CheckTrue(ia.status == ReducedQPStatus::Infeasible, "status Infeasible");
+      CheckTrue(ia.message.find("infeasible") != std::string::npos && ia.message.find("supremizers") != std::string::npos, "message says infeasible, with the supremizer hint");
+      CheckTrue(AllFinite(va) && AllFinite(la), "v, lambda finite");
+    }
+    Problem z; // a zero constraint row with a negative bound: 0 <= -1
+    z.N = 2;
+    z.R = 2;
+    z.A = {1.0, 0.0, 0.0, 1.0};
+    z.f = {1.0, 1.0};
+    z.D = {1.0, 0.0, 0.0, 0.0};
+    z.c = {0.5, -1.0};
+    la.assign(2, 0.0);
+    PetscCall(Run(as, z, &va, &la, &ia));
+    CheckTrue(ia.status == ReducedQPStatus::Infeasible && AllFinite(va) && AllFinite(la), "0 v <= -1: Infeasible, finite output");
+    Problem q = RandomProblem(10, 8, 5, false); // random + a contradictory pair
+    for (PetscInt j = 0; j < 10; ++j) q.D[7 + j * 8] = -q.D[6 + j * 8];
+    q.c[6] = -1.0;
+    q.c[7] = -1.0;
+    la.assign(8, 0.0);
+    PetscCall(Run(as, q, &va, &la, &ia));
+    CheckTrue(ia.status == ReducedQPStatus::Infeasible && AllFinite(va) && AllFinite(la), "random N = 10 with d'v <= -1, -d'v <= -1: Infeasible, finite output");
+    lt.assign(8, 0.0);
+    PetscCall(Run(tao, q, &vt, &lt, &it));
+    std::printf(" TAO on it: %s (%s)\n", ReducedQPStatusName(it.status), it.message.c_str());
+    CheckTrue(AllFinite(vt) && AllFinite(lt), "TAO on an infeasible problem: finite output");
+    CheckTrue(it.status != ReducedQPStatus::Ok || InfoWorst(it) > 1e-6, "TAO on an infeasible problem: not a clean Ok");
+  }
+
+  std::printf("6. A not SPD\n");
+  {
+    Problem p = RandomProblem(5, 3, 11, false);
+    for (int kind = 0; kind < 2; ++kind) {
+      Problem q = p;
+      if (kind == 0) q.A[2 + 2 * 5] = -1.0; // indefinite
+      else { // singular PSD: A = u u' + v v'
+        for (PetscInt i = 0; i < 5; ++i)
+          for (PetscInt j = 0; j < 5; ++j) q.A[i + j * 5] = (i + 1.0) * (j + 1.0) + 1.0;
+      }
+      for (auto *s : {&as, &tao}) {
+        la.assign(3, 1.0);
+        PetscCall(Run(*s, q, &va, &la, &ia));
+        std::printf(" %s, %s: %s: %s\n", kind ? "singular" : "indefinite", s == &as ? "activeset" : "tao", ReducedQPStatusName(ia.status), ia.message.c_str());
+        CheckTrue(ia.status == ReducedQPStatus::NotSPD && !ia.message.empty(), "status NotSPD with a message");
+        CheckTrue(AllFinite(va) && AllFinite(la), "v, lambda finite");
+      }
+    }
+    // and the next call with a good A works again
+    la.assign(3, 0.0);
+    PetscCall(Run(as, p, &va, &la, &ia));
+    CheckTrue(ia.status == ReducedQPStatus::Ok, "a good A afterwards: ok");
+  }
+
+  std::printf("7. iteration limit, non-finite input, allocations\n");
+  {
+    PetscCall(PetscOptionsSetValue(NULL, "-u_qp_type", "tao"));
+    PetscCall(PetscOptionsSetValue(NULL, "-u_qp_tao_max_it", "3"));
+    ReducedQP     tao3;
+    const Problem p3 = RandomProblem(20, 12, 31, false);
+    PetscCall(tao3.SetFromOptions("u_"));
+    lt.assign(p3.R, 0.0);
+    PetscCall(Run(tao3, p3, &vt, &lt, &it));
+    std::printf(" TAO, -u_qp_tao_max_it 3: %s, %d its: %s\n", ReducedQPStatusName(it.status), (int)it.iterations, it.message.c_str());
+    CheckTrue(it.status == ReducedQPStatus::MaxIt && it.iterations == 3 && it.message.find("u_qp_tao_max_it") != std::string::npos, "TAO options prefix u_qp_: iteration limit 3 -> MaxIt with a hint");
+    PetscCall(tao3.Reset());
+
+    const Problem p = RandomProblem(30, 25, 21, false);
+    ReducedQP     small;
+    small.maxIt = 2;
+    la.assign(p.R, 0.0);
+    PetscCall(Run(small, p, &va, &la, &ia));
+    CheckTrue(ia.status == ReducedQPStatus::MaxIt && ia.message.find("qp_max_it") != std::string::npos && AllFinite(va) && AllFinite(la), "max_it 2, cold: MaxIt with a hint, finite output");
+    double lmin = 0;
+    for (double x : la) lmin = std::min(lmin, x);
+    CheckTrue(lmin >= 0, "MaxIt: lambda still >= 0");
+
+    Problem bad = p;
+    bad.c[3]    = NAN;
+    la.assign(p.R, 0.0);
+    va.assign(p.N, 0.0);
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    PetscErrorCode ierr = as.Solve(bad.N, bad.R, bad.A.data(), bad.f.data(), bad.D.data(), bad.c.data(), va.data(), la.data(), &ia);
+    PetscCall(PetscPopErrorHandler());
+    CheckTrue(ierr == PETSC_ERR_FP && AllFinite(va) && AllFinite(la), "NaN in c: PETSC_ERR_FP, finite output");
+
+    const Problem p2 = RandomProblem(10, 8, 22, false);
+    ReducedQP     qp;
+    qp.Reserve(p.N, p.R);
+    Vecd v(p.N), l(p.R, 0.0);
+    Problem q = p;
+    long    before = gAllocs;
+    PetscCall(qp.Solve(p.N, p.R, p.A.data(), p.f.data(), p.D.data(), p.c.data(), v.data(), l.data(), &ia)); // cold
+    PetscCall(qp.Solve(p.N, p.R, p.A.data(), p.f.data(), p.D.data(), p.c.data(), v.data(), l.data(), &ia)); // warm, cached
+    q.A[0] *= 1 + 1e-12;
+    PetscCall(qp.Solve(q.N, q.R, q.A.data(), q.f.data(), q.D.data(), q.c.data(), v.data(), l.data(), &ia)); // warm, new A
+    PetscCall(qp.Solve(p2.N, p2.R, p2.A.data(), p2.f.data(), p2.D.data(), p2.c.data(), v.data(), l.data(), &ia)); // smaller sizes
+    Check(gAllocs - before == 0, "heap allocations in 4 Solve calls after Reserve", (double)(gAllocs - before), 0);
+  }
+
+  PetscCall(as.Reset());
+  PetscCall(tao.Reset());
+  std::printf("%s: %d failure(s)\n", failures ? "FAILED" : "PASSED", failures);
+  PetscCall(PetscFinalize());
+  return failures ? 1 : 0;
+}
