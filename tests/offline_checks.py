@@ -155,7 +155,7 @@ def bases(args):
     base = ["-train_type", "grid", "-train_size", "21", "-snapshots", d + "/s.h5", "-pod_tol", "1e-8", "-dual_tol", "1e-3", "-dual_tol_relative"]
     table = []
     for t in ("cpg", "mcpg", "angle", "nmf"):
-        extra = ["-dual_type", t] + (["-dual_r", "8"] if t == "nmf" else [])
+        extra = ["-dual_type", t, "-pod_supremizers", "0"] + (["-dual_r", "8"] if t == "nmf" else [])
         reps = {}
         for np_ in (1, 2):
             rom = "%s/rom_%s_np%d.h5" % (d, t, np_)

@@ -103,6 +103,7 @@ public:
   std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull
   ContactPatch           patch;                      // local data around the EIM points
   std::vector<PetscReal> warmMu, warmV, warmL;       // training parameters and their reduced solutions
+  std::vector<PetscReal> dualGram;                   // W'W (Rfull x Rfull): the Kacanov change of lambda = W lambda^ is measured in it
   // options
   PetscInt  maxIt = 30;
   PetscReal rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;

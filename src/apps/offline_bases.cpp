@@ -248,7 +248,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrde
   if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
   rep->root["time_s"]["pod"]  = (double)(t1 - t0);
   rep->root["time_s"]["dual"] = (double)(t2 - t1);
-  rep->root["rom"]            = romPath;
+  rep->root["rom_file"]       = romPath;
   PetscFunctionReturn(0);
 }
 

@@ -141,6 +141,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       if (row < 0 || b == 0) continue;
       for (PetscInt r = 0; r < R; ++r) P[(size_t)r * Q + p] += b * dual.W(row, r);
     }
+  rm.dualGram.assign((size_t)R * R, 0.0);
+  for (PetscInt a = 0; a < R; ++a)
+    for (PetscInt b = 0; b < R; ++b)
+      for (PetscInt i = 0; i < Rfom; ++i) rm.dualGram[(size_t)a * R + b] += dual.W(i, a) * dual.W(i, b);
   rm.SetExactContact(full, P);
   rm.SetContactMode(ReducedModel::ContactMode::Exact);
   PetscCall(rm.SetFromOptions()); // rom_kacanov_*, rom_qp_* (the truncation options are not for this step)

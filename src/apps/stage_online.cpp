@@ -57,7 +57,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   if (sol.outOfRange) PetscCall(PetscPrintf(comm, "rbcontact online: warning: %" PetscInt_FMT " contact projections fell at the edge of the stored contact data (outside the EIM's training range)\n", sol.outOfRange));
 
   rep.root["stage"] = "online";
-  rep.root["rom"]   = romPath;
+  rep.root["rom_file"] = romPath;
   JsonValue &m      = rep.root["mu"];
   for (size_t i = 0; i < mu.size(); ++i) m[model.par.params[i].name] = (double)mu[i];
   rep.root["converged"]          = sol.converged;

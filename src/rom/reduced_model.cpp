@@ -184,6 +184,7 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
     w->Dataset("/online/gap/B", {(U64)m.MgFull, (U64)m.MgFull}, m.gB);
     w->Dataset("/online/gap/C", {(U64)m.MgFull, R}, m.gC);
   }
+  w->Dataset("/online/dual_gram", {R, R}, m.dualGram);
   std::vector<std::pair<std::string, std::pair<std::vector<U64>, std::vector<double>>>> items;
   m.patch.Serialize(&items);
   for (auto &it : items) w->Dataset("/online/contact/" + it.first, it.second.first, it.second.second);
@@ -224,6 +225,7 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   PetscCall(ReadChecked(path, "/online/gap/meta", 2, &d));
   gapConst = d[0] != 0;
   MgFull   = gapConst ? 0 : (PetscInt)d[1];
+  PetscCall(ReadChecked(path, "/online/dual_gram", R * R, &dualGram));
   PetscCall(patch.Deserialize(path, "/online/contact"));
   PetscCheck(patch.N == Nfull && patch.dim == dim, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: the contact data has %" PetscInt_FMT " basis functions, the model %" PetscInt_FMT, path.c_str(), patch.N, Nfull);
   if (kappaConst) PetscCall(ReadChecked(path, "/online/kappa/constant", N * R, &kConstant));
@@ -508,10 +510,17 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
     PetscInt nact = 0;
     for (PetscInt i = 0; i < r; ++i) {
       sol->lambda[i] = lprev[i] + relaxation * (sol->lambda[i] - lprev[i]);
-      nl += PetscSqr(sol->lambda[i]);
-      dln += PetscSqr(sol->lambda[i] - lprev[i]);
       nact += sol->lambda[i] > 0;
     }
+    // changes of the multiplier field W lambda^ (the FOM's rule), in the Gram matrix W'W
+    for (PetscInt i = 0; i < r; ++i)
+      for (PetscInt j = 0; j < r; ++j) {
+        const PetscReal g = dualGram[(size_t)i * Rfull + j];
+        nl += sol->lambda[i] * g * sol->lambda[j];
+        dln += (sol->lambda[i] - lprev[i]) * g * (sol->lambda[j] - lprev[j]);
+      }
+    nl  = std::max<PetscReal>(nl, 0);
+    dln = std::max<PetscReal>(dln, 0);
     const PetscReal du = nv > 0 ? std::sqrt(dv / nv) : std::sqrt(dv), dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
     sol->du.push_back(du);
     sol->dl.push_back(dl);
