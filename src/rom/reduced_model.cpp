@@ -469,6 +469,12 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
   sol->iterates.clear();
   sol->v.assign(Na, 0.0);
   sol->lambda.assign(r, 0.0);
+  if (r > Na) {
+    std::ostringstream o;
+    o << "the reduced saddle point is not inf-sup stable: R = " << r << " dual vectors for N = " << Na << " primal ones (K^ is R x N: the reduced multipliers are not determined by the problem); rebuild the ROM with -pod_supremizers or use at most -rom_R " << Na;
+    sol->message = o.str();
+    PetscFunctionReturn(0);
+  }
   Operators(mu, &A_, &f_);
   // warm start: the stored reduced solution of the nearest training parameter (box-scaled distance)
   const size_t np = par.params.size(), nw = np ? warmMu.size() / np : 0;

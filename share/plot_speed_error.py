@@ -1,0 +1,285 @@
+#!/usr/bin/python3
+"""plot_speed_error.py: speed against error of a reduced model, from the sweep table of
+`rbcontact validate ... -validate_sweep -validate_sweep_output <stem>`.
+
+Reads <stem>.json:
+  {"rows": [{"N", "R", "Mk", "Mg",            sizes of the truncated ROM
+             "online_median_s",               median time of one online solve [s]
+             "max_rel_err_u",                 max over the test set, energy norm of A(mu)
+             "max_rel_err_lambda",            max over the test set, l2 weighted by the slave mass
+             "max_rel_err_force", "failed"}, ...],
+   "fom_median_s": t, "scene": name, "ndofs": n}
+(JSON has no NaN: errors of rows with failed ROM solves are null) and draws, log-log, the max
+relative error over the test set against the time per solve, one series for u and one for lambda,
+each point labelled N,R,Mk,Mg; the FOM's median time as a vertical dashed line (the FOM is exact to
+the solver tolerance); a top axis with the speedup over the FOM; optional target error lines.
+Rows with failed solves are drawn as crosses at the top of the plot.
+
+Usage: /usr/bin/python3 share/plot_speed_error.py results/ring_on_block/sweep.json -o speed_error.png \
+           [--title ring_on_block] [--targets 1e-3,1e-2] [--dpi 150]
+Run it with Debian's /usr/bin/python3 (python3-matplotlib, python3-numpy).
+"""
+import argparse
+import json
+import math
+import os
+import sys
+
+
+def fail(msg):
+    sys.stderr.write("plot_speed_error.py: error: %s\n" % msg)
+    sys.exit(1)
+
+
+try:
+    import numpy as np
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.transforms as mtransforms
+except ImportError as e:  # pragma: no cover
+    fail("%s (interpreter %s). Run with /usr/bin/python3 after share/setup.sh "
+         "(python3-numpy python3-matplotlib)" % (e, sys.executable))
+
+SIZES = ("N", "R", "Mk", "Mg")
+VALUES = ("online_median_s", "max_rel_err_u", "max_rel_err_lambda")
+
+
+def number(path, i, row, key, integer=False):
+    """row[key] as a float (None -> nan); a clear error naming the file, the row and the key."""
+    if key not in row:
+        fail("'%s': row %d lacks \"%s\" (it has: %s)" % (path, i, key, ", ".join(sorted(row.keys())) or "nothing"))
+    v = row[key]
+    if v is None:
+        if integer:
+            fail("'%s': row %d: \"%s\" is null" % (path, i, key))
+        return float("nan")
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        fail("'%s': row %d: \"%s\" is %r, expected a number" % (path, i, key, v))
+    if integer and v != int(v):
+        fail("'%s': row %d: \"%s\" is %r, expected an integer" % (path, i, key, v))
+    return float(v)
+
+
+def read_table(path):
+    if not os.path.isfile(path):
+        fail("file '%s' not found (write it with: rbcontact validate ... -validate_sweep "
+             "-validate_sweep_output <stem>, which writes <stem>.json)" % path)
+    try:
+        with open(path) as fh:
+            t = json.load(fh)
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        fail("cannot read '%s' as JSON: %s" % (path, e))
+    if not isinstance(t, dict):
+        fail("'%s' is not a sweep table (expected a JSON object with \"rows\")" % path)
+    if "rows" not in t:
+        hint = ""
+        if "sweep_files" in t:
+            hint = " This looks like a validate report: give the sweep table it names, %s." % t["sweep_files"]
+        elif t.get("stage") == "validate":
+            hint = " This looks like a validate report of a run without -validate_sweep."
+        fail("'%s' has no \"rows\" (it has: %s).%s" % (path, ", ".join(sorted(t.keys())) or "nothing", hint))
+    rows = t["rows"]
+    if not isinstance(rows, list) or not rows:
+        fail("'%s': \"rows\" is %s, expected a non-empty list of rows" % (path, "empty" if rows == [] else repr(type(rows).__name__)))
+    out = []
+    for i, row in enumerate(rows):
+        if not isinstance(row, dict):
+            fail("'%s': row %d is not an object" % (path, i))
+        r = {k: int(number(path, i, row, k, integer=True)) for k in SIZES}
+        r.update({k: number(path, i, row, k) for k in VALUES})
+        r["failed"] = int(number(path, i, row, "failed", integer=True)) if "failed" in row else 0
+        r["first_failure"] = row.get("first_failure", "")
+        out.append(r)
+    fom = t.get("fom_median_s")
+    if fom is not None and (isinstance(fom, bool) or not isinstance(fom, (int, float))):
+        fail("'%s': \"fom_median_s\" is %r, expected a number" % (path, fom))
+    fom = float(fom) if fom is not None else float("nan")
+    return out, fom, t.get("scene"), t.get("ndofs")
+
+
+def parse_targets(s):
+    vals = []
+    for tok in s.split(","):
+        tok = tok.strip()
+        if not tok:
+            continue
+        try:
+            v = float(tok)
+        except ValueError:
+            fail("--targets: '%s' is not a number (give e.g. --targets 1e-3,1e-2)" % tok)
+        if not (v > 0 and math.isfinite(v)):
+            fail("--targets: %s must be > 0 (the error axis is logarithmic)" % tok)
+        vals.append((v, tok))
+    return sorted(dict(vals).items())  # (value, as given), one per value
+
+
+def ok(v):
+    return math.isfinite(v) and v > 0
+
+
+def label(r):
+    return "%d,%d,%d,%d" % tuple(r[k] for k in SIZES)
+
+
+def place_labels(fig, ax, labels, avoid):
+    """Annotates each (x, y, text, color) at the first of a few offsets around its point where the text
+    overlaps no marker, line, other label, text or legend (else where it overlaps least)."""
+    fig.canvas.draw()
+    rend = fig.canvas.get_renderer()
+    box = matplotlib.transforms.Bbox
+    obst = [a.get_window_extent(rend) for a in avoid + ax.texts]
+    for line in ax.get_lines():  # markers, and samples along the segments (straight on log-log axes)
+        if line.get_transform() != ax.transData or not len(line.get_xdata()):
+            continue
+        d = ax.transData.transform(np.column_stack([line.get_xdata(), line.get_ydata()]))
+        for p0, p1 in zip(d[:-1], d[1:]):
+            for t in np.linspace(0.0, 1.0, 16):
+                q = p0 + t * (p1 - p0)
+                obst.append(box.from_extents(q[0] - 2, q[1] - 2, q[0] + 2, q[1] + 2))
+        for q in d:
+            obst.append(box.from_extents(q[0] - 6, q[1] - 6, q[0] + 6, q[1] + 6))
+    frame = ax.get_window_extent(rend)
+    # offsets [points] from the point, nearest first; the farther ones get a leader line
+    cands = [(dx * s, dy * s, ha, va) for s in (1, 2, 3, 4)
+             for dx, dy, ha, va in ((5, 4, "left", "bottom"), (5, -4, "left", "top"), (-5, 4, "right", "bottom"),
+                                    (-5, -4, "right", "top"), (0, 7, "center", "bottom"), (0, -7, "center", "top"),
+                                    (8, 0, "left", "center"), (-8, 0, "right", "center"))]
+
+    def overlap(bb):
+        area = 0.0
+        for o in obst:
+            w = min(bb.x1, o.x1) - max(bb.x0, o.x0)
+            h = min(bb.y1, o.y1) - max(bb.y0, o.y0)
+            if w > 0 and h > 0:
+                area += w * h
+        out = bb.width * bb.height - max(0.0, min(bb.x1, frame.x1) - max(bb.x0, frame.x0)) * \
+            max(0.0, min(bb.y1, frame.y1) - max(bb.y0, frame.y0))
+        return area + 10.0 * out
+
+    for x, y, text, color in labels:
+        best = None
+        for dx, dy, ha, va in cands:
+            an = ax.annotate(text, (x, y), xytext=(dx, dy), textcoords="offset points", ha=ha, va=va, fontsize=7.5,
+                             color=color, zorder=4,
+                             arrowprops=dict(arrowstyle="-", color=color, lw=0.7, shrinkA=1, shrinkB=5)
+                             if abs(dx) > 8 or abs(dy) > 8 else None,
+                             bbox=dict(boxstyle="round,pad=0.1", facecolor="white", edgecolor="none", alpha=0.75))
+            bb = an.get_window_extent(rend).expanded(1.0, 1.0)
+            cost = overlap(bb)
+            if best is None or cost < best[0]:
+                if best is not None:
+                    best[1].remove()
+                best = (cost, an, bb)
+            else:
+                an.remove()
+            if cost == 0:
+                break
+        obst.append(best[2])
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description="Plot the max relative error against the online time per solve "
+                                            "of the ROM truncations in an rbcontact validate sweep table.")
+    p.add_argument("json", help="sweep table <stem>.json written by `rbcontact validate -validate_sweep "
+                                "-validate_sweep_output <stem>`")
+    p.add_argument("-o", "--output", help="PNG to write (default: <json without .json>.png)")
+    p.add_argument("--title", default=None, help="scene name shown in the title (default: the table's \"scene\")")
+    p.add_argument("--targets", default=None,
+                   help="comma-separated target errors drawn as horizontal lines, e.g. 1e-3,1e-2")
+    p.add_argument("--dpi", type=int, default=150, help="resolution (default 150)")
+    a = p.parse_args(argv)
+
+    out = a.output or (a.json[:-5] if a.json.endswith(".json") else a.json) + ".png"
+    targets = parse_targets(a.targets) if a.targets else []
+    rows, fom, scene, ndofs = read_table(a.json)
+    title = a.title or scene or os.path.basename(a.json)
+
+    series = [("max_rel_err_u", "u, energy norm", "o", "tab:blue"),
+              ("max_rel_err_lambda", "$\\lambda$, weighted $\\ell^2$", "s", "tab:orange")]
+    good = [r for r in rows if not r["failed"] and ok(r["online_median_s"])]
+    bad = [r for r in rows if r not in good]
+    ys = [r[k] for r in good for k, _, _, _ in series if ok(r[k])]
+    xs = [r["online_median_s"] for r in rows if ok(r["online_median_s"])]
+    if not ys and not bad:
+        fail("'%s': no row has a positive time and error to plot" % a.json)
+    if not ok(fom):
+        print("plot_speed_error.py: warning: '%s' has no FOM time (fom_median_s): no FOM line" % a.json)
+
+    fig, ax = plt.subplots(figsize=(8.5, 5.6), layout="constrained")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    labels = []  # (x, y, text, color): placed once the axes are final
+    for key, name, marker, color in series:
+        pts = sorted((r["online_median_s"], r[key], i) for i, r in enumerate(good) if ok(r[key]))
+        if not pts:
+            continue
+        ax.plot([q[0] for q in pts], [q[1] for q in pts], "-", marker=marker, color=color, markersize=6,
+                linewidth=1.0, zorder=3, label="max rel. error of %s" % name)
+        labels += [(xi, yi, label(good[i]), color) for xi, yi, i in pts]
+
+    # limits: all times and the FOM line in x, all errors and targets in y (decades, with margins)
+    xall = xs + ([fom] if ok(fom) else [])
+    xlo, xhi = min(xall), max(xall)
+    ax.set_xlim(xlo / 2.5, xhi * 4.0)
+    yall = ys + [tv for tv, _ in targets]
+    ylo, yhi = (min(yall), max(yall)) if yall else (1e-3, 1.0)
+    ylo, yhi = 10 ** math.floor(math.log10(ylo) - 0.15), 10 ** math.ceil(math.log10(yhi) + 0.15)
+    ax.set_ylim(ylo, yhi)
+
+    if ok(fom):
+        ax.axvline(fom, color="k", linestyle="--", linewidth=1.2, zorder=2,
+                   label="FOM (exact to solver tolerance), median %.3g s" % fom)
+        ax.text(fom, 0.98, "FOM (exact to solver tolerance) ", rotation=90, ha="right", va="top",
+                fontsize=8, transform=mtransforms.blended_transform_factory(ax.transData, ax.transAxes),
+                bbox=dict(boxstyle="square,pad=0.05", facecolor="white", edgecolor="none", alpha=0.8))
+        sec = ax.secondary_xaxis("top", functions=(lambda t: fom / np.maximum(t, 1e-300),
+                                                   lambda s: fom / np.maximum(s, 1e-300)))
+        sec.set_xlabel("speedup over the FOM (FOM median time / time per solve)", fontsize=9)
+    for tv, tok in targets:
+        ax.axhline(tv, color="tab:green", linestyle=":", linewidth=1.2, zorder=1)
+        ax.text(0.995, tv, "target %s" % tok, ha="right", va="bottom", fontsize=8, color="tab:green",
+                transform=mtransforms.blended_transform_factory(ax.transAxes, ax.transData))
+    if bad:  # failed truncations: crosses at the top edge (there is no error to plot)
+        trans = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
+        for r in bad:
+            if ok(r["online_median_s"]):
+                ax.plot(r["online_median_s"], 0.97, "x", color="tab:red", markersize=8, mew=2, transform=trans,
+                        clip_on=False, zorder=5)
+                ax.annotate(label(r) + " failed", (r["online_median_s"], 0.97), xycoords=trans, xytext=(5, -3),
+                            textcoords="offset points", fontsize=7, color="tab:red", va="top")
+        ax.plot([], [], "x", color="tab:red", mew=2, label="truncation with failed solves (no error)")
+
+    ax.set_xlabel("time per online solve [s] (median)")
+    ax.set_ylabel("max relative error over the test set")
+    ax.grid(True, which="major", alpha=0.35)
+    ax.grid(True, which="minor", alpha=0.12)
+    # legend below the axes: the plot area is for the points and their labels
+    leg = ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=3, frameon=False)
+    place_labels(fig, ax, labels, [leg])
+    sub = "point labels: N,R,Mk,Mg (reduced primal, dual, EIM kappa, EIM gap sizes); %d truncations" % len(rows)
+    if bad:
+        sub += ", %d with failed solves" % len(bad)
+    hidden = ["%s %s" % (label(r), "u" if k == "max_rel_err_u" else "lambda") for r in good for k, _, _, _ in series
+              if not ok(r[k])]
+    if hidden:  # zero (exact) or missing errors have no place on a log axis
+        sub += "\nnot drawn (error zero or missing): %s" % "; ".join(hidden)
+    if bad:
+        first = next((r["first_failure"] for r in bad if r["first_failure"]), "")
+        if first:
+            sub += "\nfirst failure: %s" % (first if len(first) <= 110 else first[:107] + "...")
+    fig.suptitle("%s: ROM speed against error%s\n%s"
+                 % (title, (", %s dofs" % ndofs) if ndofs is not None else "", sub), fontsize=10)
+
+    odir = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(odir):
+        fail("output directory '%s' does not exist" % odir)
+    fig.savefig(out, dpi=a.dpi)
+    plt.close(fig)
+    print("plot_speed_error.py: wrote %s" % out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,212 @@
+#!/usr/bin/python3
+"""Checks of the ROM pipeline (offline -> ROM file -> online, validate), run by ctest (tests/rom.cmake).
+
+  pipeline    ring_on_block with its options file (the seed's 21 radii): the ROM file holds nothing of
+              the size of the mesh; online on 1 and 2 ranks gives the same answer; the TAO QP agrees with
+              the active-set QP; validate on 20 random radii meets the accuracy targets (u <= 1e-3,
+              lambda <= 1e-2, N, R <= 30) on 1 and 2 ranks with the same errors; the sweep table; the
+              reconstructed fields against the FOM at the same radius.
+  bad_input   missing/corrupt/mismatched ROM files, a bases-only file, mu outside the box, truncation
+              out of range: clear errors naming the file, dataset, option or value.
+  infeasible  a dual basis too rich for the primal one (no supremizers) is refused with a hint.
+  half_disks  two parameters (radius, imposed displacement): the whole pipeline runs, the ROM converges
+              and its errors are reported.
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import h5py
+import numpy as np
+
+FAILED = []
+os.environ["HDF5_USE_FILE_LOCKING"] = "FALSE"
+
+
+def check(cond, msg):
+    print(("  ok    " if cond else "  FAIL  ") + msg)
+    if not cond:
+        FAILED.append(msg)
+
+
+def run(args, np_, stage, extra, expect_ok=True):
+    c = ["mpirun", "-n", str(np_), args.exe, stage] + extra
+    p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if expect_ok and p.returncode != 0:
+        print(p.stdout[-4000:])
+        sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
+    return p
+
+
+def report(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def datasets(path):
+    out = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj.shape) if isinstance(obj, h5py.Dataset) else None)
+    return out
+
+
+def offline(args, d, opts="runs/ring_on_block.opts", np_=2, extra=()):
+    rom = d + "/rom.h5"
+    run(args, np_, "offline", ["-options_file", opts, "-rom", rom, "-report", d + "/off.json"] + list(extra))
+    return rom, report(d + "/off.json")
+
+
+def pipeline(args):
+    d = tempfile.mkdtemp(prefix="rbc_rom_")
+    rom, off = offline(args, d)
+    ro = off["rom"]
+    ndofs = off["ndofs"]
+    print("  ROM: N %d (POD %d + %d supremizers), R %d, Mk %d, Mg %d; ndofs %d, R_fom %d" % (ro["N"], ro["Npod"], ro["supremizers"], ro["R"], ro["Mk"], ro["Mg"], ndofs, off["ncontact"]))
+    check(ro["N"] <= 30 and ro["R"] <= 30, "N = %d and R = %d <= 30" % (ro["N"], ro["R"]))
+    ds = datasets(rom)
+    big = max(int(np.prod(s)) for s in ds.values())
+    longest = max(max(s) if s else 0 for s in ds.values())
+    check(big == off["rom_largest_array"]["entries"], "largest ROM array %s: %d entries (reported %d)" % (off["rom_largest_array"]["name"], big, off["rom_largest_array"]["entries"]))
+    # the same scene on a refined mesh: the ROM file must not grow with the mesh
+    d1 = d + "/refine1"
+    os.makedirs(d1)
+    rom1, off1 = offline(args, d1, extra=["-mesh_refine", "1"])
+    ds1 = datasets(rom1)
+    big1 = max(int(np.prod(s)) for s in ds1.values())
+    longest1 = max(max(s) if s else 0 for s in ds1.values())
+    # the sizes are those of the reduced model (N, R, M), not of the mesh: the largest array is C (Mk x N x R)
+    # or B (M x M); R itself grows somewhat with the mesh at a fixed dual tolerance (more nodes enter the
+    # contact zone one by one over the parameter range)
+    def expected(o):
+        r = o["rom"]
+        return max(r["Mk"] * r["N"] * r["R"], r["Mk"] ** 2, r["Mg"] ** 2, r["Mg"] * r["R"])
+    check(big == expected(off) and big1 == expected(off1), "largest ROM array = max(Mk N R, Mk^2, Mg^2): %d and %d (refined)" % (big, big1))
+    check(off1["ndofs"] > 3 * ndofs and big1 / big < 0.5 * off1["ndofs"] / ndofs and longest1 / longest < 0.5 * off1["ndofs"] / ndofs,
+          "mesh refined (ndofs x%.2f): largest ROM array x%.2f (R %d -> %d), longest dimension %d -> %d" % (off1["ndofs"] / ndofs, big1 / big, off["rom"]["R"], off1["rom"]["R"], longest, longest1))
+    check(off["eim"]["kappa"]["kind"] == "eim" and off["eim"]["kappa"]["depends_on_u"], "kappa depends on u (measured %.2e): EIM" % off["eim"]["kappa"]["u_sensitivity"])
+    check(off["eim"]["patch"]["check_max_diff"] <= 1e-12, "local contact data = full contact map at the EIM points (%.1e)" % off["eim"]["patch"]["check_max_diff"])
+
+    # online: 1 vs 2 ranks on the same file, TAO cross-check
+    on = {}
+    for np_ in (1, 2):
+        run(args, np_, "online", ["-rom", rom, "-mu", "1.02", "-report", "%s/on%d.json" % (d, np_)])
+        on[np_] = report("%s/on%d.json" % (d, np_))
+    v1, v2 = np.array(on[1]["u_hat"]), np.array(on[2]["u_hat"])
+    check(on[1]["converged"] and np.abs(v1 - v2).max() <= 1e-14 * np.abs(v1).max(), "online mu = 1.02: same reduced solution on 1 and 2 ranks (diff %.1e)" % np.abs(v1 - v2).max())
+    kkt = max(on[1]["kkt"].values())
+    check(kkt <= 1e-8, "online KKT residual %.1e <= 1e-8" % kkt)
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-rom_qp_type", "tao", "-report", d + "/on_tao.json"])
+    vt = np.array(report(d + "/on_tao.json")["u_hat"])
+    check(np.abs(vt - v1).max() <= 1e-6 * np.abs(v1).max(), "TAO BQPIP QP = active-set QP (rel diff %.1e)" % (np.abs(vt - v1).max() / np.abs(v1).max()))
+
+    # validate on 1 and 2 ranks
+    val = {}
+    for np_ in (1, 2):
+        extra = ["-validate_sweep", "-validate_sweep_fractions", "0.5,1"] if np_ == 1 else []
+        run(args, np_, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "10", "-report", "%s/val%d.json" % (d, np_)] + extra)
+        val[np_] = report("%s/val%d.json" % (d, np_))
+    t = val[1]["test"]
+    print("  test (20 random radii): max rel err u %.2e lambda %.2e force %.2e; no EIM: u %.2e lambda %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], val[1]["test_no_eim"]["max_rel_err_u"], val[1]["test_no_eim"]["max_rel_err_lambda"]))
+    check(t["n"] == 20 and t["max_rel_err_u"] <= 1e-3, "max rel err u %.2e <= 1e-3" % t["max_rel_err_u"])
+    check(t["max_rel_err_lambda"] <= 1e-2, "max rel err lambda %.2e <= 1e-2" % t["max_rel_err_lambda"])
+    for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force"):
+        a, b = val[1]["test"][k], val[2]["test"][k]
+        check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
+    check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
+    check(val[1]["speedup_median"] > 10, "speedup %.0f (online median %.2e s, FOM %.2e s)" % (val[1]["speedup_median"], val[1]["online_time_s"]["median"], val[1]["fom_time_s"]["median"]))
+    with open(d + "/val1_sweep.json") as f:
+        sw = json.load(f)
+    rows = sw["rows"]
+    check(len(rows) == 2 and os.path.exists(d + "/val1_sweep.csv"), "sweep table: 2 rows, CSV and JSON")
+    check(abs(rows[-1]["max_rel_err_u"] - t["max_rel_err_u"]) <= 1e-12 * t["max_rel_err_u"], "sweep's full row = the main test (u %.3e)" % rows[-1]["max_rel_err_u"])
+
+    # reconstructed fields against the FOM at the same radius
+    run(args, 2, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-rom_reconstruct", d + "/rec.h5", "-report", d + "/rec.json"])
+    run(args, 2, "fom", ["-options_file", "runs/ring_on_block.opts", "-mu", "1.02", "-fom_output", d + "/fom.h5", "-report", d + "/fom.json"])
+    rr, rf = report(d + "/rec.json"), report(d + "/fom.json")
+    with h5py.File(d + "/rec.h5", "r") as f, h5py.File(d + "/fom.h5", "r") as g:
+        lr, lf = np.array(f["contact/lambda"]), np.array(g["contact/lambda"])
+        xr, xf = np.array(f["geometry/vertices"]), np.array(g["geometry/vertices"])
+    check(lr.shape == lf.shape and lr.min() >= 0, "reconstructed pressure: %d slave nodes, nonnegative" % lr.size)
+    check(abs(rr["energy"] - rf["energy"]) <= 1e-3 * rf["energy"], "reconstructed energy %.8e vs FOM %.8e" % (rr["energy"], rf["energy"]))
+    check(abs(rr["contact_force"] - rf["contact_force"]) <= 1e-2 * rf["contact_force"], "reconstructed contact force %.6e vs FOM %.6e" % (rr["contact_force"], rf["contact_force"]))
+    check(xr.shape == xf.shape and np.abs(xr - xf).max() <= 1e-12, "reconstructed fields on the FOM's (physical, radius 1.02) configuration")
+    shutil.rmtree(d, ignore_errors=True)
+
+
+def expect_error(args, extra, words, what, stage="online", np_=1):
+    p = run(args, np_, stage, extra, expect_ok=False)
+    ok = p.returncode != 0 and all(w in p.stdout for w in words) and "nan" not in p.stdout.lower().replace("nan.", "")
+    check(ok, "%s: error naming %s" % (what, ", ".join(words)))
+    if not ok:
+        print(p.stdout[-1500:])
+
+
+def bad_input(args):
+    d = tempfile.mkdtemp(prefix="rbc_rom_bad_")
+    rom, _ = offline(args, d, np_=1, extra=["-train_size", "7", "-eim_max", "10"])
+    expect_error(args, ["-mu", "1.02"], ["-rom"], "missing -rom")
+    expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5", "does not exist"], "missing ROM file")
+    expect_error(args, ["-rom", rom, "-mu", "1.3"], ["radius", "1.3", "outside its box"], "mu outside the box")
+    expect_error(args, ["-rom", rom, "-rom_N", "99"], ["-rom_N", "99"], "truncation out of range")
+    # a truncated (corrupt) copy
+    with open(rom, "rb") as f:
+        data = f.read()
+    with open(d + "/cut.h5", "wb") as f:
+        f.write(data[: len(data) // 2])
+    expect_error(args, ["-rom", d + "/cut.h5"], ["cut.h5"], "corrupt ROM file")
+    # a dataset removed
+    shutil.copy(rom, d + "/tamper.h5")
+    with h5py.File(d + "/tamper.h5", "a") as f:
+        del f["online/kappa/B"]
+    expect_error(args, ["-rom", d + "/tamper.h5"], ["tamper.h5", "/online/kappa/B"], "ROM file without /online/kappa/B")
+    # a bases-only file (format_version 1)
+    run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "7", "-offline_stop", "bases", "-snapshots", d + "/rom.snapshots.h5", "-rom", d + "/bases.h5"])
+    expect_error(args, ["-rom", d + "/bases.h5"], ["format_version 1", "without -offline_stop"], "bases-only file")
+    # validate with the wrong scene
+    expect_error(args, ["-options_file", "runs/half_disks.opts", "-rom", rom, "-test_size", "2"], ["ring_on_block", "half_disks"], "validate with another scene", stage="validate")
+    shutil.rmtree(d, ignore_errors=True)
+
+
+def infeasible(args):
+    d = tempfile.mkdtemp(prefix="rbc_rom_inf_")
+    p = run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "7", "-pod_supremizers", "0", "-rom", d + "/rom.h5"], expect_ok=False)
+    check(p.returncode != 0 and "inf-sup" in p.stdout and "-pod_supremizers" in p.stdout, "R > N without supremizers: refused with the hint -pod_supremizers")
+    if p.returncode == 0:
+        print(p.stdout[-1500:])
+    shutil.rmtree(d, ignore_errors=True)
+
+
+def half_disks(args):
+    d = tempfile.mkdtemp(prefix="rbc_rom_hd_")
+    extra = ["-train_type", "grid", "-train_size", "4", "-pod_tol", "1e-8", "-pod_supremizers", "-dual_type", "mcpg", "-dual_tol", "1e-3", "-dual_tol_relative", "-eim_kappa_tol", "1e-4", "-eim_gap_tol", "1e-5", "-eim_max", "40"]
+    rom, off = offline(args, d, opts="runs/half_disks.opts", extra=extra)
+    ro = off["rom"]
+    print("  half_disks ROM: N %d R %d Mk %d Mg %d (16 training points)" % (ro["N"], ro["R"], ro["Mk"], ro["Mg"]))
+    run(args, 2, "validate", ["-options_file", "runs/half_disks.opts", "-rom", rom, "-test_type", "random", "-test_size", "5", "-test_seed", "3", "-validate_repeat", "5", "-report", d + "/val.json"])
+    v = report(d + "/val.json")
+    t = v["test"]
+    print("  test (5 random points): max rel err u %.2e lambda %.2e force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
+    check(t["n"] == 5 and t["failed"] == 0, "the ROM converges on 5 random (radius, displacement)")
+    check(t["max_rel_err_u"] < 1e-2, "2 parameters, 16 training points: u error %.2e < 1e-2" % t["max_rel_err_u"])
+    shutil.rmtree(d, ignore_errors=True)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks"])
+    ap.add_argument("--exe", required=True)
+    args = ap.parse_args()
+    globals()[args.check](args)
+    if FAILED:
+        print("%d check(s) failed" % len(FAILED))
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,5 @@
+# tests/rom_unit.cmake -- unit checks of the reduced model's building blocks against the full-order code:
+#   test_reduced_contact   ContactPatch (full patch = FOM contact map with the composite rule, Restrict,
+#                          serialization) and ReducedParametrization (thetas, ROM-file roundtrip, CheckBox)
+rbc_test_exe(test_reduced_contact)
+rbc_add_mpi_test(NAME reduced_contact RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FILE:test_reduced_contact> -options_file runs/ring_on_block.opts LABELS rom)
