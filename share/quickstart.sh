@@ -2,7 +2,8 @@
 # share/quickstart.sh: from a fresh Debian bookworm machine to a solved scene and its picture.
 #   1. share/setup.sh             installs the missing Debian packages (idempotent)
 #   2. cmake configure + build    into build/ (Release)
-#   3. the main job               (the MAIN JOB block below) under mpirun -n $NP
+#   3. the main job               (the MAIN JOB block below) under mpirun -n $NP: FOM, offline
+#                                 (ROM file), online (+ fields), validate (+ speed-error sweep)
 #   4. prints where the reports, fields and pictures are
 # Runs from any working directory (it changes to the repository root).
 # Environment: RBC_BUILD_DIR (default build), RBC_NP (default 2).
@@ -65,20 +66,43 @@ plot_pressure() {
 }
 
 # ============================== MAIN JOB ==============================
-# Extend here: the offline/online pipeline (offline snapshots, bases, EIM, online, validate) goes
-# below the fom stage, each writing its report into $OUT.
+# The default scene end to end: the FOM at the default radius, the offline stage (snapshots over the
+# seed's 21 radii, POD + supremizers, dual basis, EIM -> the ROM file), one online solve with the
+# full fields reconstructed (the deformed-configuration picture), and the validation against the FOM
+# on 20 random radii with the speed-against-error sweep (the speed-error picture). Every setting is in
+# runs/$SCENE.opts; each stage writes its report into $OUT.
 SCENE=ring_on_block
 OUT="results/$SCENE"
-# The FOM runs with contact (the scene's -contact_slave/-contact_master pair). Add options here,
-# e.g. CONTACT_OPTS=(-kacanov_monitor); CONTACT_OPTS=(-contact 0) solves the elastic problem only
-# (then there is no contact pressure to plot: drop the plot_pressure line).
+MU_ONLINE=1.02
+# Extra options for the FOM run, e.g. CONTACT_OPTS=(-kacanov_monitor).
 CONTACT_OPTS=()
+
+speed_error() {
+  echo "+ $PYTHON share/plot_speed_error.py $1 -o $2 --targets 1e-3,1e-2"
+  "$PYTHON" share/plot_speed_error.py "$1" -o "$2" --targets 1e-3,1e-2 || die "plotting $1 failed"
+  PICTURES+=("$2")
+}
 
 main_job() {
   step "main job: scene $SCENE on $NP ranks -> $OUT/"
   rbc fom "$OUT/fom.json" -options_file "runs/$SCENE.opts" ${CONTACT_OPTS[@]+"${CONTACT_OPTS[@]}"} -fom_output "$OUT/fom.h5"
   plot "$OUT/fom.h5" "$OUT/fom.png" "$SCENE"
   plot_pressure "$OUT/fom.h5" "$OUT/pressure.png" "$SCENE"
+  # offline: resumes the snapshot file of an earlier (killed) run of the same problem
+  rbc offline "$OUT/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -snapshots_monitor
+  rbc online "$OUT/online.json" -rom "$OUT/rom.h5" -mu "$MU_ONLINE" -online_repeat 1000 -options_file "runs/$SCENE.opts" -rom_reconstruct "$OUT/online_fields.h5"
+  plot "$OUT/online_fields.h5" "$OUT/deformed_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"
+  plot_pressure "$OUT/online_fields.h5" "$OUT/pressure_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"
+  rbc validate "$OUT/validate.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -validate_sweep -validate_sweep_output "$OUT/sweep"
+  speed_error "$OUT/sweep.json" "$OUT/speed_error.png"
+  "$PYTHON" - "$OUT/validate.json" <<'PY' || die "reading the validation report failed"
+import json, sys
+r = json.load(open(sys.argv[1]))
+t, ro = r["test"], r["rom"]
+print("validation (%d random radii): ROM N %d R %d Mk %d Mg %d" % (t["n"], ro["N"], ro["R"], ro["Mk"], ro["Mg"]))
+print("  max rel err u %.2e (target 1e-3), lambda %.2e (target 1e-2), force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
+print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
+PY
 }
 # ============================ END MAIN JOB ============================
 
@@ -86,6 +110,8 @@ main_job
 
 step "done: outputs"
 for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
-echo "fields:  $ROOT/$OUT/fom.h5"
-echo "fields:  $ROOT/$OUT/fom.xmf (open it in ParaView)"
+echo "fields:  $ROOT/$OUT/fom.h5, $ROOT/$OUT/online_fields.h5 (ROM)"
+echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf (open them in ParaView)"
+echo "ROM:     $ROOT/$OUT/rom.h5 (online data), rom.basis.h5, rom.snapshots.h5"
+echo "sweep:   $ROOT/$OUT/sweep.csv"
 for p in "${PICTURES[@]}"; do echo "picture: $ROOT/$p"; done

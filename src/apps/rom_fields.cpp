@@ -71,7 +71,10 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   PetscCall(fom.SetMu(mu));
   PetscCall(order.BuildDofs(fom.elas));
   PetscCall(bases.Read(comm, model, model.file, order.NumDofs()));
-  if (!fom.u) PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
+  if (!fom.u) {
+    PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
+    PetscCall(PetscObjectSetName((PetscObject)fom.u, "displacement"));
+  }
   PetscCall(bases.Displacement(model, order, sol.v, fom.u));
   // the contact system at the reconstructed displacement: multiplier layout, weights, normals
   PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
