@@ -159,7 +159,7 @@ static PetscErrorCode Run()
 
   CanonicalOrder order;
   PetscCall(order.BuildDofs(fom.elas));
-  PetscCall(order.BuildMultipliers(kac.sys.coord, dim));
+  PetscCall(order.BuildMultipliers(kac.sys.coordRef, dim));
   const PetscInt ndofs = order.NumDofs(), R = order.NumMultipliers();
   std::vector<PetscReal> ucan;
   PetscCall(order.DofsToCanonical(fom.u, &ucan));

@@ -82,7 +82,8 @@ struct ContactSystem {
   Vec       g = nullptr;       // R, gap (Dirichlet lifting included)
   Vec       weight = nullptr;  // R, int psi_i over the slave surface (lambda_i is the nodal pressure; force = lambda_i weight_i)
   Vec       normal[3] = {nullptr, nullptr, nullptr}; // R, mean master normal of row i (int psi_i n2 / weight_i)
-  Vec       coord[3]  = {nullptr, nullptr, nullptr}; // R, reference coordinates of slave vertex i
+  Vec       coord[3]  = {nullptr, nullptr, nullptr}; // R, coordinates of slave vertex i in the current geometry (physical at mu)
+  Vec       coordRef[3] = {nullptr, nullptr, nullptr}; // R, its reference (mesh file) coordinates: the canonical multiplier order
   PetscInt  R = 0;
   ~ContactSystem();
   PetscErrorCode Destroy();

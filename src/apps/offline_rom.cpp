@@ -117,7 +117,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
     PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
     // a resumed run that solved nothing has not numbered the multipliers yet
-    if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(const_cast<CanonicalOrder &>(order).BuildMultipliers(sys.coord, fom.elas.dim));
+    if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(const_cast<CanonicalOrder &>(order).BuildMultipliers(sys.coordRef, fom.elas.dim));
   }
   std::vector<char> support(Rfom, 0);
   for (PetscInt i = 0; i < Rfom; ++i)

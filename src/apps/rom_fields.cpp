@@ -86,7 +86,7 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
     PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
     PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
   }
-  PetscCall(order.BuildMultipliers(sys.coord, fom.elas.dim));
+  PetscCall(order.BuildMultipliers(sys.coordRef, fom.elas.dim));
   std::vector<PetscReal> lam;
   bases.Multipliers(model, sol.lambda, &lam);
   Vec lambda;

@@ -216,7 +216,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
           cmap.SetGeometry(&fom.map, mu);
           PetscCall(kac.Solve(fom, cmap));
           if (!multOrderBuilt) {
-            PetscCall(order.BuildMultipliers(kac.sys.coord, fom.elas.dim));
+            PetscCall(order.BuildMultipliers(kac.sys.coordRef, fom.elas.dim));
             multOrderBuilt = true;
           }
           PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));

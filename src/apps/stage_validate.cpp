@@ -177,7 +177,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
     PetscCall(cmap.Assemble(fom.elas, uloc, &sys0));
     PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-    PetscCall(order.BuildMultipliers(sys0.coord, dim));
+    PetscCall(order.BuildMultipliers(sys0.coordRef, dim));
     std::vector<char> support(bases.R, 0);
     for (PetscInt k = 0; k < bases.r; ++k)
       for (PetscInt i = 0; i < bases.R; ++i)

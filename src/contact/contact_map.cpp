@@ -25,6 +25,7 @@ PetscErrorCode ContactSystem::Destroy()
   for (int d = 0; d < 3; ++d) {
     PetscCall(VecDestroy(&normal[d]));
     PetscCall(VecDestroy(&coord[d]));
+    PetscCall(VecDestroy(&coordRef[d]));
   }
   PetscFunctionReturn(0);
 }
@@ -240,6 +241,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   for (PetscInt d = 0; d < dim; ++d) {
     PetscCall(VecDuplicate(sys->g, &sys->normal[d]));
     PetscCall(VecDuplicate(sys->g, &sys->coord[d]));
+    PetscCall(VecDuplicate(sys->g, &sys->coordRef[d]));
   }
   PetscCall(VecSet(sys->g, 0.0));
   PetscCall(VecSet(sys->weight, 0.0));
@@ -333,11 +335,14 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       }
     }
     for (PetscInt k = 0; k < nv; ++k)
-      for (PetscInt d = 0; d < dim; ++d) PetscCall(VecSetValue(sys->coord[d], rows[k], F.X[k * dim + d], INSERT_VALUES));
+      for (PetscInt d = 0; d < dim; ++d) {
+        PetscCall(VecSetValue(sys->coord[d], rows[k], F.X[k * dim + d], INSERT_VALUES));
+        PetscCall(VecSetValue(sys->coordRef[d], rows[k], F.Xref[k * dim + d], INSERT_VALUES));
+      }
   }
   PetscCall(MatAssemblyBegin(sys->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(sys->K, MAT_FINAL_ASSEMBLY));
-  Vec all[8] = {sys->g, sys->weight, sys->normal[0], sys->normal[1], sys->normal[2], sys->coord[0], sys->coord[1], sys->coord[2]};
+  Vec all[11] = {sys->g, sys->weight, sys->normal[0], sys->normal[1], sys->normal[2], sys->coord[0], sys->coord[1], sys->coord[2], sys->coordRef[0], sys->coordRef[1], sys->coordRef[2]};
   for (Vec v : all)
     if (v) {
       PetscCall(VecAssemblyBegin(v));
