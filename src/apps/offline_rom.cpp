@@ -6,6 +6,7 @@
 // restricted to the facets around the EIM points; warm starts. Every rank of the group computes the
 // same (deterministic) data; world rank 0 writes it.
 #include "offline_rom.hpp"
+#include "rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include <slepcbv.h>
@@ -40,7 +41,6 @@ static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscR
 
 PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, const CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
 {
-  MPI_Comm       comm = PetscObjectComm((PetscObject)fom.dm);
   PetscLogDouble t0, t1, t2;
   PetscMPIInt    wrank;
   ReducedModel   rm;
@@ -103,28 +103,12 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscInt nsub = 4;
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &nsub, NULL));
   PetscCheck(nsub >= 1 && nsub <= 64, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
-  {
-    ContactSystem sys;
-    Vec           uloc;
-    PetscCall(fom.SetMu(ParamValues(fom.scene)));
-    cmap.SetGeometry(&fom.map, fom.mu);
-    Vec zero;
-    PetscCall(DMGetGlobalVector(fom.dm, &zero));
-    PetscCall(VecSet(zero, 0.0));
-    PetscCall(DMGetLocalVector(fom.dm, &uloc));
-    PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
-    PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
-    PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
-    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-    // a resumed run that solved nothing has not numbered the multipliers yet
-    if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(const_cast<CanonicalOrder &>(order).BuildMultipliers(sys.coordRef, fom.elas.dim));
-  }
-  std::vector<char> support(Rfom, 0);
-  for (PetscInt i = 0; i < Rfom; ++i)
-    for (PetscInt k = 0; k < R; ++k)
-      if (dual.W(i, k) > 0) support[i] = 1;
-  auto full = std::make_shared<ContactPatch>();
-  PetscCall(full->BuildFull(comm, cmap, order, modes, N, support, nsub));
+  std::vector<double> Wt((size_t)R * Rfom);
+  for (PetscInt k = 0; k < R; ++k)
+    for (PetscInt i = 0; i < Rfom; ++i) Wt[(size_t)k * Rfom + i] = dual.W(i, k);
+  std::shared_ptr<ContactPatch> full;
+  std::vector<PetscReal>        P;
+  PetscCall(BuildFullContact(fom, cmap, const_cast<CanonicalOrder &>(order), modes, N, Wt, R, nsub, &full, &P));
   {
     bool bcParam = false, uDnonzero = false;
     for (const auto &d : fom.scene.dirichlet) bcParam = bcParam || d.param >= 0;
@@ -132,15 +116,6 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     PetscCheck(!(bcParam && uDnonzero), world, PETSC_ERR_SUP, "offline: a parametrized Dirichlet condition (-param_bc_*) acts on the contact surfaces; the reduced contact map does not support it yet");
   }
   const PetscInt Q = full->NumPoints();
-  // P = W' Psi (R x Q, row-major)
-  std::vector<PetscReal> P((size_t)R * Q, 0.0);
-  for (PetscInt p = 0; p < Q; ++p)
-    for (PetscInt k = 0; k < rm.dim; ++k) {
-      const PetscInt row = full->points[p].row[k];
-      const PetscReal b  = full->points[p].b[k];
-      if (row < 0 || b == 0) continue;
-      for (PetscInt r = 0; r < R; ++r) P[(size_t)r * Q + p] += b * dual.W(row, r);
-    }
   rm.dualGram.assign((size_t)R * R, 0.0);
   for (PetscInt a = 0; a < R; ++a)
     for (PetscInt b = 0; b < R; ++b)

@@ -52,6 +52,54 @@ void RomBases::Multipliers(const ReducedModel &model, const std::vector<PetscRea
     for (PetscInt i = 0; i < R; ++i) (*lambda)[i] += lhat[k] * W[(size_t)k * R + i];
 }
 
+PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P)
+{
+  ContactSystem sys;
+  Vec           zero, uloc;
+
+  PetscFunctionBeginUser;
+  PetscCall(fom.SetMu(ParamValues(fom.scene)));
+  cmap.SetGeometry(&fom.map, fom.mu);
+  PetscCall(DMGetGlobalVector(fom.dm, &zero));
+  PetscCall(VecSet(zero, 0.0));
+  PetscCall(DMGetLocalVector(fom.dm, &uloc));
+  PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
+  PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
+  PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
+  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys.coordRef, fom.elas.dim));
+  const PetscInt    Rfom = cmap.NumMultipliers();
+  std::vector<char> support(Rfom, 0);
+  for (PetscInt k = 0; k < r; ++k)
+    for (PetscInt i = 0; i < Rfom; ++i)
+      if (Wt[(size_t)k * Rfom + i] > 0) support[i] = 1;
+  *full = std::make_shared<ContactPatch>();
+  PetscCall((*full)->BuildFull(PetscObjectComm((PetscObject)fom.dm), cmap, order, modes, N, support, nsub));
+  const PetscInt Q = (*full)->NumPoints();
+  P->assign((size_t)r * Q, 0.0);
+  for (PetscInt p = 0; p < Q; ++p)
+    for (PetscInt k = 0; k < fom.elas.dim; ++k) {
+      const PetscInt  row = (*full)->points[p].row[k];
+      const PetscReal b   = (*full)->points[p].b[k];
+      if (row < 0 || b == 0) continue;
+      for (PetscInt q = 0; q < r; ++q) (*P)[(size_t)q * Q + p] += b * Wt[(size_t)q * Rfom + row];
+    }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::vector<PetscReal> &lambda, Vec v)
+{
+  PetscInt     lo, hi;
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetOwnershipRange(v, &lo, &hi));
+  PetscCall(VecGetArray(v, &a));
+  for (PetscInt i = lo; i < hi; ++i) a[i - lo] = lambda[order.CanonicalMultiplier(i)];
+  PetscCall(VecRestoreArray(v, &a));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep)
 {
   SceneSpec      scene;
@@ -91,14 +139,7 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   bases.Multipliers(model, sol.lambda, &lam);
   Vec lambda;
   PetscCall(VecDuplicate(sys.g, &lambda));
-  {
-    PetscInt     lo, hi;
-    PetscScalar *a;
-    PetscCall(VecGetOwnershipRange(lambda, &lo, &hi));
-    PetscCall(VecGetArray(lambda, &a));
-    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = lam[order.CanonicalMultiplier(i)];
-    PetscCall(VecRestoreArray(lambda, &a));
-  }
+  PetscCall(CanonicalToMultipliers(order, lam, lambda));
   ContactSummary cs;
   PetscCall(SummarizeContact(sys, lambda, fom.elas.dim, &cs));
   rep->root["contact_force"] = (double)cs.force;

@@ -2,7 +2,9 @@
 // dual bases read from the ROM's basis file, the displacement u = sum_n v_n theta_n and the
 // multipliers lambda = sum_r lambda_r xi_r (canonical order), and -rom_reconstruct's output file.
 #pragma once
+#include <memory>
 #include "rbcontact/canonical_order.hpp"
+#include "rbcontact/contact.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
@@ -22,6 +24,14 @@ public:
   PetscInt               N = 0, ndofs = 0, r = 0, R = 0;
   std::vector<double>    modes, W; // N x ndofs, r x R (row-major, canonical)
 };
+
+// The full contact patch (ContactPatch::BuildFull) on the support of the dual basis Wt (r x R_fom,
+// row-major, canonical) with the primal basis modes (N x ndofs, canonical), nsub composite pieces, and
+// P = W' Psi (r x Q, row-major). The surfaces are assembled at the default parameter with u = 0 (they
+// then carry the Dirichlet values); numbers order's multipliers if not done yet. Collective on fom.
+PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P);
+// lambda (canonical multiplier order) into the distributed multiplier vector v (rows of K).
+PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::vector<PetscReal> &lambda, Vec v);
 
 // -rom_reconstruct: the scene from the options (must match the ROM's), fields at mu written to path.
 PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep);

@@ -76,14 +76,7 @@ static PetscErrorCode Compare(const ReducedModel &model, const RomBases &bases, 
   *eu = std::sqrt(std::max<PetscReal>(PetscRealPart(e2), 0)) / F.energyNorm;
   std::vector<PetscReal> lam;
   bases.Multipliers(model, sol.lambda, &lam);
-  {
-    PetscInt     lo, hi;
-    PetscScalar *a;
-    PetscCall(VecGetOwnershipRange(lwork, &lo, &hi));
-    PetscCall(VecGetArray(lwork, &a));
-    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = lam[order.CanonicalMultiplier(i)];
-    PetscCall(VecRestoreArray(lwork, &a));
-  }
+  PetscCall(CanonicalToMultipliers(order, lam, lwork));
   ContactSummary cs;
   PetscCall(SummarizeContact(sys, lwork, dim, &cs));
   PetscReal df = 0, nf = 0;
@@ -165,34 +158,9 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     std::vector<unsigned long long> dims;
     std::vector<double>             q;
     PetscCall(RomReadDataset(romPath, "/online/eim_quadrature", &dims, &q));
-    ContactSystem sys0;
-    Vec           uloc;
-    PetscCall(fom.SetMu(ParamValues(fom.scene)));
-    cmap.SetGeometry(&fom.map, fom.mu);
-    Vec zero;
-    PetscCall(DMGetGlobalVector(fom.dm, &zero));
-    PetscCall(VecSet(zero, 0.0));
-    PetscCall(DMGetLocalVector(fom.dm, &uloc));
-    PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
-    PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
-    PetscCall(cmap.Assemble(fom.elas, uloc, &sys0));
-    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-    PetscCall(order.BuildMultipliers(sys0.coordRef, dim));
-    std::vector<char> support(bases.R, 0);
-    for (PetscInt k = 0; k < bases.r; ++k)
-      for (PetscInt i = 0; i < bases.R; ++i)
-        if (bases.W[(size_t)k * bases.R + i] > 0) support[i] = 1;
-    auto full = std::make_shared<ContactPatch>();
-    PetscCall(full->BuildFull(comm, cmap, order, bases.modes, bases.N, support, (PetscInt)q[0]));
-    const PetscInt         Q = full->NumPoints();
-    std::vector<PetscReal> P((size_t)bases.r * Q, 0.0);
-    for (PetscInt p = 0; p < Q; ++p)
-      for (PetscInt k = 0; k < dim; ++k) {
-        const PetscInt  row = full->points[p].row[k];
-        const PetscReal b   = full->points[p].b[k];
-        if (row < 0 || b == 0) continue;
-        for (PetscInt r = 0; r < bases.r; ++r) P[(size_t)r * Q + p] += b * bases.W[(size_t)r * bases.R + row];
-      }
+    std::shared_ptr<ContactPatch> full;
+    std::vector<PetscReal>        P;
+    PetscCall(BuildFullContact(fom, cmap, order, bases.modes, bases.N, bases.W, bases.r, (PetscInt)q[0], &full, &P));
     PetscCall(exact.Open(romPath));
     PetscCall(exact.SetFromOptions());
     exact.SetExactContact(full, P);
@@ -205,7 +173,6 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   std::vector<FomSolution> F(nt);
   std::vector<double>      fomTimes;
   std::vector<Mat>         Amu(nt, nullptr);
-  ContactSystem            sysLast;
   std::vector<std::shared_ptr<ContactSystem>> sysAt(nt);
   for (PetscInt j = 0; j < nt; ++j) {
     F[j].mu = test.points[j];
