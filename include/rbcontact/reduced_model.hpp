@@ -112,7 +112,7 @@ public:
   ReducedQP qp;
 
 private:
-  PetscErrorCode Evaluate(const std::vector<PetscReal> &mu, const PetscReal *v);
+  PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
   ContactMode            mode_ = ContactMode::EIM;
   std::vector<PetscInt>  cols_;
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;

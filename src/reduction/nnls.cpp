@@ -3,6 +3,7 @@
 // ../shared/notes/nnls-with-bqpip.md, then a Lawson-Hanson polish on Q, KKT check, retries), the
 // QR-based Lawson-Hanson active-set method NNLSLawsonHanson, the KKT measure NNLSKKT, the nnls_
 // options and the RBCNNLS log event.
+#include "rbcontact/tao_recipe.hpp"
 #include "rbcontact/dual_basis.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -280,18 +281,7 @@ PetscErrorCode NNLSSolver::SetupTao(PetscInt n)
   PetscCall(TaoSetVariableBounds(tao_, lo_, hi_));
   // The notes' recipe: absolute test only (the relative one fires spuriously), gatol 1e-7 (BQPIP's
   // measure stalls near 3e-8), at most 200 iterations, inner Cholesky.
-  PetscCall(TaoSetTolerances(tao_, 1e-7, 0.0, 0.0));
-  PetscCall(TaoSetMaximumIterations(tao_, 200));
-  {
-    KSP ksp;
-    PC  pc;
-    PetscCall(TaoGetKSP(tao_, &ksp));
-    if (ksp) {
-      PetscCall(KSPSetType(ksp, KSPPREONLY));
-      PetscCall(KSPGetPC(ksp, &pc));
-      PetscCall(PCSetType(pc, PCCHOLESKY));
-    }
-  }
+  PetscCall(TaoBQPIPRecipe(tao_));
   PetscCall(TaoSetFromOptions(tao_));
   PetscFunctionReturn(0);
 }

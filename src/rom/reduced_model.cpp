@@ -8,6 +8,19 @@
 
 namespace rbc {
 
+static PetscLogEvent ROM_Solve = 0, ROM_Contact = 0, ROM_QP = 0;
+
+static PetscErrorCode RegisterEvents()
+{
+  PetscFunctionBeginUser;
+  if (!ROM_Solve) {
+    PetscCall(PetscLogEventRegister("RBCOnlineSolve", DM_CLASSID, &ROM_Solve));
+    PetscCall(PetscLogEventRegister("RBCOnlineContact", DM_CLASSID, &ROM_Contact));
+    PetscCall(PetscLogEventRegister("RBCOnlineQP", DM_CLASSID, &ROM_QP));
+  }
+  PetscFunctionReturn(0);
+}
+
 namespace {
 std::vector<double> CoefRecords(const std::vector<Coefficient> &c)
 {
@@ -455,10 +468,20 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
 
 PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolution *sol)
 {
+  PetscFunctionBeginUser;
+  PetscCall(par.CheckBox(PETSC_COMM_SELF, mu));
+  PetscCall(RegisterEvents());
+  PetscCall(PetscLogEventBegin(ROM_Solve, 0, 0, 0, 0));
+  PetscCall(SolveLoop(mu, sol));
+  PetscCall(PetscLogEventEnd(ROM_Solve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol)
+{
   const PetscInt Na = (PetscInt)cols_.size(), r = r_;
 
   PetscFunctionBeginUser;
-  PetscCall(par.CheckBox(PETSC_COMM_SELF, mu));
   sol->converged  = false;
   sol->iterations = 0;
   sol->outOfRange = 0;
@@ -497,9 +520,13 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
     vprev = sol->v;
     lprev = sol->lambda;
     if (recordIterates) sol->iterates.insert(sol->iterates.end(), vprev.begin(), vprev.end());
+    PetscCall(PetscLogEventBegin(ROM_Contact, 0, 0, 0, 0));
     sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data());
+    PetscCall(PetscLogEventEnd(ROM_Contact, 0, 0, 0, 0));
     vnew.resize(Na);
+    PetscCall(PetscLogEventBegin(ROM_QP, 0, 0, 0, 0));
     PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
+    PetscCall(PetscLogEventEnd(ROM_QP, 0, 0, 0, 0));
     sol->iterations = it;
     if (sol->qp.status != ReducedQPStatus::Ok) {
       sol->message = std::string("reduced QP failed at Kacanov iteration ") + std::to_string(it) + " (" + ReducedQPStatusName(sol->qp.status) + "): " + sol->qp.message;

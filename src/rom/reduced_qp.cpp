@@ -3,6 +3,7 @@
 // incremental Cholesky factors of S on the free set (dependent constraints handled by null-space ray
 // steps, unboundedness = primal infeasibility), the TAO BQPIP cross-check, v = A^{-1}(f - D'lambda) and
 // the scaled KKT residuals. See docs/reduced_qp.md.
+#include "rbcontact/tao_recipe.hpp"
 #include "rbcontact/reduced_qp.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -537,18 +538,7 @@ PetscErrorCode ReducedQP::SetupTao(PetscInt R)
   // shared/notes/nnls-with-bqpip.md: absolute test only (the relative one fires spuriously), gatol 1e-7
   // (BQPIP's measure stalls near 3e-8), at most 200 iterations, inner Cholesky. Equilibration is done
   // by the caller (unit diagonal S, ||b|| = 1). No finite upper bound is provable here: [0, inf].
-  PetscCall(TaoSetTolerances(tao_, 1e-7, 0.0, 0.0));
-  PetscCall(TaoSetMaximumIterations(tao_, 200));
-  {
-    KSP ksp;
-    PC  pc;
-    PetscCall(TaoGetKSP(tao_, &ksp));
-    if (ksp) {
-      PetscCall(KSPSetType(ksp, KSPPREONLY));
-      PetscCall(KSPGetPC(ksp, &pc));
-      PetscCall(PCSetType(pc, PCCHOLESKY));
-    }
-  }
+  PetscCall(TaoBQPIPRecipe(tao_));
   PetscCall(TaoSetFromOptions(tao_));
   PetscFunctionReturn(0);
 }

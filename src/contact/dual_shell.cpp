@@ -1,0 +1,414 @@
+// src/contact/dual_shell.cpp: the matrix-free dual QP of a Kacanov iterate: S = K A^{-1} K^T as a
+// MATSHELL (one back-solve per product), solved by a primal-dual active-set method with CG on the
+// free set (see rbcontact/dual_shell.hpp).
+#include "rbcontact/dual_shell.hpp"
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+namespace rbc {
+
+static PetscLogEvent DS_Solve = 0, DS_Diag = 0;
+
+struct DualShellCtx {
+  Mat         K   = nullptr;
+  ElasticFOM *fom = nullptr;
+  Vec         w1 = nullptr, w2 = nullptr; // displacement layout
+  Vec         xm = nullptr, mask = nullptr, d = nullptr; // multiplier layout; mask 1 on F, 0 off F
+  PetscInt    products = 0;
+};
+
+// y = K A^{-1} K^T x
+static PetscErrorCode ApplyS(DualShellCtx *c, Vec x, Vec y)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatMultTranspose(c->K, x, c->w1));
+  PetscCall(c->fom->ApplyInverse(c->w1, c->w2));
+  PetscCall(MatMult(c->K, c->w2, y));
+  ++c->products;
+  PetscFunctionReturn(0);
+}
+
+// y = P S P x + (I - P) x, P = diag(mask): S_FF on F, identity off F
+static PetscErrorCode MaskedMult(Mat S, Vec x, Vec y)
+{
+  DualShellCtx      *c;
+  const PetscScalar *m, *xa;
+  PetscScalar       *ya;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(S, &c));
+  PetscCall(VecPointwiseMult(c->xm, c->mask, x));
+  PetscCall(ApplyS(c, c->xm, y));
+  PetscCall(VecGetLocalSize(y, &n));
+  PetscCall(VecGetArrayRead(c->mask, &m));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArray(y, &ya));
+  for (PetscInt i = 0; i < n; ++i) ya[i] = PetscRealPart(m[i]) != 0 ? ya[i] : xa[i];
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecRestoreArrayRead(c->mask, &m));
+  PetscFunctionReturn(0);
+}
+
+// The Jacobi diagonal of the masked operator: d on F (an estimate, -fom_dual_diag), 1 off F
+static PetscErrorCode MaskedDiagonal(Mat S, Vec diag)
+{
+  DualShellCtx      *c;
+  const PetscScalar *m, *d;
+  PetscScalar       *o;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(S, &c));
+  PetscCall(VecGetLocalSize(diag, &n));
+  PetscCall(VecGetArrayRead(c->mask, &m));
+  PetscCall(VecGetArrayRead(c->d, &d));
+  PetscCall(VecGetArray(diag, &o));
+  for (PetscInt i = 0; i < n; ++i) o[i] = PetscRealPart(m[i]) != 0 ? d[i] : 1.0;
+  PetscCall(VecRestoreArray(diag, &o));
+  PetscCall(VecRestoreArrayRead(c->d, &d));
+  PetscCall(VecRestoreArrayRead(c->mask, &m));
+  PetscFunctionReturn(0);
+}
+
+DualShellSolver::~DualShellSolver()
+{
+  (void)KSPDestroy(&ksp_);
+  (void)MatDestroy(&S_);
+  if (ctx_) {
+    (void)VecDestroy(&ctx_->w1);
+    (void)VecDestroy(&ctx_->w2);
+    (void)VecDestroy(&ctx_->xm);
+    (void)VecDestroy(&ctx_->mask);
+    (void)VecDestroy(&ctx_->d);
+    delete ctx_;
+  }
+}
+
+PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string &prefix)
+{
+  char      dtype[16] = "lumped";
+  PetscBool set;
+
+  PetscFunctionBeginUser;
+  if (!DS_Solve) {
+    PetscCall(PetscLogEventRegister("RBCDualPDAS", KSP_CLASSID, &DS_Solve));
+    PetscCall(PetscLogEventRegister("RBCDualDiag", KSP_CLASSID, &DS_Diag));
+  }
+  prefix_ = prefix + "dual_";
+  PetscOptionsBegin(comm, prefix_.c_str(), "Matrix-free dual QP (primal-dual active set + CG)", "DualShellSolver");
+  PetscCall(PetscOptionsInt("-pdas_max_it", "Maximum active-set steps", NULL, maxIt, &maxIt, NULL));
+  PetscCall(PetscOptionsReal("-pdas_tol", "Add a multiplier when its scaled gradient is below -tol |b|", NULL, setTol, &setTol, NULL));
+  PetscCall(PetscOptionsString("-diag", "Jacobi diagonal: lumped (diag(K diag(A)^-1 K^T)) or exact (R products)", NULL, dtype, dtype, sizeof dtype, &set));
+  PetscOptionsEnd();
+  diag = dtype;
+  PetscCheck(diag == "lumped" || diag == "exact", comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sdiag %s: use lumped or exact", prefix_.c_str(), dtype);
+  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it must be >= 1", prefix_.c_str());
+  PetscCall(KSPDestroy(&ksp_));
+  PetscCall(KSPCreate(comm, &ksp_));
+  PetscCall(KSPSetOptionsPrefix(ksp_, prefix_.c_str()));
+  PetscCall(KSPSetType(ksp_, KSPCG));
+  {
+    PC pc;
+    PetscCall(KSPGetPC(ksp_, &pc));
+    PetscCall(PCSetType(pc, PCJACOBI));
+  }
+  // the true (unpreconditioned) residual relative to |b_F|; the floor is set per solve from |b|
+  PetscCall(KSPSetNormType(ksp_, KSP_NORM_UNPRECONDITIONED));
+  PetscCall(KSPSetTolerances(ksp_, 1e-14, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  PetscCall(KSPSetInitialGuessNonzero(ksp_, PETSC_TRUE));
+  PetscCall(KSPSetFromOptions(ksp_));
+  {
+    PetscReal dt;
+    PetscInt  mi;
+    PetscCall(KSPGetTolerances(ksp_, &rtol_, &atol_, &dt, &mi));
+    PetscCall(PetscOptionsHasName(NULL, prefix_.c_str(), "-ksp_atol", &set));
+    if (!set) atol_ = 0;
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode DualShellSolver::Create(ElasticFOM &fom, Mat K)
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)K);
+  PetscInt m, M;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ksp_, comm, PETSC_ERR_ORDER, "DualShellSolver: call SetFromOptions first");
+  ctx_ = new DualShellCtx;
+  PetscCall(MatGetLocalSize(K, &m, NULL));
+  PetscCall(MatGetSize(K, &M, NULL));
+  PetscCall(VecDuplicate(fom.f, &ctx_->w1));
+  PetscCall(VecDuplicate(fom.f, &ctx_->w2));
+  PetscCall(MatCreateVecs(K, NULL, &ctx_->xm));
+  PetscCall(VecDuplicate(ctx_->xm, &ctx_->mask));
+  PetscCall(VecDuplicate(ctx_->xm, &ctx_->d));
+  PetscCall(MatCreateShell(comm, m, m, M, M, ctx_, &S_));
+  PetscCall(MatShellSetOperation(S_, MATOP_MULT, (void (*)(void))MaskedMult));
+  PetscCall(MatShellSetOperation(S_, MATOP_GET_DIAGONAL, (void (*)(void))MaskedDiagonal));
+  PetscCall(MatSetOption(S_, MAT_SPD, PETSC_TRUE));
+  PetscCall(KSPSetOperators(ksp_, S_, S_));
+  PetscFunctionReturn(0);
+}
+
+// ctx_->d: lumped d_i = sum_j K_ij^2 / A_jj (cheap, exact for a diagonal A), or exact d_i = (K A^{-1} K^T)_ii
+PetscErrorCode DualShellSolver::Diagonal(ElasticFOM &fom, Mat K)
+{
+  PetscInt lo, hi;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(DS_Diag, 0, 0, 0, 0));
+  PetscCall(MatGetOwnershipRange(K, &lo, &hi));
+  if (diag == "lumped") {
+    Vec          s;
+    Mat          Ks;
+    PetscScalar *d;
+    PetscCall(VecDuplicate(fom.f, &s));
+    PetscCall(MatGetDiagonal(fom.A, s));
+    PetscCall(VecSqrtAbs(s));
+    PetscCall(VecReciprocal(s));
+    PetscCall(MatDuplicate(K, MAT_COPY_VALUES, &Ks));
+    PetscCall(MatDiagonalScale(Ks, NULL, s)); // K_ij / sqrt(A_jj)
+    PetscCall(VecGetArray(ctx_->d, &d));
+    for (PetscInt r = lo; r < hi; ++r) {
+      PetscInt           nc;
+      const PetscScalar *v;
+      PetscReal          sum = 0;
+      PetscCall(MatGetRow(Ks, r, &nc, NULL, &v));
+      for (PetscInt k = 0; k < nc; ++k) sum += PetscRealPart(v[k] * PetscConj(v[k]));
+      PetscCall(MatRestoreRow(Ks, r, &nc, NULL, &v));
+      d[r - lo] = sum;
+    }
+    PetscCall(VecRestoreArray(ctx_->d, &d));
+    PetscCall(MatDestroy(&Ks));
+    PetscCall(VecDestroy(&s));
+  } else {
+    Vec      e, y;
+    PetscInt R;
+    PetscCall(MatGetSize(K, &R, NULL));
+    PetscCall(VecDuplicate(ctx_->d, &e));
+    PetscCall(VecDuplicate(ctx_->d, &y));
+    for (PetscInt i = 0; i < R; ++i) {
+      PetscCall(VecSet(e, 0.0));
+      if (i >= lo && i < hi) PetscCall(VecSetValue(e, i, 1.0, INSERT_VALUES));
+      PetscCall(VecAssemblyBegin(e));
+      PetscCall(VecAssemblyEnd(e));
+      PetscCall(ApplyS(ctx_, e, y));
+      if (i >= lo && i < hi) {
+        PetscScalar v;
+        PetscCall(VecGetValues(y, 1, &i, &v));
+        PetscCall(VecSetValue(ctx_->d, i, v, INSERT_VALUES));
+      }
+    }
+    PetscCall(VecAssemblyBegin(ctx_->d));
+    PetscCall(VecAssemblyEnd(ctx_->d));
+    PetscCall(VecDestroy(&e));
+    PetscCall(VecDestroy(&y));
+  }
+  PetscReal dmin;
+  PetscInt  imin;
+  PetscCall(VecMin(ctx_->d, &imin, &dmin));
+  PetscCheck(dmin > 0, PetscObjectComm((PetscObject)K), PETSC_ERR_NOT_CONVERGED, "Dual QP: diagonal entry %" PetscInt_FMT " of S = K A^-1 K^T is %g (a multiplier with no constraint row?)", imin, (double)dmin);
+  PetscCall(PetscLogEventEnd(DS_Diag, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+// Order-independent fingerprint of a distributed index set (cycle detection).
+static PetscErrorCode SetFingerprint(MPI_Comm comm, PetscInt lo, const std::vector<char> &F, uint64_t *h, PetscInt *count)
+{
+  uint64_t loc[2] = {0, 0}, glob[2];
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < F.size(); ++i)
+    if (F[i]) {
+      uint64_t z = (uint64_t)(lo + (PetscInt)i) + 0x9e3779b97f4a7c15ULL; // splitmix64
+      z          = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      z          = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+      loc[0] += z ^ (z >> 31);
+      ++loc[1];
+    }
+  PetscCallMPI(MPI_Allreduce(loc, glob, 2, MPI_UINT64_T, MPI_SUM, comm));
+  *h     = glob[0];
+  *count = (PetscInt)glob[1];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda, PetscBool warm, DualShellInfo *info)
+{
+  MPI_Comm           comm = PetscObjectComm((PetscObject)K);
+  PetscInt           n, lo, hi;
+  PetscReal          bmax;
+  Vec                mu, rhs;
+  std::vector<char>  F;
+  std::vector<PetscReal> sd; // sqrt(d)
+
+  PetscFunctionBeginUser;
+  *info = DualShellInfo();
+  PetscCall(VecMax(b, NULL, &bmax));
+  if (!(bmax > 0)) { // gradient -b >= 0 at 0: lambda = 0 is optimal (exactly)
+    PetscCall(VecSet(lambda, 0.0));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscLogEventBegin(DS_Solve, 0, 0, 0, 0));
+  if (!ctx_) PetscCall(Create(fom, K));
+  ctx_->K        = K;
+  ctx_->fom      = &fom;
+  ctx_->products = 0;
+  PetscCall(Diagonal(fom, K));
+  PetscCall(VecGetLocalSize(b, &n));
+  PetscCall(VecGetOwnershipRange(b, &lo, &hi));
+  PetscCall(VecDuplicate(b, &mu));
+  PetscCall(VecDuplicate(b, &rhs));
+  F.assign(n, 0);
+  sd.resize(n);
+  PetscReal bscale = 0, bnorm;
+  {
+    const PetscScalar *d, *ba;
+    PetscCall(VecGetArrayRead(ctx_->d, &d));
+    PetscCall(VecGetArrayRead(b, &ba));
+    for (PetscInt i = 0; i < n; ++i) {
+      sd[i]  = std::sqrt(PetscRealPart(d[i]));
+      bscale = std::max(bscale, std::abs(PetscRealPart(ba[i])) / sd[i]);
+    }
+    PetscCall(VecRestoreArrayRead(b, &ba));
+    PetscCall(VecRestoreArrayRead(ctx_->d, &d));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bscale, 1, MPIU_REAL, MPIU_MAX, comm));
+  }
+  PetscCall(VecNorm(b, NORM_2, &bnorm));
+  // First free set. Warm: one semismooth Newton update from the previous multipliers,
+  // F = {lambda_i - (S lambda - b)_i / d_i > 0}; cold (or no previous contact): F = {b_i > 0}.
+  PetscReal lmax = 0;
+  if (warm) {
+    PetscCall(VecMax(lambda, NULL, &lmax));
+  }
+  {
+    PetscScalar *l;
+    const PetscScalar *ba, *m = NULL;
+    if (lmax > 0) {
+      PetscCall(VecPointwiseMax(lambda, lambda, ctx_->xm)); // placeholder, replaced below
+    }
+    (void)m;
+    if (lmax > 0) {
+      PetscCall(VecGetArray(lambda, &l));
+      for (PetscInt i = 0; i < n; ++i) l[i] = std::max(0.0, (double)PetscRealPart(l[i]));
+      PetscCall(VecRestoreArray(lambda, &l));
+      PetscCall(ApplyS(ctx_, lambda, mu));
+      PetscCall(VecAXPY(mu, -1.0, b));
+      const PetscScalar *mua, *d;
+      PetscCall(VecGetArrayRead(mu, &mua));
+      PetscCall(VecGetArrayRead(ctx_->d, &d));
+      PetscCall(VecGetArray(lambda, &l));
+      for (PetscInt i = 0; i < n; ++i) {
+        F[i] = PetscRealPart(l[i]) - PetscRealPart(mua[i]) / PetscRealPart(d[i]) > 0;
+        if (!F[i]) l[i] = 0;
+      }
+      PetscCall(VecRestoreArray(lambda, &l));
+      PetscCall(VecRestoreArrayRead(ctx_->d, &d));
+      PetscCall(VecRestoreArrayRead(mu, &mua));
+    } else {
+      PetscCall(VecSet(lambda, 0.0));
+      PetscCall(VecGetArrayRead(b, &ba));
+      for (PetscInt i = 0; i < n; ++i) F[i] = PetscRealPart(ba[i]) > 0;
+      PetscCall(VecRestoreArrayRead(b, &ba));
+    }
+  }
+  std::unordered_map<uint64_t, PetscInt> seen; // fingerprint of F -> step
+  PetscBool converged = PETSC_FALSE;
+  PetscInt  cycleFrom = -1;
+  for (PetscInt it = 1; it <= maxIt; ++it) {
+    // CG on S_FF lambda_F = b_F, started from the current lambda (0 off F)
+    {
+      uint64_t h;
+      PetscInt cnt;
+      PetscCall(SetFingerprint(comm, lo, F, &h, &cnt));
+      auto found = seen.find(h);
+      if (found != seen.end()) { cycleFrom = found->second; break; }
+      seen[h]      = it;
+      info->nfree  = cnt;
+    }
+    {
+      PetscScalar       *m, *r;
+      const PetscScalar *ba;
+      PetscCall(VecGetArray(ctx_->mask, &m));
+      PetscCall(VecGetArray(rhs, &r));
+      PetscCall(VecGetArrayRead(b, &ba));
+      for (PetscInt i = 0; i < n; ++i) {
+        m[i] = F[i] ? 1.0 : 0.0;
+        r[i] = F[i] ? ba[i] : 0.0;
+      }
+      PetscCall(VecRestoreArrayRead(b, &ba));
+      PetscCall(VecRestoreArray(rhs, &r));
+      PetscCall(VecRestoreArray(ctx_->mask, &m));
+    }
+    PetscCall(PetscObjectStateIncrease((PetscObject)S_)); // the Jacobi diagonal changed with F
+    PetscCall(KSPSetTolerances(ksp_, rtol_, atol_ > 0 ? atol_ : 1e-2 * rtol_ * bnorm, PETSC_DEFAULT, PETSC_DEFAULT));
+    PetscCall(KSPSolve(ksp_, rhs, lambda));
+    KSPConvergedReason reason;
+    PetscInt           its;
+    PetscCall(KSPGetConvergedReason(ksp_, &reason));
+    PetscCall(KSPGetIterationNumber(ksp_, &its));
+    info->cgIterations += its;
+    info->pdasIterations = it;
+    // mu = S lambda - b on all multipliers: the residual on F, the sign test off F
+    PetscCall(ApplyS(ctx_, lambda, mu));
+    PetscCall(VecAXPY(mu, -1.0, b));
+    PetscReal rF = 0, bF = 0;
+    PetscInt  changes = 0;
+    {
+      PetscScalar       *l;
+      const PetscScalar *mua, *ba;
+      PetscCall(VecGetArray(lambda, &l));
+      PetscCall(VecGetArrayRead(mu, &mua));
+      PetscCall(VecGetArrayRead(b, &ba));
+      for (PetscInt i = 0; i < n; ++i) {
+        const PetscReal li = PetscRealPart(l[i]), mi = PetscRealPart(mua[i]);
+        if (F[i]) {
+          rF += mi * mi;
+          bF += PetscRealPart(ba[i]) * PetscRealPart(ba[i]);
+          if (!(li > 0)) { F[i] = 0; ++changes; }
+        } else {
+          l[i] = 0; // exactly zero off F
+          if (mi / sd[i] < -setTol * bscale) { F[i] = 1; ++changes; }
+        }
+        if (!F[i]) l[i] = 0;
+      }
+      PetscCall(VecRestoreArrayRead(b, &ba));
+      PetscCall(VecRestoreArrayRead(mu, &mua));
+      PetscCall(VecRestoreArray(lambda, &l));
+      PetscReal loc[3] = {rF, bF, (PetscReal)changes}, glob[3];
+      PetscCallMPI(MPI_Allreduce(loc, glob, 3, MPIU_REAL, MPIU_SUM, comm));
+      info->residual = glob[1] > 0 ? std::sqrt(glob[0] / glob[1]) : 0;
+      changes        = (PetscInt)glob[2];
+    }
+    if (reason < 0) {
+      PetscCall(VecDestroy(&mu));
+      PetscCall(VecDestroy(&rhs));
+      SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "Matrix-free dual QP (-fom_dual_matrix shell): CG on the free set (%" PetscInt_FMT " multipliers, active-set step %" PetscInt_FMT ") failed: %s after %" PetscInt_FMT " iterations, true relative residual %.3e (-%sksp_rtol %g, -%sksp_max_it; or -fom_dual_matrix dense)", info->nfree, it, KSPConvergedReasons[reason], its, (double)info->residual, prefix_.c_str(), (double)rtol_, prefix_.c_str());
+    }
+    if (!changes) { converged = PETSC_TRUE; break; }
+  }
+  // Scaled KKT of the QP: min(lambda_i sqrt(d_i), mu_i / sqrt(d_i)) = 0
+  {
+    const PetscScalar *l, *mua;
+    PetscReal          worst = 0;
+    PetscCall(VecGetArrayRead(lambda, &l));
+    PetscCall(VecGetArrayRead(mu, &mua));
+    for (PetscInt i = 0; i < n; ++i) worst = std::max(worst, std::abs(std::min(PetscRealPart(l[i]) * sd[i], PetscRealPart(mua[i]) / sd[i])));
+    PetscCall(VecRestoreArrayRead(mu, &mua));
+    PetscCall(VecRestoreArrayRead(lambda, &l));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPIU_MAX, comm));
+    info->kkt = worst / bscale;
+  }
+  info->products = ctx_->products;
+  PetscCall(VecDestroy(&mu));
+  PetscCall(VecDestroy(&rhs));
+  PetscCall(PetscLogEventEnd(DS_Solve, 0, 0, 0, 0));
+  PetscCheck(cycleFrom < 0, comm, PETSC_ERR_NOT_CONVERGED, "Matrix-free dual QP (-fom_dual_matrix shell): the primal-dual active-set method cycles (the free set of step %" PetscInt_FMT " came back at step %" PetscInt_FMT ", %" PetscInt_FMT " free multipliers); use -fom_dual_matrix dense", cycleFrom, info->pdasIterations + 1, info->nfree);
+  PetscCheck(converged, comm, PETSC_ERR_NOT_CONVERGED, "Matrix-free dual QP (-fom_dual_matrix shell): the free set still changed after %" PetscInt_FMT " active-set steps (-%spdas_max_it); use -fom_dual_matrix dense", maxIt, prefix_.c_str());
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
