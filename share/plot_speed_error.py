@@ -96,7 +96,10 @@ def read_table(path):
     if fom is not None and (isinstance(fom, bool) or not isinstance(fom, (int, float))):
         fail("'%s': \"fom_median_s\" is %r, expected a number" % (path, fom))
     fom = float(fom) if fom is not None else float("nan")
-    return out, fom, t.get("scene"), t.get("ndofs")
+    tol = t.get("fom_tolerance", 1e-8)
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not tol > 0:
+        fail("'%s': \"fom_tolerance\" is %r, expected a positive number" % (path, tol))
+    return out, (fom, float(tol)), t.get("scene"), t.get("ndofs")
 
 
 def parse_targets(s):
@@ -193,7 +196,7 @@ def main(argv=None):
 
     out = a.output or (a.json[:-5] if a.json.endswith(".json") else a.json) + ".png"
     targets = parse_targets(a.targets) if a.targets else []
-    rows, fom, scene, ndofs = read_table(a.json)
+    rows, (fom, fom_tol), scene, ndofs = read_table(a.json)
     title = a.title or scene or os.path.basename(a.json)
 
     series = [("max_rel_err_u", "u, energy norm", "o", "tab:blue"),
@@ -223,7 +226,7 @@ def main(argv=None):
     xall = xs + ([fom] if ok(fom) else [])
     xlo, xhi = min(xall), max(xall)
     ax.set_xlim(xlo / 2.5, xhi * 4.0)
-    yall = ys + [tv for tv, _ in targets]
+    yall = ys + [tv for tv, _ in targets] + ([fom_tol] if ok(fom) else [])
     ylo, yhi = (min(yall), max(yall)) if yall else (1e-3, 1.0)
     ylo, yhi = 10 ** math.floor(math.log10(ylo) - 0.15), 10 ** math.ceil(math.log10(yhi) + 0.15)
     ax.set_ylim(ylo, yhi)
@@ -234,6 +237,9 @@ def main(argv=None):
         ax.text(fom, 0.98, "FOM (exact to solver tolerance) ", rotation=90, ha="right", va="top",
                 fontsize=8, transform=mtransforms.blended_transform_factory(ax.transData, ax.transAxes),
                 bbox=dict(boxstyle="square,pad=0.05", facecolor="white", edgecolor="none", alpha=0.8))
+        # the FOM as a point: its error is the solver's tolerance (Kacanov, KKT)
+        ax.plot([fom], [fom_tol], marker="*", color="k", markersize=13, linestyle="none", zorder=4,
+                label="FOM: median %.3g s, error ~ solver tolerance %.0e" % (fom, fom_tol))
         sec = ax.secondary_xaxis("top", functions=(lambda t: fom / np.maximum(t, 1e-300),
                                                    lambda s: fom / np.maximum(s, 1e-300)))
         sec.set_xlabel("speedup over the FOM (FOM median time / time per solve)", fontsize=9)

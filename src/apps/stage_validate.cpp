@@ -328,6 +328,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     JsonValue table;
     table["rows"]            = rows;
     table["fom_median_s"]    = fomMedian;
+    table["fom_tolerance"]   = (double)std::max(kac.rtolPrimal, kac.rtolDual);
     table["scene"]           = scene.name;
     table["ndofs"]           = (long long)order.NumDofs();
     PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".csv", csv.str()));

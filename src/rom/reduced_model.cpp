@@ -499,10 +499,11 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     PetscFunctionReturn(0);
   }
   Operators(mu, &A_, &f_);
-  // warm start: the stored reduced solution of the nearest training parameter (box-scaled distance)
+  // warm start: the stored reduced solutions of the training parameters; with one parameter the
+  // linear interpolation between the two that bracket mu, otherwise the nearest (box-scaled distance)
   const size_t np = par.params.size(), nw = np ? warmMu.size() / np : 0;
   if (warmStart && nw > 0) {
-    size_t    best = 0;
+    size_t    best = 0, lo = nw, hi = nw;
     PetscReal bd   = PETSC_MAX_REAL;
     for (size_t k = 0; k < nw; ++k) {
       PetscReal d = 0;
@@ -511,9 +512,16 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
         d += PetscSqr((warmMu[k * np + i] - mu[i]) / w);
       }
       if (d < bd) { bd = d; best = k; }
+      if (np == 1) {
+        if (warmMu[k] <= mu[0] && (lo == nw || warmMu[k] > warmMu[lo])) lo = k;
+        if (warmMu[k] >= mu[0] && (hi == nw || warmMu[k] < warmMu[hi])) hi = k;
+      }
     }
-    for (PetscInt i = 0; i < Na; ++i) sol->v[i] = warmV[best * Nfull + cols_[i]];
-    for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = warmL[best * Rfull + i];
+    PetscReal t = 0;
+    if (np == 1 && lo < nw && hi < nw && warmMu[hi] > warmMu[lo]) t = (mu[0] - warmMu[lo]) / (warmMu[hi] - warmMu[lo]);
+    else lo = hi = best;
+    for (PetscInt i = 0; i < Na; ++i) sol->v[i] = (1 - t) * warmV[lo * Nfull + cols_[i]] + t * warmV[hi * Nfull + cols_[i]];
+    for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = (1 - t) * warmL[lo * Rfull + i] + t * warmL[hi * Rfull + i];
   }
   thread_local std::vector<PetscReal> vprev, lprev, vnew;
   for (PetscInt it = 1; it <= maxIt; ++it) {
