@@ -153,6 +153,8 @@ def bad_input(args):
     expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5", "does not exist"], "missing ROM file")
     expect_error(args, ["-rom", rom, "-mu", "1.3"], ["radius", "1.3", "outside its box"], "mu outside the box")
     expect_error(args, ["-rom", rom, "-rom_N", "99"], ["-rom_N", "99"], "truncation out of range")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "1", "-rom_warm_start", "0"], ["did not converge", "-rom_kacanov_max_it"], "reduced Kacanov not converged")
+    expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
     # a truncated (corrupt) copy
     with open(rom, "rb") as f:
         data = f.read()
