@@ -1,5 +1,6 @@
 # tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test, no-contact gap,
-# ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers.
+# ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers, the matrix-free
+# dual (-fom_dual_matrix shell) against the dense one.
 find_program(RBC_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_CC ${RBC_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/contact_checks.py)
 foreach(np 1 2)
@@ -7,7 +8,8 @@ foreach(np 1 2)
   add_test(NAME contact_flat_punch_np${np} COMMAND ${RBC_CC} flat_punch --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_no_contact_np${np} COMMAND ${RBC_CC} no_contact --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_kkt_all_np${np} COMMAND ${RBC_CC} kkt_all --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np}
+  add_test(NAME contact_dual_shell_np${np} COMMAND ${RBC_CC} dual_shell --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np}
     PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
 endforeach()
 # runs both rank counts itself and compares them

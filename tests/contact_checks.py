@@ -5,7 +5,7 @@ Each subcommand runs `rbcontact fom` (under mpirun -n NP) on a scene of runs/ an
 -report JSON (and -fom_output HDF5 where fields are compared). Exit 0 = pass; a failure prints what
 was measured and the bound it broke. References: Hertz's analytic line contact, the flat-punch patch
 test (uniform pressure), the elastic solution (a gap larger than any motion), KKT residuals,
-1 vs 2 ranks.
+1 vs 2 ranks, the matrix-free dual (-fom_dual_matrix shell) against the dense one.
 """
 import argparse
 import json
@@ -147,9 +147,39 @@ def kkt_all(args):
         check_kkt(r)
 
 
+def dual_shell(args):
+    print("Matrix-free dual (-fom_dual_matrix shell: MATSHELL S, active set + CG) vs dense S (np %d)" % args.np)
+    cases = [("ring_on_block", ["-mu", "0.95"]), ("ring_on_block", ["-mu", "1.15"]), ("flat_punch", []), ("hertz", [])]
+    for s, opts in cases:
+        tag = s + "".join(opts)
+        rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + args.extra, tag + "_dense")
+        # auto with a tiny -fom_dual_dense_max must pick the shell (and shell must skip the compliance)
+        shell = ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"] if s == "flat_punch" else ["-fom_dual_matrix", "shell"]
+        rs, h5s = run(args, args.np, "runs/%s.opts" % s, opts + shell + args.extra, tag + "_shell")
+        check(rd["dual_matrix"] == "dense" and rs["dual_matrix"] == "shell", "%s: dual_matrix %s (default auto) / %s (%s)" % (tag, rd["dual_matrix"], rs["dual_matrix"], " ".join(shell)))
+        (ld, xd), (ls, xs) = contact_fields(h5d), contact_fields(h5s)
+        cg = rs["kacanov_history"].get("dual_cg", [])
+        print("  %-22s R %4d active %3d  Kacanov its dense %d shell %d  CG its per Kacanov iterate %s"
+              % (tag, rs["ncontact"], rs["nactive"], rd["kacanov_iterations"], rs["kacanov_iterations"], cg))
+        check(abs(rd["kacanov_iterations"] - rs["kacanov_iterations"]) <= 1, "%s: Kacanov iterations dense %d, shell %d (+-1)" % (tag, rd["kacanov_iterations"], rs["kacanov_iterations"]))
+        check(np.array_equal(xd, xs), "%s: same slave vertices" % tag)
+        dl = np.max(np.abs(ld - ls)) / np.max(np.abs(ld))
+        check(dl <= 1e-8, "%s: multipliers shell vs dense max rel diff %.1e <= 1e-8" % (tag, dl))
+        check(rd["nactive"] == rs["nactive"], "%s: active nodes dense %d, shell %d" % (tag, rd["nactive"], rs["nactive"]))
+        de = abs(rd["energy"] - rs["energy"]) / abs(rd["energy"])
+        check(de <= 1e-10, "%s: energy rel diff %.1e <= 1e-10" % (tag, de))
+        check_kkt(rs)
+    # the cycling / iteration guard is an error with a message naming the option
+    out = tempfile.mkdtemp(prefix="rbc_contact_")
+    cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts", "-fom_dual_matrix", "shell",
+           "-fom_dual_pdas_max_it", "2", "-report", os.path.join(out, "r.json")] + args.extra
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "-fom_dual_pdas_max_it" in p.stdout, "-fom_dual_pdas_max_it 2: refused with a message naming the option (exit %d)" % p.returncode)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

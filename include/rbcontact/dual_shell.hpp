@@ -5,10 +5,11 @@
 // set F by CG (KSP prefix fom_dual_, default cg + jacobi, rtol 1e-14) on a MATSHELL that masks S to F
 // (identity off F); a product with S is one back-solve with the factored A (ElasticFOM::ApplyInverse).
 // lambda = 0 off F; F is then updated from the sign of lambda (on F) and of S lambda - b (off F), until
-// it does not change: the last step is an exact solve on the final support.
-// Options (prefix fom_dual_): -pdas_max_it (100), -pdas_tol (1e-12, scaled threshold for adding a
-// multiplier), -diag lumped|exact (Jacobi diagonal: diag(K diag(A)^{-1} K^T), or exact by R products),
-// -ksp_* / -pc_* of the CG.
+// it does not change under an exact solve: the last step is an exact solve on the final support.
+// While F changes, CG stops early (-pdas_rtol_loose); a set that repeats under exact solves is an error.
+// Options (prefix fom_dual_): -pdas_max_it (100), -pdas_rtol_loose (1e-3), -pdas_tol (1e-12, scaled
+// threshold for adding a multiplier), -pdas_monitor, -diag lumped|exact (Jacobi diagonal:
+// diag(K diag(A)^{-1} K^T), or exact by R products), -ksp_* / -pc_* of the CG.
 #pragma once
 #include <petscksp.h>
 #include <string>
@@ -42,7 +43,9 @@ public:
 
   PetscInt    maxIt   = 100;
   PetscReal   setTol  = 1e-12;
+  PetscReal   looseRtol = 1e-3; // CG rtol while the free set still changes (-pdas_rtol_loose)
   std::string diag    = "lumped";
+  PetscBool   monitor = PETSC_FALSE; // -fom_dual_pdas_monitor
 
 private:
   PetscErrorCode Create(ElasticFOM &fom, Mat K);

@@ -5,10 +5,14 @@
 // Stops on the relative changes of u and lambda; non-convergence is an error with the history.
 // Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
 // -kacanov_monitor; the dual QP takes the fom_ prefix (-fom_tao_type, -fom_qp_polish); -fom_kkt_tol.
+// -fom_dual_matrix dense|shell|auto (-fom_dual_dense_max R): dense S through the surface compliance
+// (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), or S as a MATSHELL with the matrix-free
+// primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*).
 #pragma once
 #include "rbcontact/bound_qp.hpp"
 #include "rbcontact/compliance.hpp"
 #include "rbcontact/contact.hpp"
+#include "rbcontact/dual_shell.hpp"
 #include "rbcontact/fom.hpp"
 
 namespace rbc {
@@ -21,6 +25,7 @@ struct KKTResiduals {
 struct KacanovHistory {
   std::vector<PetscReal> du, dl;
   std::vector<PetscInt>  nactive;
+  std::vector<PetscInt>  dualSteps, dualCG; // shell dual: active-set steps and CG iterations per iterate
 };
 
 class KacanovSolver {
@@ -45,11 +50,16 @@ public:
   PetscReal      rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
   PetscBool      monitor = PETSC_FALSE;
   DualQPInfo     lastQP;
+  DualShellInfo  lastShell;
   SurfaceCompliance compliance;
+  std::string    dualMatrixOption = "auto"; // -fom_dual_matrix
+  PetscInt       dualDenseMax     = 3000;   // -fom_dual_dense_max: auto = dense up to this R
+  std::string    dualMatrix;                // used by the last Solve: "dense" or "shell" (report key dual_matrix)
 
 private:
   PetscErrorCode ComputeKKT(ElasticFOM &fom);
-  DualQPSolver qp_;
+  DualQPSolver    qp_;
+  DualShellSolver shell_;
 };
 
 // Contact quantities for reports: resultant normal force, max pressure, active count, half-width (2D).

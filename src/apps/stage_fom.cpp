@@ -59,6 +59,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     PetscCall(SummarizeContact(kacanov.sys, kacanov.lambda, fom.elas.dim, &cs));
     rep.root["converged"]          = (bool)kacanov.converged;
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
+    rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
     rep.root["ncontact"]           = (long long)cs.R;
     rep.root["nactive"]            = (long long)cs.nactive;
     rep.root["contact_force"]      = (double)cs.force;
@@ -75,6 +76,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     std::vector<double> dl(kacanov.history.dl.begin(), kacanov.history.dl.end()), na(kacanov.history.nactive.begin(), kacanov.history.nactive.end());
     h["dlambda"] = dl;
     h["nactive"] = na;
+    if (!kacanov.history.dualCG.empty()) h["dual_cg"] = std::vector<double>(kacanov.history.dualCG.begin(), kacanov.history.dualCG.end());
     if (hertz) {
       PetscReal a, p0;
       HertzReference(scene, hertzRadius, cs.force, &a, &p0);

@@ -64,6 +64,7 @@ static PetscErrorCode MaskedDiagonal(Mat S, Vec diag)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(S, &c));
   PetscCall(VecGetLocalSize(diag, &n));
+  PetscCall(PetscInfo(S, "Jacobi diagonal of the masked dual operator\n"));
   PetscCall(VecGetArrayRead(c->mask, &m));
   PetscCall(VecGetArrayRead(c->d, &d));
   PetscCall(VecGetArray(diag, &o));
@@ -74,18 +75,26 @@ static PetscErrorCode MaskedDiagonal(Mat S, Vec diag)
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode DestroyCtx(DualShellCtx **c)
+{
+  PetscFunctionBeginUser;
+  if (*c) {
+    PetscCall(VecDestroy(&(*c)->w1));
+    PetscCall(VecDestroy(&(*c)->w2));
+    PetscCall(VecDestroy(&(*c)->xm));
+    PetscCall(VecDestroy(&(*c)->mask));
+    PetscCall(VecDestroy(&(*c)->d));
+    delete *c;
+    *c = nullptr;
+  }
+  PetscFunctionReturn(0);
+}
+
 DualShellSolver::~DualShellSolver()
 {
   (void)KSPDestroy(&ksp_);
   (void)MatDestroy(&S_);
-  if (ctx_) {
-    (void)VecDestroy(&ctx_->w1);
-    (void)VecDestroy(&ctx_->w2);
-    (void)VecDestroy(&ctx_->xm);
-    (void)VecDestroy(&ctx_->mask);
-    (void)VecDestroy(&ctx_->d);
-    delete ctx_;
-  }
+  (void)DestroyCtx(&ctx_);
 }
 
 PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string &prefix)
@@ -101,7 +110,9 @@ PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string 
   prefix_ = prefix + "dual_";
   PetscOptionsBegin(comm, prefix_.c_str(), "Matrix-free dual QP (primal-dual active set + CG)", "DualShellSolver");
   PetscCall(PetscOptionsInt("-pdas_max_it", "Maximum active-set steps", NULL, maxIt, &maxIt, NULL));
+  PetscCall(PetscOptionsReal("-pdas_rtol_loose", "CG rtol while the free set changes (then -ksp_rtol)", NULL, looseRtol, &looseRtol, NULL));
   PetscCall(PetscOptionsReal("-pdas_tol", "Add a multiplier when its scaled gradient is below -tol |b|", NULL, setTol, &setTol, NULL));
+  PetscCall(PetscOptionsBool("-pdas_monitor", "Print each active-set step", NULL, monitor, &monitor, NULL));
   PetscCall(PetscOptionsString("-diag", "Jacobi diagonal: lumped (diag(K diag(A)^-1 K^T)) or exact (R products)", NULL, dtype, dtype, sizeof dtype, &set));
   PetscOptionsEnd();
   diag = dtype;
@@ -253,6 +264,17 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
     PetscFunctionReturn(0);
   }
   PetscCall(PetscLogEventBegin(DS_Solve, 0, 0, 0, 0));
+  if (ctx_) { // another discretization than the last Solve: new work vectors and shell
+    PetscInt nu, nuw, nl, nlw;
+    PetscCall(VecGetLocalSize(fom.f, &nu));
+    PetscCall(VecGetLocalSize(ctx_->w1, &nuw));
+    PetscCall(VecGetLocalSize(b, &nl));
+    PetscCall(VecGetLocalSize(ctx_->xm, &nlw));
+    if (nu != nuw || nl != nlw) {
+      PetscCall(MatDestroy(&S_));
+      PetscCall(DestroyCtx(&ctx_));
+    }
+  }
   if (!ctx_) PetscCall(Create(fom, K));
   ctx_->K        = K;
   ctx_->fom      = &fom;
@@ -278,54 +300,40 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bscale, 1, MPIU_REAL, MPIU_MAX, comm));
   }
   PetscCall(VecNorm(b, NORM_2, &bnorm));
-  // First free set. Warm: one semismooth Newton update from the previous multipliers,
-  // F = {lambda_i - (S lambda - b)_i / d_i > 0}; cold (or no previous contact): F = {b_i > 0}.
+  // First free set: warm, the previous Kacanov iterate's support (lambda > 0), lambda its start for CG;
+  // cold (or no previous contact): F = {b_i > 0}, the first semismooth Newton step from lambda = 0.
   PetscReal lmax = 0;
-  if (warm) {
-    PetscCall(VecMax(lambda, NULL, &lmax));
-  }
+  if (warm) PetscCall(VecMax(lambda, NULL, &lmax));
   {
-    PetscScalar *l;
-    const PetscScalar *ba, *m = NULL;
-    if (lmax > 0) {
-      PetscCall(VecPointwiseMax(lambda, lambda, ctx_->xm)); // placeholder, replaced below
+    PetscScalar       *l;
+    const PetscScalar *ba;
+    PetscCall(VecGetArray(lambda, &l));
+    PetscCall(VecGetArrayRead(b, &ba));
+    for (PetscInt i = 0; i < n; ++i) {
+      if (lmax > 0) F[i] = PetscRealPart(l[i]) > 0;
+      else F[i] = PetscRealPart(ba[i]) > 0;
+      if (!F[i] || !(lmax > 0)) l[i] = 0;
     }
-    (void)m;
-    if (lmax > 0) {
-      PetscCall(VecGetArray(lambda, &l));
-      for (PetscInt i = 0; i < n; ++i) l[i] = std::max(0.0, (double)PetscRealPart(l[i]));
-      PetscCall(VecRestoreArray(lambda, &l));
-      PetscCall(ApplyS(ctx_, lambda, mu));
-      PetscCall(VecAXPY(mu, -1.0, b));
-      const PetscScalar *mua, *d;
-      PetscCall(VecGetArrayRead(mu, &mua));
-      PetscCall(VecGetArrayRead(ctx_->d, &d));
-      PetscCall(VecGetArray(lambda, &l));
-      for (PetscInt i = 0; i < n; ++i) {
-        F[i] = PetscRealPart(l[i]) - PetscRealPart(mua[i]) / PetscRealPart(d[i]) > 0;
-        if (!F[i]) l[i] = 0;
-      }
-      PetscCall(VecRestoreArray(lambda, &l));
-      PetscCall(VecRestoreArrayRead(ctx_->d, &d));
-      PetscCall(VecRestoreArrayRead(mu, &mua));
-    } else {
-      PetscCall(VecSet(lambda, 0.0));
-      PetscCall(VecGetArrayRead(b, &ba));
-      for (PetscInt i = 0; i < n; ++i) F[i] = PetscRealPart(ba[i]) > 0;
-      PetscCall(VecRestoreArrayRead(b, &ba));
-    }
+    PetscCall(VecRestoreArrayRead(b, &ba));
+    PetscCall(VecRestoreArray(lambda, &l));
   }
   std::unordered_map<uint64_t, PetscInt> seen; // fingerprint of F -> step
   PetscBool converged = PETSC_FALSE;
   PetscInt  cycleFrom = -1;
+  // Inexact phase: CG to -pdas_rtol_loose while F changes; then exact solves (rtol) until F stays.
+  PetscBool tight = looseRtol > rtol_ ? PETSC_FALSE : PETSC_TRUE;
   for (PetscInt it = 1; it <= maxIt; ++it) {
     // CG on S_FF lambda_F = b_F, started from the current lambda (0 off F)
     {
-      uint64_t h;
-      PetscInt cnt;
+      uint64_t h   = 0;
+      PetscInt cnt = 0;
       PetscCall(SetFingerprint(comm, lo, F, &h, &cnt));
       auto found = seen.find(h);
-      if (found != seen.end()) { cycleFrom = found->second; break; }
+      if (found != seen.end()) {
+        if (tight) { cycleFrom = found->second; break; }
+        tight = PETSC_TRUE; // a repeated set under inexact solves: decide the rest exactly
+        seen.clear();
+      }
       seen[h]      = it;
       info->nfree  = cnt;
     }
@@ -343,8 +351,11 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
       PetscCall(VecRestoreArray(rhs, &r));
       PetscCall(VecRestoreArray(ctx_->mask, &m));
     }
-    PetscCall(PetscObjectStateIncrease((PetscObject)S_)); // the Jacobi diagonal changed with F
-    PetscCall(KSPSetTolerances(ksp_, rtol_, atol_ > 0 ? atol_ : 1e-2 * rtol_ * bnorm, PETSC_DEFAULT, PETSC_DEFAULT));
+    // F changed: a new state of S_ makes the PC take the new Jacobi diagonal
+    PetscCall(MatAssemblyBegin(S_, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(S_, MAT_FINAL_ASSEMBLY));
+    const PetscReal rtol = tight ? rtol_ : looseRtol, addTol = tight ? setTol : std::max(setTol, looseRtol);
+    PetscCall(KSPSetTolerances(ksp_, rtol, atol_ > 0 ? atol_ : 1e-2 * rtol * bnorm, PETSC_DEFAULT, PETSC_DEFAULT));
     PetscCall(KSPSolve(ksp_, rhs, lambda));
     KSPConvergedReason reason;
     PetscInt           its;
@@ -356,7 +367,7 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
     PetscCall(ApplyS(ctx_, lambda, mu));
     PetscCall(VecAXPY(mu, -1.0, b));
     PetscReal rF = 0, bF = 0;
-    PetscInt  changes = 0;
+    PetscInt  changes = 0, added = 0;
     {
       PetscScalar       *l;
       const PetscScalar *mua, *ba;
@@ -371,24 +382,30 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
           if (!(li > 0)) { F[i] = 0; ++changes; }
         } else {
           l[i] = 0; // exactly zero off F
-          if (mi / sd[i] < -setTol * bscale) { F[i] = 1; ++changes; }
+          if (mi / sd[i] < -addTol * bscale) { F[i] = 1; ++changes; ++added; }
         }
         if (!F[i]) l[i] = 0;
       }
       PetscCall(VecRestoreArrayRead(b, &ba));
       PetscCall(VecRestoreArrayRead(mu, &mua));
       PetscCall(VecRestoreArray(lambda, &l));
-      PetscReal loc[3] = {rF, bF, (PetscReal)changes}, glob[3];
-      PetscCallMPI(MPI_Allreduce(loc, glob, 3, MPIU_REAL, MPIU_SUM, comm));
+      PetscReal loc[4] = {rF, bF, (PetscReal)changes, (PetscReal)added}, glob[4];
+      PetscCallMPI(MPI_Allreduce(loc, glob, 4, MPIU_REAL, MPIU_SUM, comm));
       info->residual = glob[1] > 0 ? std::sqrt(glob[0] / glob[1]) : 0;
       changes        = (PetscInt)glob[2];
+      added          = (PetscInt)glob[3];
     }
+    if (monitor) PetscCall(PetscPrintf(comm, "      dual step %2" PetscInt_FMT " (%s): free %5" PetscInt_FMT ", CG %4" PetscInt_FMT " its (%s), residual on F %.2e; then %" PetscInt_FMT " added, %" PetscInt_FMT " removed\n", it, tight ? "exact" : "loose", info->nfree, its, KSPConvergedReasons[reason], (double)info->residual, added, changes - added));
     if (reason < 0) {
       PetscCall(VecDestroy(&mu));
       PetscCall(VecDestroy(&rhs));
       SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "Matrix-free dual QP (-fom_dual_matrix shell): CG on the free set (%" PetscInt_FMT " multipliers, active-set step %" PetscInt_FMT ") failed: %s after %" PetscInt_FMT " iterations, true relative residual %.3e (-%sksp_rtol %g, -%sksp_max_it; or -fom_dual_matrix dense)", info->nfree, it, KSPConvergedReasons[reason], its, (double)info->residual, prefix_.c_str(), (double)rtol_, prefix_.c_str());
     }
-    if (!changes) { converged = PETSC_TRUE; break; }
+    if (!changes) {
+      if (tight) { converged = PETSC_TRUE; break; }
+      tight = PETSC_TRUE; // confirm the set with an exact solve (from the current lambda)
+      seen.clear();
+    }
   }
   // Scaled KKT of the QP: min(lambda_i sqrt(d_i), mu_i / sqrt(d_i)) = 0
   {

@@ -1,5 +1,6 @@
-// src/contact/kacanov.cpp: Kacanov fixed-point iterations with the TAO dual solve, KKT checks and
-// the contact summary (force, pressure, active zone).
+// src/contact/kacanov.cpp: Kacanov fixed-point iterations with the dual solve (dense S and TAO, or the
+// matrix-free S of dual_shell.cpp: -fom_dual_matrix), KKT checks and the contact summary (force,
+// pressure, active zone).
 #include "rbcontact/kacanov.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -30,12 +31,20 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscOptionsEnd();
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
+  {
+    const char *types[] = {"dense", "shell", "auto"};
+    PetscInt    t       = dualMatrixOption == "dense" ? 0 : dualMatrixOption == "shell" ? 1 : 2;
+    PetscCall(PetscOptionsEList("-dual_matrix", "Dual Hessian S = K A^-1 K^T: dense (via the surface compliance), shell (matrix-free), auto", NULL, types, 3, types[t], &t, NULL));
+    dualMatrixOption = types[t];
+  }
+  PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, shell above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscOptionsEnd();
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
   PetscCheck(rtolPrimal > 0 && rtolDual > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_rtol_primal and -kacanov_rtol_dual must be > 0");
   PetscCheck(relaxation > 0 && relaxation <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
   PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp_.Setup("fom_"));
+  PetscCall(shell_.SetFromOptions(comm, "fom_"));
   PetscFunctionReturn(0);
 }
 
@@ -212,24 +221,60 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(VecSet(uprev, 0.0));
   PetscCall(DMCreateLocalVector(fom.dm, &uloc));
   PetscCall(VecSet(uloc, 0.0)); // u^0 = 0: the reference configuration
-  // Compliance of the contact dofs, once per parameter: S = K_D G K_D^T costs dense operations only.
+  // Dual Hessian: dense S through the compliance of the contact dofs (once per parameter: every
+  // iterate's S = K_D G K_D^T costs dense operations only), or a MATSHELL with no compliance at all.
+  const PetscInt R0 = map.NumMultipliers();
+  const bool     shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && R0 > dualDenseMax);
+  dualMatrix           = shell ? "shell" : "dense";
   PetscCall(PetscTime(&t0));
   std::vector<PetscInt> D;
   std::vector<PetscReal> u0D;
-  PetscCall(map.SurfaceDofs(comm, &D));
-  PetscCall(compliance.Compute(fom, D));
-  PetscCall(GatherAt(u0, D, &u0D));
+  if (!shell) {
+    PetscCall(map.SurfaceDofs(comm, &D));
+    PetscCall(compliance.Compute(fom, D));
+    PetscCall(GatherAt(u0, D, &u0D));
+  }
   PetscCall(PetscTime(&t1));
   fom.times.contact += t1 - t0;
   const PetscBLASInt nD = (PetscBLASInt)D.size();
-  if (monitor) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %d contact dofs, compliance by %s in %.3f s\n", map.NumMultipliers(), (int)nD, compliance.method.c_str(), (double)compliance.seconds));
+  if (monitor) {
+    if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ")\n", R0, dualMatrixOption.c_str(), dualDenseMax));
+    else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
+  }
 
   for (PetscInt k = 1; k <= maxIt; ++k) {
     std::vector<PetscReal> KD, T, Sfull, gfull, bfull, lam;
+    PetscInt               nact = 0;
     PetscCall(PetscTime(&t0));
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
+    const PetscBool warm = lambda ? PETSC_TRUE : PETSC_FALSE;
+    if (!lambda) {
+      PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
+      PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
+      PetscCall(VecSet(lambda, 0.0));
+    }
+    if (shell) {
+      // b = K u0 - g; lambda (the previous iterate's multipliers) is the warm start
+      Vec b;
+      PetscCall(VecDuplicate(sys.g, &b));
+      PetscCall(MatMult(sys.K, u0, b));
+      PetscCall(VecAXPY(b, -1.0, sys.g));
+      PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
+      PetscCall(shell_.Solve(fom, sys.K, b, lambda, warm, &lastShell));
+      PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
+      PetscCall(VecDestroy(&b));
+      const PetscScalar *la;
+      PetscInt           nloc;
+      PetscCall(VecGetLocalSize(lambda, &nloc));
+      PetscCall(VecGetArrayRead(lambda, &la));
+      for (PetscInt i = 0; i < nloc; ++i) if (PetscRealPart(la[i]) > 0) ++nact;
+      PetscCall(VecRestoreArrayRead(lambda, &la));
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nact, 1, MPIU_INT, MPI_SUM, comm));
+      history.dualSteps.push_back(lastShell.pdasIterations);
+      history.dualCG.push_back(lastShell.cgIterations);
+    } else {
     // S = K_D G K_D^T, b = K_D u0_D - g
     PetscCall(PetscLogEventBegin(KAC_Schur, 0, 0, 0, 0));
     const PetscBLASInt R = (PetscBLASInt)sys.R;
@@ -268,10 +313,6 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
     PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP));
     PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
-    if (!lambda) {
-      PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
-      PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
-    }
     {
       PetscInt     lo, hi;
       PetscScalar *la;
@@ -279,6 +320,8 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       PetscCall(VecGetArray(lambda, &la));
       for (PetscInt i = lo; i < hi; ++i) la[i - lo] = lam[i];
       PetscCall(VecRestoreArray(lambda, &la));
+    }
+    for (PetscReal l : lam) if (l > 0) ++nact;
     }
     PetscCall(PetscTime(&t1));
     fom.times.contact += t1 - t0;
@@ -303,13 +346,12 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       PetscCall(VecNorm(lamPrev, NORM_2, &ndl));
     } else ndl = nl;
     const PetscReal du = RelChange(ndu, nup, nu), dl = lamPrev ? RelChange(ndl, nlp, nl) : (nl == 0 ? 0.0 : kInf);
-    PetscInt        nact = 0;
-    for (PetscReal l : lam) if (l > 0) ++nact;
     history.du.push_back(du);
     history.dl.push_back(dl);
     history.nactive.push_back(nact);
     iterations = k;
-    if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
+    if (monitor && shell) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (dual shell: active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt));
+    else if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
     PetscCall(VecCopy(fom.u, uprev));
