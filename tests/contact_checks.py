@@ -10,6 +10,7 @@ test (uniform pressure), the elastic solution (a gap larger than any motion), KK
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -150,9 +151,11 @@ def kkt_all(args):
 def dual_shell(args):
     print("Matrix-free dual (-fom_dual_matrix shell: MATSHELL S, active set + CG) vs dense S (np %d)" % args.np)
     cases = [("ring_on_block", ["-mu", "0.95"]), ("ring_on_block", ["-mu", "1.15"]), ("flat_punch", []), ("hertz", [])]
+    dense = {}
     for s, opts in cases:
         tag = s + "".join(opts)
         rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + args.extra, tag + "_dense")
+        dense[tag] = (rd, h5d)
         # auto with a tiny -fom_dual_dense_max must pick the shell (and shell must skip the compliance)
         shell = ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"] if s == "flat_punch" else ["-fom_dual_matrix", "shell"]
         rs, h5s = run(args, args.np, "runs/%s.opts" % s, opts + shell + args.extra, tag + "_shell")
@@ -169,8 +172,38 @@ def dual_shell(args):
         de = abs(rd["energy"] - rs["energy"]) / abs(rd["energy"])
         check(de <= 1e-10, "%s: energy rel diff %.1e <= 1e-10" % (tag, de))
         check_kkt(rs)
-    # the cycling / iteration guard is an error with a message naming the option
+    # TAO phase (-fom_dual_shell_tao, TAO prefix fom_) before the active-set method: BQPIP (default type,
+    # a MATSHELL Hessian it shifts in place), BLMVM (no Hessian), GPCG (H(free, free) as a submatrix);
+    # the active-set method polishes, so the answer is the dense one
     out = tempfile.mkdtemp(prefix="rbc_contact_")
+    for s, opts in [("ring_on_block", ["-mu", "0.95"]), ("hertz", [])]:
+        tag = s + "".join(opts)
+        rd, h5d = dense[tag]
+        ld, xd = contact_fields(h5d)
+        for tt in ["bqpip", "blmvm", "gpcg"]:
+            rep, h5 = os.path.join(out, tag + tt + ".json"), os.path.join(out, tag + tt + ".h5")
+            cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/%s.opts" % s] + opts + \
+                  ["-fom_dual_matrix", "shell", "-fom_dual_shell_tao", "1", "-fom_tao_type", tt, "-kacanov_monitor",
+                   "-report", rep, "-fom_output", h5] + args.extra
+            p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            if p.returncode != 0:
+                print(p.stdout[-4000:])
+                check(False, "%s -fom_tao_type %s: exit %d" % (tag, tt, p.returncode))
+                continue
+            with open(rep) as f:
+                rs = json.load(f)
+            m = re.search(r" 1 Kacanov .*TAO its (\d+) \((\d+) products\)", p.stdout)
+            its, prods = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+            ls, xs = contact_fields(h5)
+            dl = np.max(np.abs(ld - ls)) / np.max(np.abs(ld))
+            cg = rs["kacanov_history"].get("dual_cg", [])
+            print("  %-22s TAO %-5s: first iterate %3d TAO its, %4d products; CG its per Kacanov iterate %s" % (tag, tt, its, prods, cg))
+            check(its > 0 and prods > 0, "%s %s: the TAO phase ran on the first iterate (%d its, %d products)" % (tag, tt, its, prods))
+            check(np.array_equal(xd, xs) and dl <= 1e-10, "%s %s: multipliers vs dense max rel diff %.1e <= 1e-10" % (tag, tt, dl))
+            check(rd["nactive"] == rs["nactive"] and abs(rd["kacanov_iterations"] - rs["kacanov_iterations"]) <= 1,
+                  "%s %s: active %d / %d, Kacanov its %d / %d" % (tag, tt, rs["nactive"], rd["nactive"], rs["kacanov_iterations"], rd["kacanov_iterations"]))
+            check_kkt(rs)
+    # the cycling / iteration guard is an error with a message naming the option
     cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts", "-fom_dual_matrix", "shell",
            "-fom_dual_pdas_max_it", "2", "-report", os.path.join(out, "r.json")] + args.extra
     p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

@@ -10,8 +10,18 @@
 // Options (prefix fom_dual_): -pdas_max_it (100), -pdas_rtol_loose (1e-3), -pdas_tol (1e-12, scaled
 // threshold for adding a multiplier), -pdas_monitor, -diag lumped|exact (Jacobi diagonal:
 // diag(K diag(A)^{-1} K^T), or exact by R products), -ksp_* / -pc_* of the CG.
+// Optional TAO phase before the active-set method (-fom_dual_shell_tao, default off: with BQPIP it costs
+// 700-1000 products on the ring, 2-3x the shell time; docs/contact.md): TAO (prefix fom_: -fom_tao_type,
+// default BQPIP by TaoBQPIPRecipe, at most -fom_tao_max_it 50 iterations) on the Jacobi-equilibrated S
+// (a second MATSHELL, full S, unit diagonal estimate, with its own MatDiagonalSet / MatShift: BQPIP
+// shifts the diagonal in place and MATSHELL's native shifts do not survive its MatAssemblyEnd),
+// bounds [0, inf]; its inner KSP has prefix fom_dual_tao_ (cg + jacobi for BQPIP; TRON / GPCG get
+// H(free, free) as a MATSHELL too). Entries above -fom_dual_shell_tao_support (1e-6) * max are the first
+// free set of the active-set method, which then finishes exactly as without TAO. The phase runs on cold
+// starts only (no previous support), on every Kacanov iterate with -fom_dual_shell_tao_warm.
 #pragma once
 #include <petscksp.h>
+#include <petsctao.h>
 #include <string>
 #include "rbcontact/fom.hpp"
 
@@ -26,6 +36,13 @@ struct DualShellInfo {
   PetscInt  nfree          = 0; // size of the final free set
   PetscReal residual       = 0; // true |S_FF lambda_F - b_F|_2 / |b_F|_2 on the final set
   PetscReal kkt            = 0; // max_i |min(lambda_i sqrt(d_i), (S lambda - b)_i / sqrt(d_i))| / |b / sqrt(d)|_inf
+  // TAO phase (-fom_dual_shell_tao; all 0 when it did not run)
+  PetscInt           taoIterations = 0; // TAO iterations
+  PetscInt           taoKSP        = 0; // iterations of TAO's inner KSP (each one a product)
+  PetscInt           taoProducts   = 0; // products with S in the TAO phase (included in products)
+  PetscInt           taoSupport    = 0; // size of the free set taken from TAO
+  TaoConvergedReason taoReason     = TAO_CONTINUE_ITERATING;
+  PetscReal          taoShiftDrift = 0; // max |diagonal shift left on the TAO Hessian shell| after TaoSolve
 };
 
 class DualShellSolver {
@@ -46,10 +63,15 @@ public:
   PetscReal   looseRtol = 1e-3; // CG rtol while the free set still changes (-pdas_rtol_loose)
   std::string diag    = "lumped";
   PetscBool   monitor = PETSC_FALSE; // -fom_dual_pdas_monitor
+  PetscBool   useTao  = PETSC_FALSE; // -fom_dual_shell_tao (off with -fom_tao_type activeset)
+  PetscBool   taoWarm = PETSC_FALSE; // -fom_dual_shell_tao_warm: TAO on warm starts too
+  PetscReal   taoSupport = 1e-6;     // -fom_dual_shell_tao_support: free if > this * max
 
 private:
   PetscErrorCode Create(ElasticFOM &fom, Mat K);
   PetscErrorCode Diagonal(ElasticFOM &fom, Mat K);
+  PetscErrorCode TaoPhase(Vec b, Vec lambda, PetscBool warm, DualShellInfo *info);
+  std::string   taoPrefix_; // "fom_": the TAO's prefix
   std::string   prefix_;
   KSP           ksp_ = nullptr;
   Mat           S_   = nullptr;

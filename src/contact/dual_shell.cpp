@@ -2,9 +2,11 @@
 // MATSHELL (one back-solve per product), solved by a primal-dual active-set method with CG on the
 // free set (see rbcontact/dual_shell.hpp).
 #include "rbcontact/dual_shell.hpp"
+#include "rbcontact/tao_recipe.hpp"
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <unordered_map>
 
 namespace rbc {
@@ -75,6 +77,203 @@ static PetscErrorCode MaskedDiagonal(Mat S, Vec diag)
   PetscFunctionReturn(0);
 }
 
+// --- TAO phase: the Jacobi-equilibrated QP min_{y >= 0} 1/2 y'(D S D)y - bs'y, D = diag(d)^{-1/2},
+// bs = D b / |D b|, lambda = |D b| D y; its Hessian a MATSHELL of the full S (no mask) -----------------
+
+struct TaoHessCtx {
+  DualShellCtx *c     = nullptr;
+  Vec           s     = nullptr; // D
+  Vec           bs    = nullptr; // scaled b
+  Vec           xs    = nullptr; // work
+  Vec           shift = nullptr; // diagonal shift set by TAO (MatDiagonalSet / MatShift)
+};
+
+// y = D S D x (one product)
+static PetscErrorCode ScaledS(TaoHessCtx *t, Vec x, Vec y)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecPointwiseMult(t->xs, t->s, x));
+  PetscCall(ApplyS(t->c, t->xs, y));
+  PetscCall(VecPointwiseMult(y, y, t->s));
+  PetscFunctionReturn(0);
+}
+
+// (D S D + diag(shift)) x
+static PetscErrorCode TaoHessMult(Mat H, Vec x, Vec y)
+{
+  TaoHessCtx *t;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(H, &t));
+  PetscCall(ScaledS(t, x, y));
+  PetscCall(VecPointwiseMult(t->xs, t->shift, x));
+  PetscCall(VecAXPY(y, 1.0, t->xs));
+  PetscFunctionReturn(0);
+}
+
+// diag(D S D) estimated by d_i / d_i = 1 (exact with -fom_dual_diag exact), plus the shift
+static PetscErrorCode TaoHessDiagonal(Mat H, Vec v)
+{
+  TaoHessCtx *t;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(H, &t));
+  PetscCall(VecCopy(t->shift, v));
+  PetscCall(VecShift(v, 1.0));
+  PetscFunctionReturn(0);
+}
+
+// The shifts are ours, not MATSHELL's: PETSc 3.18's MATSHELL drops its own MatDiagonalSet / MatShift
+// shifts in MatAssemblyEnd (MAT_FINAL_ASSEMBLY), and BQPIP assembles right after shifting, so with the
+// native shifts its Newton systems lost the barrier term and it diverged (objective rising, residual
+// stuck). INSERT_VALUES sets the diagonal to D, i.e. shift = D - 1 (BQPIP restores to exactly 0).
+static PetscErrorCode TaoHessDiagonalSet(Mat H, Vec D, InsertMode mode)
+{
+  TaoHessCtx *t;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(H, &t));
+  if (mode == INSERT_VALUES) {
+    PetscCall(VecCopy(D, t->shift));
+    PetscCall(VecShift(t->shift, -1.0));
+  } else PetscCall(VecAXPY(t->shift, 1.0, D));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoHessShift(Mat H, PetscScalar a)
+{
+  TaoHessCtx *t;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(H, &t));
+  PetscCall(VecShift(t->shift, a));
+  PetscFunctionReturn(0);
+}
+
+// H(is, is) for TRON and GPCG (-fom_tao_subset_type subvec, the default): a MATSHELL that scatters into
+// a full vector, multiplies by H (with its shifts, if any) and gathers.
+struct TaoSubCtx {
+  Mat H  = nullptr;
+  IS  is = nullptr;
+  Vec xf = nullptr, yf = nullptr;
+};
+
+static PetscErrorCode TaoSubMult(Mat M, Vec x, Vec y)
+{
+  TaoSubCtx *sc;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(M, &sc));
+  PetscCall(VecSet(sc->xf, 0.0));
+  PetscCall(VecISCopy(sc->xf, sc->is, SCATTER_FORWARD, x));
+  PetscCall(MatMult(sc->H, sc->xf, sc->yf));
+  PetscCall(VecISCopy(sc->yf, sc->is, SCATTER_REVERSE, y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoSubDiagonal(Mat M, Vec v)
+{
+  TaoSubCtx *sc;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(M, &sc));
+  PetscCall(MatGetDiagonal(sc->H, sc->yf));
+  PetscCall(VecISCopy(sc->yf, sc->is, SCATTER_REVERSE, v));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoSubDestroy(Mat M)
+{
+  TaoSubCtx *sc;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(M, &sc));
+  PetscCall(ISDestroy(&sc->is));
+  PetscCall(VecDestroy(&sc->xf));
+  PetscCall(VecDestroy(&sc->yf));
+  delete sc;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoHessSubMatrix(Mat H, IS isrow, IS iscol, MatReuse reuse, Mat *B)
+{
+  PetscBool same;
+  PetscInt  nloc, N;
+
+  PetscFunctionBeginUser;
+  PetscCall(ISEqual(isrow, iscol, &same));
+  PetscCheck(same, PetscObjectComm((PetscObject)H), PETSC_ERR_SUP, "Dual TAO Hessian shell: only square submatrices H(is, is)");
+  PetscCall(ISGetLocalSize(isrow, &nloc));
+  PetscCall(ISGetSize(isrow, &N));
+  if (reuse == MAT_REUSE_MATRIX) {
+    TaoSubCtx *sc;
+    PetscInt   m, M;
+    PetscCall(MatGetLocalSize(*B, &m, NULL));
+    PetscCall(MatGetSize(*B, &M, NULL));
+    PetscCheck(m == nloc && M == N, PetscObjectComm((PetscObject)H), PETSC_ERR_ARG_SIZ, "Dual TAO Hessian shell: MAT_REUSE_MATRIX with another size");
+    PetscCall(MatShellGetContext(*B, &sc));
+    PetscCall(PetscObjectReference((PetscObject)isrow));
+    PetscCall(ISDestroy(&sc->is));
+    sc->is = isrow;
+    PetscFunctionReturn(0);
+  }
+  auto *sc = new TaoSubCtx;
+  sc->H    = H;
+  sc->is   = isrow;
+  PetscCall(PetscObjectReference((PetscObject)isrow));
+  PetscCall(MatCreateVecs(H, &sc->xf, &sc->yf));
+  PetscCall(MatCreateShell(PetscObjectComm((PetscObject)H), nloc, nloc, N, N, sc, B));
+  PetscCall(MatShellSetOperation(*B, MATOP_MULT, (void (*)(void))TaoSubMult));
+  PetscCall(MatShellSetOperation(*B, MATOP_GET_DIAGONAL, (void (*)(void))TaoSubDiagonal));
+  PetscCall(MatShellSetOperation(*B, MATOP_DESTROY, (void (*)(void))TaoSubDestroy));
+  PetscCall(MatSetOption(*B, MAT_SPD, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoObjGrad(Tao, Vec y, PetscReal *f, Vec g, void *ctx)
+{
+  TaoHessCtx *t = static_cast<TaoHessCtx *>(ctx);
+  PetscScalar yHy, by;
+
+  PetscFunctionBeginUser;
+  PetscCall(ScaledS(t, y, g));
+  PetscCall(VecDot(y, g, &yHy));
+  PetscCall(VecDot(y, t->bs, &by));
+  *f = 0.5 * PetscRealPart(yHy) - PetscRealPart(by);
+  PetscCall(VecAXPY(g, -1.0, t->bs));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode TaoHessNoop(Tao, Vec, Mat, Mat, void *)
+{
+  PetscFunctionBeginUser;
+  PetscFunctionReturn(0);
+}
+
+// The inner KSP of the TAO (if its type has one): prefix fom_dual_tao_ (not fom_, the prefix of the
+// FOM's own Cholesky KSP), jacobi (the Hessian is a shell: no factorization), cg for BQPIP (the recipe's
+// preonly + cholesky needs an assembled matrix). Again after TaoSetFromOptions if -fom_tao_type made a new KSP.
+static PetscErrorCode ConfigureTaoKSP(Tao tao, const std::string &kspPrefix)
+{
+  KSP         ksp;
+  PC          pc;
+  const char *pre;
+  PetscBool   bqpip;
+
+  PetscFunctionBeginUser;
+  PetscCall(TaoGetKSP(tao, &ksp));
+  if (!ksp) PetscFunctionReturn(0);
+  PetscCall(KSPGetOptionsPrefix(ksp, &pre));
+  if (pre && kspPrefix == pre) PetscFunctionReturn(0);
+  PetscCall(KSPSetOptionsPrefix(ksp, kspPrefix.c_str()));
+  PetscCall(PetscObjectTypeCompare((PetscObject)tao, TAOBQPIP, &bqpip));
+  if (bqpip) PetscCall(KSPSetType(ksp, KSPCG));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCJACOBI));
+  PetscCall(KSPSetFromOptions(ksp));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode DestroyCtx(DualShellCtx **c)
 {
   PetscFunctionBeginUser;
@@ -114,7 +313,16 @@ PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string 
   PetscCall(PetscOptionsReal("-pdas_tol", "Add a multiplier when its scaled gradient is below -tol |b|", NULL, setTol, &setTol, NULL));
   PetscCall(PetscOptionsBool("-pdas_monitor", "Print each active-set step", NULL, monitor, &monitor, NULL));
   PetscCall(PetscOptionsString("-diag", "Jacobi diagonal: lumped (diag(K diag(A)^-1 K^T)) or exact (R products)", NULL, dtype, dtype, sizeof dtype, &set));
+  PetscCall(PetscOptionsBool("-shell_tao", "TAO (-fom_tao_type, default bqpip) on the shell first, its support starts the active-set method", NULL, useTao, &useTao, NULL));
+  PetscCall(PetscOptionsBool("-shell_tao_warm", "Run the TAO phase on warm starts too (default: only when there is no previous support)", NULL, taoWarm, &taoWarm, NULL));
+  PetscCall(PetscOptionsReal("-shell_tao_support", "TAO entries above this times their max start the free set", NULL, taoSupport, &taoSupport, NULL));
   PetscOptionsEnd();
+  taoPrefix_ = prefix;
+  {
+    char tt[64] = "";
+    PetscCall(PetscOptionsGetString(NULL, taoPrefix_.c_str(), "-tao_type", tt, sizeof tt, NULL));
+    if (!strcmp(tt, "activeset")) useTao = PETSC_FALSE; // as in dense mode: the active-set method alone
+  }
   diag = dtype;
   PetscCheck(diag == "lumped" || diag == "exact", comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sdiag %s: use lumped or exact", prefix_.c_str(), dtype);
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it must be >= 1", prefix_.c_str());
@@ -227,6 +435,106 @@ PetscErrorCode DualShellSolver::Diagonal(ElasticFOM &fom, Mat K)
   PetscFunctionReturn(0);
 }
 
+// TAO on the equilibrated QP; lambda (in: a warm start if warm) out: TAO's answer, >= 0, entries at or
+// below taoSupport * max set to 0 (all 0 if TAO gave nothing usable: the active-set method starts cold).
+PetscErrorCode DualShellSolver::TaoPhase(Vec b, Vec lambda, PetscBool warm, DualShellInfo *info)
+{
+  MPI_Comm   comm = PetscObjectComm((PetscObject)b);
+  TaoHessCtx t;
+  Tao        tao;
+  Mat        H;
+  Vec        y, lo, hi;
+  PetscInt   m, M;
+  PetscReal  bsnorm;
+  const PetscInt p0 = ctx_->products;
+
+  PetscFunctionBeginUser;
+  t.c = ctx_;
+  PetscCall(VecDuplicate(b, &t.s));
+  PetscCall(VecDuplicate(b, &t.bs));
+  PetscCall(VecDuplicate(b, &t.xs));
+  PetscCall(VecDuplicate(b, &y));
+  PetscCall(VecDuplicate(b, &lo));
+  PetscCall(VecDuplicate(b, &hi));
+  PetscCall(VecCopy(ctx_->d, t.s));
+  PetscCall(VecSqrtAbs(t.s));
+  PetscCall(VecReciprocal(t.s));
+  PetscCall(VecPointwiseMult(t.bs, t.s, b));
+  PetscCall(VecNorm(t.bs, NORM_2, &bsnorm));
+  PetscCall(VecScale(t.bs, 1.0 / bsnorm));
+  // y = D^{-1} lambda / |D b| (a warm start for the TAO types that use one; BQPIP only clamps it)
+  if (warm) {
+    PetscCall(VecPointwiseDivide(y, lambda, t.s));
+    PetscCall(VecScale(y, 1.0 / bsnorm));
+  } else PetscCall(VecSet(y, 0.0));
+  PetscCall(VecSet(lo, 0.0));
+  PetscCall(VecSet(hi, PETSC_INFINITY));
+  // A new Hessian shell per solve (cheap): nothing survives from an earlier TaoSolve
+  PetscCall(VecGetLocalSize(b, &m));
+  PetscCall(VecGetSize(b, &M));
+  PetscCall(VecDuplicate(b, &t.shift));
+  PetscCall(VecSet(t.shift, 0.0));
+  PetscCall(MatCreateShell(comm, m, m, M, M, &t, &H));
+  PetscCall(MatShellSetManageScalingShifts(H)); // the shifts below (see TaoHessDiagonalSet)
+  PetscCall(MatShellSetOperation(H, MATOP_MULT, (void (*)(void))TaoHessMult));
+  PetscCall(MatShellSetOperation(H, MATOP_DIAGONAL_SET, (void (*)(void))TaoHessDiagonalSet));
+  PetscCall(MatShellSetOperation(H, MATOP_SHIFT, (void (*)(void))TaoHessShift));
+  PetscCall(MatShellSetOperation(H, MATOP_GET_DIAGONAL, (void (*)(void))TaoHessDiagonal));
+  PetscCall(MatShellSetOperation(H, MATOP_CREATE_SUBMATRIX, (void (*)(void))TaoHessSubMatrix));
+  PetscCall(MatSetOption(H, MAT_SPD, PETSC_TRUE));
+  PetscCall(MatAssemblyBegin(H, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(H, MAT_FINAL_ASSEMBLY));
+
+  const std::string kspPrefix = prefix_ + "tao_"; // fom_dual_tao_
+  PetscCall(TaoCreate(comm, &tao));
+  PetscCall(TaoSetOptionsPrefix(tao, taoPrefix_.c_str()));
+  PetscCall(TaoBQPIPRecipe(tao));                // BQPIP, gatol 1e-7, grtol 0 (then the KSP below)
+  PetscCall(TaoSetMaximumIterations(tao, 50));   // a start for the active-set method, not the answer
+  PetscCall(ConfigureTaoKSP(tao, kspPrefix));
+  PetscCall(TaoSetSolution(tao, y));
+  PetscCall(TaoSetObjectiveAndGradient(tao, NULL, TaoObjGrad, &t));
+  PetscCall(TaoSetHessian(tao, H, H, TaoHessNoop, &t));
+  PetscCall(TaoSetVariableBounds(tao, lo, hi));
+  PetscCall(TaoSetFromOptions(tao));
+  PetscCall(ConfigureTaoKSP(tao, kspPrefix));
+  PetscCall(TaoSolve(tao));
+  PetscCall(TaoGetConvergedReason(tao, &info->taoReason));
+  PetscCall(TaoGetIterationNumber(tao, &info->taoIterations));
+  PetscCall(TaoGetLinearSolveIterations(tao, &info->taoKSP));
+  info->taoProducts = ctx_->products - p0;
+  PetscCall(VecNorm(t.shift, NORM_INFINITY, &info->taoShiftDrift)); // BQPIP restores its shifts
+  PetscCall(TaoDestroy(&tao));
+  PetscCall(MatDestroy(&H));
+  // lambda = |D b| D y, clipped at 0; entries <= taoSupport * max are zeros of an interior point
+  PetscReal ymax, ynorm;
+  PetscCall(VecNorm(y, NORM_2, &ynorm));
+  PetscCall(VecPointwiseMult(lambda, t.s, y));
+  PetscCall(VecScale(lambda, bsnorm));
+  PetscCall(VecMax(lambda, NULL, &ymax));
+  PetscInt n, cnt = 0;
+  PetscCall(VecGetLocalSize(lambda, &n));
+  {
+    PetscScalar *l;
+    PetscCall(VecGetArray(lambda, &l));
+    for (PetscInt i = 0; i < n; ++i) {
+      if (!(PetscIsNormalReal(ynorm) && ymax > 0) || !(PetscRealPart(l[i]) > taoSupport * ymax)) l[i] = 0;
+      else ++cnt;
+    }
+    PetscCall(VecRestoreArray(lambda, &l));
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cnt, 1, MPIU_INT, MPI_SUM, comm));
+  info->taoSupport = cnt;
+  if (monitor) PetscCall(PetscPrintf(comm, "      dual TAO phase: %" PetscInt_FMT " its (%s), %" PetscInt_FMT " KSP its, %" PetscInt_FMT " products; support %" PetscInt_FMT " (> %g max); shift left on the Hessian shell %.1e\n", info->taoIterations, TaoConvergedReasons[info->taoReason], info->taoKSP, info->taoProducts, cnt, (double)taoSupport, (double)info->taoShiftDrift));
+  PetscCall(VecDestroy(&t.s));
+  PetscCall(VecDestroy(&t.bs));
+  PetscCall(VecDestroy(&t.xs));
+  PetscCall(VecDestroy(&t.shift));
+  PetscCall(VecDestroy(&y));
+  PetscCall(VecDestroy(&lo));
+  PetscCall(VecDestroy(&hi));
+  PetscFunctionReturn(0);
+}
+
 // Order-independent fingerprint of a distributed index set (cycle detection).
 static PetscErrorCode SetFingerprint(MPI_Comm comm, PetscInt lo, const std::vector<char> &F, uint64_t *h, PetscInt *count)
 {
@@ -300,10 +608,17 @@ PetscErrorCode DualShellSolver::Solve(ElasticFOM &fom, Mat K, Vec b, Vec lambda,
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bscale, 1, MPIU_REAL, MPIU_MAX, comm));
   }
   PetscCall(VecNorm(b, NORM_2, &bnorm));
-  // First free set: warm, the previous Kacanov iterate's support (lambda > 0), lambda its start for CG;
-  // cold (or no previous contact): F = {b_i > 0}, the first semismooth Newton step from lambda = 0.
+  // TAO phase (cold starts; warm ones too with -fom_dual_shell_tao_warm): lambda = its support
   PetscReal lmax = 0;
   if (warm) PetscCall(VecMax(lambda, NULL, &lmax));
+  if (useTao && (!(lmax > 0) || taoWarm)) {
+    PetscCall(TaoPhase(b, lambda, lmax > 0 ? PETSC_TRUE : PETSC_FALSE, info));
+    PetscCall(VecMax(lambda, NULL, &lmax));
+    warm = PETSC_TRUE;
+  }
+  // First free set: warm, the previous Kacanov iterate's (or TAO's) support (lambda > 0), lambda its
+  // start for CG; cold (or no previous contact): F = {b_i > 0}, the first semismooth Newton step from 0.
+  if (!warm) lmax = 0;
   {
     PetscScalar       *l;
     const PetscScalar *ba;

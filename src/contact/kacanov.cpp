@@ -350,7 +350,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     history.dl.push_back(dl);
     history.nactive.push_back(nact);
     iterations = k;
-    if (monitor && shell) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (dual shell: active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt));
+    if (monitor && shell) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (dual shell: TAO its %" PetscInt_FMT " (%" PetscInt_FMT " products), active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastShell.taoIterations, lastShell.taoProducts, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt));
     else if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
