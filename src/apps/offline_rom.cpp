@@ -9,6 +9,7 @@
 #include "rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/training_set.hpp"
 #include <slepcbv.h>
 #include <algorithm>
 #include <cmath>
@@ -167,6 +168,30 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     rm.warmV.insert(rm.warmV.end(), sol.v.begin(), sol.v.end());
     rm.warmL.insert(rm.warmL.end(), sol.lambda.begin(), sol.lambda.end());
   }
+  // optional extra parameters for the EIM only (-eim_train_type ...): no FOM solve, the reduced loop
+  // with exact contact terms is cheap, and its iterates widen what the EIM is trained on
+  PetscBool extraSet = PETSC_FALSE;
+  PetscInt  nExtra   = 0;
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_train_type", &extraSet));
+  if (extraSet) {
+    ParameterSet extra;
+    PetscCall(ParameterSetFromOptions(world, fom.scene.params, "eim_train_", &extra));
+    for (const auto &mu : extra.points) {
+      full->SetGeometry(&fom.map, mu);
+      ReducedSolution sol;
+      PetscCall(rm.Solve(mu, &sol));
+      PetscCheck(sol.converged, world, PETSC_ERR_NOT_CONVERGED, "offline: the reduced model with exact contact terms fails at an -eim_train_ parameter: %s", sol.message.c_str());
+      nRomIts += sol.iterations;
+      maxRomIts = std::max(maxRomIts, sol.iterations);
+      for (PetscInt it = 0; it < sol.iterations; ++it) {
+        full->SetReduced(&sol.iterates[(size_t)it * N]);
+        Append(*full, &Sk, &Sg, &hits, &all, &kap, &gam, &hit);
+      }
+      full->SetReduced(sol.v.data());
+      Append(*full, &Sk, &Sg, &hits, &all, &kap, &gam, &hit);
+      ++nExtra;
+    }
+  }
   const PetscInt ms = (PetscInt)(Sg.size() / Q);
   PetscCall(PetscTime(&t1));
 
@@ -269,6 +294,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   e["quadrature_points"]    = (long long)Q;
   e["quadrature_subdivisions"] = (long long)nsub;
   e["snapshots"]            = (long long)ms;
+  e["extra_parameters"]     = (long long)nExtra;
   e["rom_kacanov_iterations"]["total"] = (long long)nRomIts;
   e["rom_kacanov_iterations"]["max"]   = (long long)maxRomIts;
   JsonValue &k = e["kappa"];
