@@ -16,6 +16,7 @@
 //   algorithms, options and measured numbers: docs/dual_basis.md.
 #pragma once
 #include <petsctao.h>
+#include "rbcontact/tao_recipe.hpp"
 #include <string>
 #include <vector>
 
@@ -69,7 +70,6 @@ public:
   PetscErrorCode Reset(); // destroys the cached Tao and problem data
 
 private:
-  static PetscErrorCode ObjGrad(Tao, Vec, PetscReal *, Vec, void *);
   PetscErrorCode SetupTao(PetscInt n);
   PetscErrorCode SolveTao(const std::vector<PetscReal> &H, const std::vector<PetscReal> &c, PetscBool bounded, PetscReal gatolFactor, std::vector<PetscReal> *y, PetscInt *its, TaoConvergedReason *reason);
 
@@ -78,6 +78,7 @@ private:
   Tao       tao_ = nullptr;
   Mat       H_   = nullptr;
   Vec       x_ = nullptr, c_ = nullptr, lo_ = nullptr, hi_ = nullptr;
+  TaoQuadratic quad_; // H_, c_ for TAO
   PetscInt  n_ = -1;
   // equilibrated copy of the last Q (reused while Q does not change, e.g. all snapshots of a greedy step)
   DenseMatrix            lastQ_, Qs_;

@@ -8,6 +8,7 @@
 // Implementation: src/rom/reduced_qp.cpp; method, options, statuses and timings: docs/reduced_qp.md.
 #pragma once
 #include <petsctao.h>
+#include "rbcontact/tao_recipe.hpp"
 #include <string>
 #include <vector>
 
@@ -87,6 +88,7 @@ private:
   // TAO cross-check
   Tao tao_ = nullptr;
   Mat H_   = nullptr;
+  TaoQuadratic quad_; // H_, cv_ for TAO
   Vec x_ = nullptr, cv_ = nullptr, lo_ = nullptr, hi_ = nullptr;
   PetscInt taoR_ = -1;
 };

@@ -9,4 +9,12 @@ namespace rbc {
 // Sets type BQPIP, the tolerances and the inner KSP/PC on tao (before TaoSetFromOptions, so that the
 // options of its prefix still override everything).
 PetscErrorCode TaoBQPIPRecipe(Tao tao);
+
+// The quadratic objective 1/2 x'Hx - c'x with gradient Hx - c and the constant Hessian H (filled in
+// before TaoSolve). q must outlive the solves.
+struct TaoQuadratic {
+  Mat H = nullptr;
+  Vec c = nullptr;
+};
+PetscErrorCode TaoSetQuadratic(Tao tao, TaoQuadratic *q);
 } // namespace rbc

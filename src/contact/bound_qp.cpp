@@ -1,6 +1,7 @@
 // src/contact/bound_qp.cpp: dense bound-constrained QP solvers: the active-set method and the TAO
 // (BQPIP by default) driver with equilibration and active-set polish.
 #include "rbcontact/bound_qp.hpp"
+#include "rbcontact/tao_recipe.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
 #include <cmath>
@@ -111,31 +112,6 @@ PetscErrorCode BoundQPActiveSet(PetscInt n, const PetscReal *H, const PetscReal 
 
 // --- TAO driver -------------------------------------------------------------------------------
 
-struct QPCtx {
-  Mat H;
-  Vec c;
-};
-
-static PetscErrorCode QPObjGrad(Tao tao, Vec x, PetscReal *f, Vec g, void *ctx)
-{
-  QPCtx      *q = static_cast<QPCtx *>(ctx);
-  PetscScalar xHx, cx;
-
-  PetscFunctionBeginUser;
-  PetscCall(MatMult(q->H, x, g));
-  PetscCall(VecDot(x, g, &xHx));
-  PetscCall(VecDot(x, q->c, &cx));
-  *f = 0.5 * PetscRealPart(xHx) - PetscRealPart(cx);
-  PetscCall(VecAXPY(g, -1.0, q->c));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode QPHess(Tao tao, Vec x, Mat H, Mat Hpre, void *ctx)
-{
-  PetscFunctionBeginUser;
-  PetscFunctionReturn(0);
-}
-
 DualQPSolver::~DualQPSolver() = default;
 
 PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
@@ -181,7 +157,7 @@ PetscErrorCode DualQPSolver::Solve(PetscInt R, const std::vector<PetscReal> &S, 
     Tao   tao;
     Mat   H;
     Vec   x, c, lo, hi;
-    QPCtx ctx;
+    TaoQuadratic ctx;
     PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, R, R, NULL, &H));
     PetscScalar *h;
     PetscCall(MatDenseGetArrayWrite(H, &h));
@@ -204,24 +180,10 @@ PetscErrorCode DualQPSolver::Solve(PetscInt R, const std::vector<PetscReal> &S, 
     ctx.c = c;
     PetscCall(TaoCreate(PETSC_COMM_SELF, &tao));
     PetscCall(TaoSetOptionsPrefix(tao, prefix_.c_str()));
-    PetscCall(TaoSetType(tao, TAOBQPIP));
     PetscCall(TaoSetSolution(tao, x));
-    PetscCall(TaoSetObjectiveAndGradient(tao, NULL, QPObjGrad, &ctx));
-    PetscCall(TaoSetHessian(tao, H, H, QPHess, &ctx));
+    PetscCall(TaoSetQuadratic(tao, &ctx));
     PetscCall(TaoSetVariableBounds(tao, lo, hi));
-    // BQPIP's default relative test fires spuriously (shared/notes/nnls-with-bqpip.md): absolute only.
-    PetscCall(TaoSetTolerances(tao, 1e-7, 0.0, 0.0)); // BQPIP stalls near 3e-8; the polish makes it exact
-    PetscCall(TaoSetMaximumIterations(tao, 200));
-    {
-      KSP ksp;
-      PC  pc;
-      PetscCall(TaoGetKSP(tao, &ksp));
-      if (ksp) {
-        PetscCall(KSPSetType(ksp, KSPPREONLY));
-        PetscCall(KSPGetPC(ksp, &pc));
-        PetscCall(PCSetType(pc, PCCHOLESKY));
-      }
-    }
+    PetscCall(TaoBQPIPRecipe(tao)); // the polish makes the answer exact
     PetscCall(TaoSetFromOptions(tao));
     PetscCall(TaoSolve(tao));
     PetscCall(TaoGetConvergedReason(tao, &info->taoReason));

@@ -193,26 +193,6 @@ PetscReal NNLSKKT(const DenseMatrix &Q, const std::vector<PetscReal> &b, const s
 
 // --- NNLSSolver ------------------------------------------------------------------------------------
 
-// f = 1/2 x'Hx - c'x and its gradient; ctx is the solver (H_, c_ hold the current problem).
-PetscErrorCode NNLSSolver::ObjGrad(Tao tao, Vec x, PetscReal *f, Vec g, void *ctx)
-{
-  NNLSSolver *s = static_cast<NNLSSolver *>(ctx);
-  PetscScalar xHx, cx;
-
-  PetscFunctionBeginUser;
-  PetscCall(MatMult(s->H_, x, g));
-  PetscCall(VecDot(x, g, &xHx));
-  PetscCall(VecDot(x, s->c_, &cx));
-  *f = 0.5 * PetscRealPart(xHx) - PetscRealPart(cx);
-  PetscCall(VecAXPY(g, -1.0, s->c_));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode QPHessian(Tao tao, Vec x, Mat H, Mat Hpre, void *ctx)
-{
-  PetscFunctionBeginUser; // constant Hessian, filled in before TaoSolve
-  PetscFunctionReturn(0);
-}
 
 NNLSSolver::~NNLSSolver()
 {
@@ -274,10 +254,10 @@ PetscErrorCode NNLSSolver::SetupTao(PetscInt n)
   PetscCall(VecDuplicate(x_, &hi_));
   PetscCall(TaoCreate(PETSC_COMM_SELF, &tao_));
   PetscCall(TaoSetOptionsPrefix(tao_, "nnls_"));
-  PetscCall(TaoSetType(tao_, TAOBQPIP));
   PetscCall(TaoSetSolution(tao_, x_));
-  PetscCall(TaoSetObjectiveAndGradient(tao_, NULL, ObjGrad, this));
-  PetscCall(TaoSetHessian(tao_, H_, H_, QPHessian, NULL));
+  quad_.H = H_;
+  quad_.c = c_;
+  PetscCall(TaoSetQuadratic(tao_, &quad_));
   PetscCall(TaoSetVariableBounds(tao_, lo_, hi_));
   // The notes' recipe: absolute test only (the relative one fires spuriously), gatol 1e-7 (BQPIP's
   // measure stalls near 3e-8), at most 200 iterations, inner Cholesky.

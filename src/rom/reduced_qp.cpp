@@ -520,20 +520,10 @@ PetscErrorCode ReducedQP::SetupTao(PetscInt R)
   PetscCall(VecSet(hi_, PETSC_INFINITY));
   PetscCall(TaoCreate(PETSC_COMM_SELF, &tao_));
   PetscCall(TaoSetOptionsPrefix(tao_, (prefix_ + "qp_").c_str()));
-  PetscCall(TaoSetType(tao_, TAOBQPIP));
   PetscCall(TaoSetSolution(tao_, x_));
-  PetscCall(TaoSetObjectiveAndGradient(tao_, NULL, [](Tao, Vec x, PetscReal *fx, Vec g, void *ctx) -> PetscErrorCode {
-    ReducedQP  *qp = static_cast<ReducedQP *>(ctx);
-    PetscScalar xHx, cx;
-    PetscFunctionBeginUser;
-    PetscCall(MatMult(qp->H_, x, g));
-    PetscCall(VecDot(x, g, &xHx));
-    PetscCall(VecDot(x, qp->cv_, &cx));
-    *fx = 0.5 * PetscRealPart(xHx) - PetscRealPart(cx);
-    PetscCall(VecAXPY(g, -1.0, qp->cv_));
-    PetscFunctionReturn(0);
-  }, this));
-  PetscCall(TaoSetHessian(tao_, H_, H_, [](Tao, Vec, Mat, Mat, void *) -> PetscErrorCode { return 0; }, NULL));
+  quad_.H = H_;
+  quad_.c = cv_;
+  PetscCall(TaoSetQuadratic(tao_, &quad_));
   PetscCall(TaoSetVariableBounds(tao_, lo_, hi_));
   // shared/notes/nnls-with-bqpip.md: absolute test only (the relative one fires spuriously), gatol 1e-7
   // (BQPIP's measure stalls near 3e-8), at most 200 iterations, inner Cholesky. Equilibration is done
