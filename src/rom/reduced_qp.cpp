@@ -15,6 +15,22 @@
 namespace rbc {
 
 namespace {
+// ||M||_inf of an m x n column-major matrix (rows: work space of m); false if an entry or a row sum
+// is not finite.
+bool MaxRowSum(PetscInt m, PetscInt n, const PetscReal *M, PetscReal *rows, PetscReal *norm)
+{
+  bool finite = true;
+  *norm       = 0;
+  for (PetscInt i = 0; i < m; ++i) rows[i] = 0;
+  for (PetscInt j = 0; j < n; ++j)
+    for (PetscInt i = 0; i < m; ++i) rows[i] += std::abs(M[i + j * m]);
+  for (PetscInt i = 0; i < m; ++i) {
+    finite = finite && std::isfinite(rows[i]);
+    *norm  = std::max(*norm, rows[i]);
+  }
+  return finite;
+}
+
 // Free-set pivot test on the unit-diagonal S: a constraint whose column makes S_PP's new Cholesky
 // pivot^2 (= sin^2 of its angle to the span of the free ones, in the A^{-1} inner product) smaller
 // than this is treated as linearly dependent on the free set.
@@ -180,15 +196,7 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
   const bool hitD = hitA && cachedD_ && cR_ == R && !std::memcmp(D, Dc_.data(), sizeof(PetscReal) * R * N);
   if (!hitA) {
     cachedA_ = cachedD_ = false;
-    normA_              = 0;
-    // row sums of |A| (a NaN or Inf entry makes its row sum non-finite)
-    for (PetscInt i = 0; i < N; ++i) tN_[i] = 0;
-    for (PetscInt j = 0; j < N; ++j)
-      for (PetscInt i = 0; i < N; ++i) tN_[i] += std::abs(A[i + j * N]);
-    for (PetscInt i = 0; i < N; ++i) {
-      finite = finite && std::isfinite(tN_[i]);
-      normA_ = std::max(normA_, tN_[i]);
-    }
+    finite              = MaxRowSum(N, N, A, tN_.data(), &normA_) && finite;
     PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in A (or a row sum overflows)");
     // A = L L'
     PetscReal amax = 0;
@@ -215,14 +223,7 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
   }
   if (!hitD) {
     cachedD_ = false;
-    normD_   = 0;
-    for (PetscInt i = 0; i < R; ++i) tR_[i] = 0;
-    for (PetscInt j = 0; j < N; ++j)
-      for (PetscInt i = 0; i < R; ++i) tR_[i] += std::abs(D[i + j * R]);
-    for (PetscInt i = 0; i < R; ++i) {
-      finite = finite && std::isfinite(tR_[i]);
-      normD_ = std::max(normD_, tR_[i]);
-    }
+    finite   = MaxRowSum(R, N, D, tR_.data(), &normD_) && finite;
     PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in D (or a row sum overflows)");
     // GT = D L^{-T} (R x N; GT' = L^{-1} D'), then the lower triangle of S = GT GT'
     RightSolveT(R, N, L_.data(), D, G_.data());
