@@ -118,6 +118,7 @@ private:
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;
   ContactPatch           active_;                     // patch with the active basis columns
   std::vector<PetscInt>  evalPoints_, kPos_, gPos_;   // unique patch points evaluated, positions
+  PetscInt               nkEval_ = 0;                 // evalPoints_[0, nkEval_) carry kappa points
   std::vector<PetscReal> A_, f_, Kc_, Gc_, KB_, GB_;  // active operators
   std::vector<PetscReal> kap_, gam_, phi_, vals_, K_, g_, Ath_, fth_;
   std::vector<PetscReal> thA_, thF_;

@@ -351,6 +351,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     return (PetscInt)evalPoints_.size() - 1;
   };
   for (PetscInt j = 0; j < mk; ++j) kPos_[j] = pos(kPoint[j]);
+  nkEval_ = (PetscInt)evalPoints_.size(); // the points needing kappa come first
   for (PetscInt j = 0; j < mg; ++j) gPos_[j] = pos(gPoint[j]);
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
@@ -439,7 +440,9 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       geomMu_ = mu;
     }
     patch.SetReduced(vfull.data());
-    out = patch.Evaluate(evalPoints_.data(), np, kap_.data(), gam_.data(), nullptr);
+    // kappa (all modes) only where an EIM point of kappa is; the gap alone elsewhere
+    out = patch.Evaluate(evalPoints_.data(), nkEval_, kap_.data(), gam_.data(), nullptr);
+    out += patch.Evaluate(evalPoints_.data() + nkEval_, np - nkEval_, nullptr, gam_.data() + nkEval_, nullptr);
   }
   if (kappaConst) {
     for (PetscInt c = 0; c < Na; ++c)
