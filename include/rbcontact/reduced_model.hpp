@@ -26,6 +26,7 @@ public:
   PetscErrorCode FromFOM(const Elasticity &elas, const GeometryMap &map, const AffineDecomposition &aff);
   void           Write(RomWriter *w) const;
   PetscErrorCode Read(const std::string &file);
+  // Coefficient values at mu (after FromFOM or Read).
   void           ThetaA(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
   void           ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
   // A clear error naming the parameter, the value and the box when mu is outside it (or has the wrong size).
@@ -40,7 +41,7 @@ public:
   std::vector<Coefficient> thetaA, thetaF;
 
 private:
-  void Light(); // the parameter-only Elasticity the coefficients evaluate with
+  void Light(); // (re)builds the parameter-only Elasticity the coefficients evaluate with (FromFOM, Read)
   std::shared_ptr<Elasticity> light_;
 };
 

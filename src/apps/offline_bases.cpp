@@ -49,7 +49,7 @@ void WriteDualBasis(const DualBasisResult &dual, RomWriter *w, bool withBasis)
   w->Dataset("/dual/selected", {dual.selected.size()}, std::vector<double>(dual.selected.begin(), dual.selected.end()));
 }
 
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, const CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, const std::string &basisPath)
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, const std::string &basisPath)
 {
   PetscMPIInt    wrank;
   PetscLogDouble t0, t1, t2;

@@ -40,7 +40,7 @@ static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscR
   return *spread <= 1e-13;
 }
 
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, const CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
 {
   PetscLogDouble t0, t1, t2;
   PetscMPIInt    wrank;
@@ -109,7 +109,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     for (PetscInt i = 0; i < Rfom; ++i) Wt[(size_t)k * Rfom + i] = dual.W(i, k);
   std::shared_ptr<ContactPatch> full;
   std::vector<PetscReal>        P;
-  PetscCall(BuildFullContact(fom, cmap, const_cast<CanonicalOrder &>(order), modes, N, Wt, R, nsub, &full, &P));
+  PetscCall(BuildFullContact(fom, cmap, order, modes, N, Wt, R, nsub, &full, &P));
   {
     bool bcParam = false, uDnonzero = false;
     for (const auto &d : fom.scene.dirichlet) bcParam = bcParam || d.param >= 0;

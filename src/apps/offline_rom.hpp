@@ -13,7 +13,8 @@
 namespace rbc {
 
 // V: the primal basis (Npod POD modes then nsup supremizers) on fom's DM; modes: the same, N x ndofs
-// row-major in canonical order, on every rank of fom's communicator. Report keys eim {...}, rom {...}.
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, const CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep);
+// row-major in canonical order, on every rank of fom's communicator. order's multipliers are numbered
+// here when a resumed run solved no snapshot. Report keys eim {...}, rom {...}.
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep);
 
 } // namespace rbc

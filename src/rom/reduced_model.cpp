@@ -69,13 +69,12 @@ PetscErrorCode ReducedParametrization::FromFOM(const Elasticity &elas, const Geo
   PetscCall(map.FromRecords((PetscInt)bodies.size(), m.Records()));
   thetaA = aff.thetaA;
   thetaF = aff.thetaF;
-  light_.reset();
+  Light();
   PetscFunctionReturn(0);
 }
 
 void ReducedParametrization::Light()
 {
-  if (light_) return;
   light_               = std::make_shared<Elasticity>();
   light_->dim          = dim;
   light_->scene.bodies = bodies;
@@ -143,20 +142,18 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
   for (const auto *cs : {&thetaA, &thetaF})
     for (const auto &c : *cs)
       PetscCheck(c.tensorBody < (PetscInt)bodies.size() && c.detBody < (PetscInt)bodies.size() && c.surfBody < (PetscInt)bodies.size() && c.param < (PetscInt)params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: a coefficient function refers to an unknown body or parameter", file.c_str());
-  light_.reset();
+  Light();
   PetscFunctionReturn(0);
 }
 
 void ReducedParametrization::ThetaA(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const
 {
-  const_cast<ReducedParametrization *>(this)->Light();
   th->resize(thetaA.size());
   for (size_t q = 0; q < thetaA.size(); ++q) (*th)[q] = thetaA[q].Evaluate(*light_, &map, mu);
 }
 
 void ReducedParametrization::ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const
 {
-  const_cast<ReducedParametrization *>(this)->Light();
   th->resize(thetaF.size());
   for (size_t q = 0; q < thetaF.size(); ++q) (*th)[q] = thetaF[q].Evaluate(*light_, &map, mu);
 }
