@@ -82,9 +82,9 @@ def pipeline(args):
     # the sizes are those of the reduced model (N, R, M), not of the mesh: the largest array is C (Mk x N x R)
     # or B (M x M); R itself grows somewhat with the mesh at a fixed dual tolerance (more nodes enter the
     # contact zone one by one over the parameter range)
-    def expected(o):
+    def expected(o):  # the EIM terms in the file (Mk_stored; Mk, Mg: the sizes used by default)
         r = o["rom"]
-        return max(r["Mk"] * r["N"] * r["R"], r["Mk"] ** 2, r["Mg"] ** 2, r["Mg"] * r["R"])
+        return max(r["Mk_stored"] * r["N"] * r["R"], r["Mk_stored"] ** 2, r["Mg_stored"] ** 2, r["Mg_stored"] * r["R"])
     check(big == expected(off) and big1 == expected(off1), "largest ROM array = max(Mk N R, Mk^2, Mg^2): %d and %d (refined)" % (big, big1))
     check(off1["ndofs"] > 3 * ndofs and big1 / big < 0.5 * off1["ndofs"] / ndofs and longest1 / longest < 0.5 * off1["ndofs"] / ndofs,
           "mesh refined (ndofs x%.2f): largest ROM array x%.2f (R %d -> %d), longest dimension %d -> %d" % (off1["ndofs"] / ndofs, big1 / big, off["rom"]["R"], off1["rom"]["R"], longest, longest1))
@@ -202,6 +202,60 @@ def eim_train(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def eim_select(args):
+    """Default EIM sizes chosen on held-out parameters (docs/eim.md): the rule, the file, 1 vs 2 ranks."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_sel_")
+    common = ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-snapshots", d + "/s.h5"]
+    offs = {}
+    for np_ in (1, 2):
+        run(args, np_, "offline", common + ["-rom", "%s/rom%d.h5" % (d, np_), "-report", "%s/off%d.json" % (d, np_)])
+        offs[np_] = report("%s/off%d.json" % (d, np_))
+    off, sel = offs[2], offs[2]["eim"]["select"]
+    ro, mk_eim, mg_eim = off["rom"], off["eim"]["kappa"]["M"], off["eim"]["gap"]["M"]
+    print("  held-out %d radii: Mk %d of %d, Mg %d of %d, held-out error %.3e" % (sel["heldout"], ro["Mk"], mk_eim, ro["Mg"], mg_eim, sel["max_err"]))
+    check(sel["heldout"] == 10, "held-out parameters: the 10 midpoints of 11 training radii (%d)" % sel["heldout"])
+    ek, eg = np.array(sel["err_kappa"], dtype=float), np.array(sel["err_gap"], dtype=float)
+    check(len(ek) == mk_eim and len(eg) == mg_eim, "one held-out error per EIM size (%d kappa, %d gap)" % (len(ek), len(eg)))
+    def rule(e):
+        e = np.where(np.isfinite(e), e, np.inf)
+        return int(np.argmax(e <= (1 + sel["slack"]) * e.min())) + 1
+    check(ro["Mk"] == sel["Mk"] == rule(ek) and ro["Mg"] == sel["Mg"] == rule(eg), "sizes = smallest within slack of the best (Mk %d, Mg %d)" % (rule(ek), rule(eg)))
+    check(abs(sel["max_err"] - eg[ro["Mg"] - 1]) <= 1e-12 * eg[ro["Mg"] - 1], "error at the chosen sizes = the scanned one (%.3e)" % sel["max_err"])
+    check(ro["Mk_stored"] == ro["Mk"] and ro["Mg_stored"] == ro["Mg"], "the file keeps the terms in use only (Mk %d, Mg %d)" % (ro["Mk_stored"], ro["Mg_stored"]))
+    s1 = offs[1]["eim"]["select"]
+    e1 = np.array(s1["err_kappa"], dtype=float)
+    fin = np.isfinite(ek) & np.isfinite(e1)
+    check(s1["Mk"] == sel["Mk"] and s1["Mg"] == sel["Mg"] and np.abs(e1[fin] - ek[fin]).max() <= 1e-10 * ek[fin].max(), "same selection on 1 and 2 ranks")
+    check(off["eim"]["patch"]["check_max_diff"] <= 1e-12, "local data of the kept points = full contact map")
+    # all terms kept (-eim_select_keep_all): the chosen sizes are the default, every term available
+    run(args, 2, "offline", common + ["-eim_select_keep_all", "-rom", d + "/rom_keep.h5", "-report", d + "/off_keep.json"])
+    ok = report(d + "/off_keep.json")["rom"]
+    with h5py.File(d + "/rom_keep.h5", "r") as f:
+        dflt = list(np.array(f["online/eim_default"]))
+    check(ok["Mk_stored"] == mk_eim and dflt == [ro["Mk"], ro["Mg"]], "keep_all: %d terms stored, /online/eim_default = %s" % (ok["Mk_stored"], dflt))
+    for tag, rom, extra in (("sel", d + "/rom2.h5", []), ("keep", d + "/rom_keep.h5", []), ("keep_k", d + "/rom_keep.h5", ["-rom_Mk", str(ro["Mk"]), "-rom_Mg", str(ro["Mg"])]), ("all", d + "/rom_keep.h5", ["-rom_Mk", str(mk_eim)])):
+        run(args, 1, "online", ["-rom", rom, "-mu", "1.03", "-report", "%s/on_%s.json" % (d, tag)] + extra)
+    on = {t: report("%s/on_%s.json" % (d, t)) for t in ("sel", "keep", "keep_k", "all")}
+    same = np.abs(np.array(on["sel"]["u_hat"]) - np.array(on["keep"]["u_hat"])).max()
+    check(on["keep"]["rom"]["Mk"] == ro["Mk"] and on["keep"]["u_hat"] == on["keep_k"]["u_hat"], "online default sizes = -rom_Mk %d -rom_Mg %d" % (ro["Mk"], ro["Mg"]))
+    check(same <= 1e-13 * np.abs(np.array(on["sel"]["u_hat"])).max(), "truncated file = all terms at the chosen sizes (diff %.1e)" % same)
+    check(on["all"]["converged"] and on["all"]["rom"]["Mk"] == mk_eim, "-rom_Mk %d (every term) available in the keep_all file" % mk_eim)
+    # off: all terms, no default in the file
+    run(args, 1, "offline", common + ["-eim_select", "0", "-rom", d + "/rom_all.h5", "-report", d + "/off_all.json"])
+    oa = report(d + "/off_all.json")
+    with h5py.File(d + "/rom_all.h5", "r") as f:
+        has = "eim_default" in f["online"]
+    check(oa["rom"]["Mk"] == oa["rom"]["Mk_stored"] == mk_eim and not has, "-eim_select 0: all %d terms, no /online/eim_default" % mk_eim)
+    # the ROM and its bases file moved together elsewhere: validate finds the bases beside the ROM
+    os.makedirs(d + "/moved")
+    for f in ("rom2.h5", "rom2.basis.h5"):
+        shutil.move("%s/%s" % (d, f), "%s/moved/%s" % (d, f))
+    run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", d + "/moved/rom2.h5", "-test_size", "2", "-validate_repeat", "2", "-report", d + "/val.json"])
+    check(report(d + "/val.json")["test"]["n"] == 2, "validate reads the bases file beside a moved ROM file")
+    expect_error(args, common + ["-eim_select_slack", "-1", "-rom", d + "/bad.h5"], ["-eim_select_slack", "-1"], "negative -eim_select_slack", stage="offline")
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def half_disks(args):
     d = tempfile.mkdtemp(prefix="rbc_rom_hd_")
     extra = ["-train_type", "grid", "-train_size", "4", "-pod_tol", "1e-8", "-pod_supremizers", "-dual_type", "mcpg", "-dual_tol", "1e-3", "-dual_tol_relative", "-eim_kappa_tol", "1e-4", "-eim_gap_tol", "1e-5", "-eim_max", "40"]
@@ -219,7 +273,7 @@ def half_disks(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

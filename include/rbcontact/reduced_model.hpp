@@ -66,7 +66,7 @@ public:
   // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation).
   PetscErrorCode SetFromOptions();
   // Uses the leading n POD modes (and the supremizers of the leading r dual vectors), r dual vectors,
-  // mk and mg EIM terms (-1: all). Rebuilds the active operators.
+  // mk and mg EIM terms (-1: all for n and r, MkDefault/MgDefault for mk and mg). Rebuilds the active operators.
   PetscErrorCode Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg);
   // The reduced solution at mu (inside the box). Never throws on a numerical failure: converged =
   // false and message set (the stages turn that into an error); PETSc errors only for bad input.
@@ -99,6 +99,7 @@ public:
   std::vector<PetscReal> Aq, fq;                     // QA x Nfull x Nfull, QF x Nfull
   bool                   kappaConst = false, gapConst = false;
   PetscInt               MkFull = 0, MgFull = 0;
+  PetscInt               MkDefault = -1, MgDefault = -1; // sizes used unless -rom_Mk/-rom_Mg (-1: all; chosen offline on held-out parameters, eim_selection.hpp)
   std::vector<PetscInt>  kPoint, kMode, gPoint;      // EIM points: patch point (and mode for kappa)
   std::vector<PetscReal> kB, kC, gB, gC;             // B (M x M, column-major); C_j: Mk x Nfull x Rfull, Mg x Rfull
   std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull

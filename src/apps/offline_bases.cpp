@@ -6,6 +6,7 @@
 #include "rbcontact/rom_file.hpp"
 #include "offline_rom.hpp"
 #include <cmath>
+#include <filesystem>
 #include <cstring>
 #include <sstream>
 
@@ -47,6 +48,17 @@ void WriteDualBasis(const DualBasisResult &dual, RomWriter *w, bool withBasis)
   w->Dataset("/dual/history", {dual.history.size()}, dual.history);
   w->Dataset("/dual/gram_cond", {dual.gramCond.size()}, dual.gramCond);
   w->Dataset("/dual/selected", {dual.selected.size()}, std::vector<double>(dual.selected.begin(), dual.selected.end()));
+}
+
+// path as seen from the directory of file (so that the pair can be moved together); path itself when
+// they share no root.
+static std::string RelativeTo(const std::string &path, const std::string &file)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path  p = fs::absolute(path, ec).lexically_normal(), d = fs::absolute(file, ec).lexically_normal().parent_path();
+  const fs::path  r = p.lexically_relative(d);
+  return ec || r.empty() ? path : r.string();
 }
 
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, const std::string &basisPath)
@@ -219,7 +231,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     wr.version = 2;
     if (wrank == 0) {
       provenance(&wr);
-      wr.Attr("basis_file", basisPath);
+      wr.Attr("basis_file", RelativeTo(basisPath, romPath)); // read back relative to the ROM file (rom_fields.cpp)
       WriteDualBasis(dual, &wr, false);
     }
     PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep));

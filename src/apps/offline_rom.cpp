@@ -8,6 +8,7 @@
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
 #include "rbcontact/eim.hpp"
+#include "rbcontact/eim_selection.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/training_set.hpp"
 #include <slepcbv.h>
@@ -261,6 +262,62 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   std::vector<std::vector<PetscInt>> hitv(Q);
   for (PetscInt p = 0; p < Q; ++p) hitv[p].assign(hits[p].begin(), hits[p].end());
   full->Restrict(keep, hitv, rings, &rm.patch);
+  // --- the default EIM sizes: the smallest whose error on held-out parameters (against the reduced
+  // model with exact contact terms) is within -eim_select_slack of the best (docs/eim.md)
+  PetscBool    select = PETSC_TRUE, keepAll = PETSC_FALSE;
+  PetscReal    slack  = 0.1;
+  EIMSelection esel;
+  std::vector<std::vector<PetscReal>> held;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select", &select, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+  if (select) {
+    PetscBool heldSet = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &heldSet));
+    if (heldSet) {
+      ParameterSet hs;
+      PetscCall(ParameterSetFromOptions(world, fom.scene.params, "eim_heldout_", &hs));
+      held = hs.points;
+    } else {
+      std::vector<std::vector<PetscReal>> train;
+      for (const auto &s : snaps) train.push_back(s.mu);
+      held = HeldOutParameters(fom.scene.params, train, 20, 1);
+    }
+    rm.warmStart      = PETSC_TRUE;
+    rm.recordIterates = false;
+    PetscCall(SelectEIMSizes(world, rm, held, slack, &esel));
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select_keep_all", &keepAll, NULL));
+    if (!keepAll) { // keep only the terms in use, and the local data of their points
+      std::vector<PetscInt> keep2, kP, gP;
+      auto                  at = [&](PetscInt p) {
+        auto it = std::find(keep2.begin(), keep2.end(), p);
+        if (it != keep2.end()) return (PetscInt)(it - keep2.begin());
+        keep2.push_back(p);
+        return (PetscInt)keep2.size() - 1;
+      };
+      const PetscInt mk = rm.kappaConst ? 0 : esel.Mk, mg = rm.gapConst ? 0 : esel.Mg;
+      for (PetscInt j = 0; j < mk; ++j) kP.push_back(at(keep[rm.kPoint[j]]));
+      for (PetscInt j = 0; j < mg; ++j) gP.push_back(at(keep[rm.gPoint[j]]));
+      std::vector<PetscReal> kB((size_t)mk * mk), gB((size_t)mg * mg);
+      for (PetscInt j = 0; j < mk; ++j)
+        for (PetscInt i = 0; i < mk; ++i) kB[i + (size_t)mk * j] = rm.kB[i + (size_t)rm.MkFull * j];
+      for (PetscInt j = 0; j < mg; ++j)
+        for (PetscInt i = 0; i < mg; ++i) gB[i + (size_t)mg * j] = rm.gB[i + (size_t)rm.MgFull * j];
+      rm.kB = kB;
+      rm.gB = gB;
+      rm.kC.resize((size_t)mk * N * R); // C_j blocks are contiguous in j
+      rm.gC.resize((size_t)mg * R);
+      rm.kMode.resize(mk);
+      rm.kPoint = kP;
+      rm.gPoint = gP;
+      if (!rm.kappaConst) rm.MkFull = mk;
+      if (!rm.gapConst) rm.MgFull = mg;
+      rm.MkDefault = rm.MgDefault = -1;
+      keep = keep2;
+      full->Restrict(keep, hitv, rings, &rm.patch);
+    }
+  }
+  rm.SetContactMode(ReducedModel::ContactMode::EIM);
+  PetscCall(rm.Truncate(-1, -1, -1, -1)); // the sizes in use (report)
   // self-check: the restricted patch reproduces the full one at its points on every stored evaluation
   // state of the last training parameter
   PetscReal patchDiff = 0;
@@ -299,7 +356,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   e["rom_kacanov_iterations"]["max"]   = (long long)maxRomIts;
   JsonValue &k = e["kappa"];
   k["kind"]            = rm.kappaConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
-  k["M"]               = (long long)rm.MkFull;
+  k["M"]               = (long long)(rm.kappaConst ? 0 : ek.M); // the greedy's size (rom.Mk: in use)
   k["depends_on_u"]    = uDep > 1e-13;
   k["u_sensitivity"]   = (double)uDep;
   k["snapshot_spread"] = (double)spreadK;
@@ -310,12 +367,24 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   }
   JsonValue &g = e["gap"];
   g["kind"]            = rm.gapConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
-  g["M"]               = (long long)rm.MgFull;
+  g["M"]               = (long long)(rm.gapConst ? 0 : eg.M);
   g["snapshot_spread"] = (double)spreadG;
   if (!rm.gapConst) {
     g["history"] = eg.history;
     g["tol_abs"] = (double)eg.tolAbs;
     g["scale"]   = (double)eg.scale;
+  }
+  JsonValue &se = e["select"];
+  se["enabled"] = (bool)select;
+  if (select) {
+    se["heldout"]    = (long long)esel.heldout;
+    se["Mk"]         = (long long)esel.Mk;
+    se["Mg"]         = (long long)esel.Mg;
+    se["slack"]      = (double)slack;
+    se["max_err"]    = (double)esel.err;
+    se["err_kappa"]  = esel.errKappa;
+    se["err_gap"]    = esel.errGap;
+    se["kept_all"]   = (bool)keepAll;
   }
   JsonValue &pt = e["patch"];
   pt["points"]           = (long long)rm.patch.NumPoints();
@@ -329,8 +398,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["Npod"] = (long long)Npod;
   ro["supremizers"] = (long long)nsup;
   ro["R"]    = (long long)R;
-  ro["Mk"]   = (long long)rm.MkFull;
-  ro["Mg"]   = (long long)rm.MgFull;
+  ro["Mk"]   = (long long)rm.Mk(); // the sizes in use by default
+  ro["Mg"]   = (long long)rm.Mg();
+  ro["Mk_stored"] = (long long)rm.MkFull;
+  ro["Mg_stored"] = (long long)rm.MgFull;
   ro["affine_A"] = (long long)rm.par.NumA();
   ro["affine_f"] = (long long)rm.par.NumF();
   rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);

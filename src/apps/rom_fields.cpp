@@ -2,6 +2,7 @@
 #include "rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_file.hpp"
+#include <filesystem>
 
 namespace rbc {
 
@@ -14,7 +15,14 @@ PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const st
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", buf, sizeof buf, &set));
   if (set) path = buf;
-  else PetscCall(RomReadAttr(romPath, "basis_file", &path));
+  else {
+    // stored relative to the ROM file's directory (files of before 2026-11-22: relative to the
+    // offline run's working directory, the fallback)
+    PetscCall(RomReadAttr(romPath, "basis_file", &path));
+    const std::filesystem::path p(path), beside = std::filesystem::path(romPath).parent_path() / p;
+    std::error_code             ec;
+    if (p.is_relative() && std::filesystem::exists(beside, ec)) path = beside.string();
+  }
   PetscCall(RomReadDataset(path, "/pod/modes", &dims, &modes));
   PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Nfull && (PetscInt)dims[1] == nd, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /pod/modes is %llu x %llu, the ROM %s has N = %" PetscInt_FMT " and the scene %" PetscInt_FMT " dofs (another scene or mesh?)", path.c_str(), dims.size() > 0 ? dims[0] : 0ULL, dims.size() > 1 ? dims[1] : 0ULL, romPath.c_str(), model.Nfull, nd);
   N     = model.Nfull;

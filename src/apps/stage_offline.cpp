@@ -4,6 +4,7 @@
 // file (SnapshotFile) before the next round starts; -snapshots_restart resumes a killed job.
 #include "stages.hpp"
 #include "offline_bases.hpp"
+#include "rbcontact/eim.hpp"
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov.hpp"
@@ -119,6 +120,14 @@ PetscErrorCode StageOffline(MPI_Comm world)
   ParameterSet train;
   PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
+  if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
+    EIMOptions eo;
+    PetscReal  slack = 0;
+    PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
+    PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+    PetscCheck(slack >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_select_slack %g must be >= 0", (double)slack);
+  }
 
   // Groups of ranks, each solving its share of the parameters. Default: one group per rank for a
   // small mesh (< 200k dofs, where one rank per solve is efficient), one group otherwise.

@@ -195,6 +195,7 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
     w->Dataset("/online/gap/C", {(U64)m.MgFull, R}, m.gC);
   }
   w->Dataset("/online/dual_gram", {R, R}, m.dualGram);
+  if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
   std::vector<std::pair<std::string, std::pair<std::vector<U64>, std::vector<double>>>> items;
   m.patch.Serialize(&items);
   for (auto &it : items) w->Dataset("/online/contact/" + it.first, it.second.first, it.second.second);
@@ -275,6 +276,19 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       PetscCall(ReadChecked(path, "/online/warm/lambda", nw * R, &warmL));
     }
   }
+  MkDefault = MgDefault = -1;
+  { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
+    std::vector<U64> dims;
+    PetscErrorCode   ierr;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = RomReadDataset(path, "/online/eim_default", &dims, &d);
+    PetscCall(PetscPopErrorHandler());
+    if (!ierr) {
+      PetscCheck(d.size() == 2 && d[0] >= -1 && d[0] <= MkFull && d[1] >= -1 && d[1] <= MgFull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_default must hold 2 sizes within [-1, Mk = %" PetscInt_FMT "] and [-1, Mg = %" PetscInt_FMT "]", path.c_str(), MkFull, MgFull);
+      MkDefault = (PetscInt)d[0];
+      MgDefault = (PetscInt)d[1];
+    }
+  }
   PetscCall(Truncate(-1, -1, -1, -1));
   PetscFunctionReturn(0);
 }
@@ -309,8 +323,8 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   PetscFunctionBeginUser;
   if (n < 0) n = Npod;
   if (r < 0) r = Rfull;
-  if (mk < 0) mk = MkFull;
-  if (mg < 0) mg = MgFull;
+  if (mk < 0) mk = MkDefault >= 0 ? std::min(MkDefault, MkFull) : MkFull;
+  if (mg < 0) mg = MgDefault >= 0 ? std::min(MgDefault, MgFull) : MgFull;
   PetscCheck(n >= 1 && n <= Npod, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_N %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "] (POD modes in %s)", n, Npod, file.c_str());
   PetscCheck(r >= 1 && r <= Rfull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_R %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "]", r, Rfull);
   PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mk, MkFull);
