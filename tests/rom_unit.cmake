@@ -3,3 +3,7 @@
 #                          serialization) and ReducedParametrization (thetas, ROM-file roundtrip, CheckBox)
 rbc_test_exe(test_reduced_contact)
 rbc_add_mpi_test(NAME reduced_contact RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FILE:test_reduced_contact> -options_file runs/ring_on_block.opts LABELS rom)
+#   test_anderson          Anderson mixing of the reduced Kacanov loop (-rom_kacanov_anderson): fixed point vs
+#                          a LAPACK solve, iteration counts vs the plain iteration, the restart safeguard
+rbc_test_exe(test_anderson)
+rbc_add_mpi_test(NAME test_anderson RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_anderson> LABELS rom)

@@ -6,13 +6,14 @@
 // ContactPatch), and warm starts. Solve(mu) runs the reduced Kacanov loop: at each iterate the small
 // saddle-point QP with v in R^N, eta in R^R_+ (ReducedQP), stopping rules as the full-order model
 // (-rom_kacanov_rtol_primal, -rom_kacanov_rtol_dual, -rom_kacanov_max_it, -rom_kacanov_relaxation,
-// -rom_kacanov_monitor), KKT check -rom_kkt_tol. Nothing in it grows with the mesh.
+// -rom_kacanov_monitor; -rom_kacanov_anderson m: Anderson mixing), KKT check -rom_kkt_tol. Nothing in it grows with the mesh.
 // Usage: share/examples/online_loop.cpp.
 #pragma once
 #include <memory>
 #include <string>
 #include <vector>
 #include "rbcontact/affine_decomposition.hpp"
+#include "rbcontact/anderson.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/reduced_qp.hpp"
@@ -109,6 +110,7 @@ public:
   // options
   PetscInt  maxIt = 30;
   PetscReal rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
+  PetscInt  anderson = 3; // -rom_kacanov_anderson m: Anderson mixing of depth m (0: plain fixed point)
   PetscBool monitor = PETSC_FALSE, warmStart = PETSC_TRUE;
   bool      recordIterates = false;
   ReducedQP qp;
@@ -129,6 +131,8 @@ private:
   std::vector<PetscReal> P_, Pact_;
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
+  AndersonMixing         aa_;
+  std::vector<PetscReal> vstate_;
 };
 
 // Writes the online part of a model (everything Open reads) to w.

@@ -302,11 +302,13 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_primal", &rtolPrimal, NULL));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_dual", &rtolDual, NULL));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_relaxation", &relaxation, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_kacanov_anderson", &anderson, NULL));
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_kacanov_monitor", &monitor, NULL));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kkt_tol", &kktTol, NULL));
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_warm_start", &warmStart, NULL));
   PetscCheck(maxIt >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
   PetscCheck(rtolPrimal > 0 && rtolDual > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_rtol_primal/-rom_kacanov_rtol_dual must be > 0");
+  PetscCheck(anderson >= 0 && anderson <= 10, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_anderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", anderson);
   PetscCheck(relaxation > 0 && relaxation <= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
@@ -537,7 +539,11 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     for (PetscInt i = 0; i < Na; ++i) sol->v[i] = (1 - t) * warmV[lo * Nfull + cols_[i]] + t * warmV[hi * Nfull + cols_[i]];
     for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = (1 - t) * warmL[lo * Rfull + i] + t * warmL[hi * Rfull + i];
   }
-  thread_local std::vector<PetscReal> vprev, lprev, vnew;
+  thread_local std::vector<PetscReal> vprev, lprev, vnew, vmix;
+  if (anderson > 0) {
+    aa_.Setup(Na, anderson);
+    vmix.resize(Na);
+  }
   for (PetscInt it = 1; it <= maxIt; ++it) {
     vprev = sol->v;
     lprev = sol->lambda;
@@ -562,6 +568,12 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
       nv += PetscSqr(sol->v[i]);
       dv += PetscSqr(sol->v[i] - vprev[i]);
     }
+    // Anderson mixing: the next contact terms at the mixed input; sol->v stays the QP's solution
+    // (consistent with sol->lambda) until the test below has passed
+    bool mixed = false;
+    if (anderson > 0) {
+      mixed = aa_.Mix(vprev.data(), sol->v.data(), vmix.data()) > 0;
+    }
     PetscInt nact = 0;
     for (PetscInt i = 0; i < r; ++i) {
       sol->lambda[i] = lprev[i] + relaxation * (sol->lambda[i] - lprev[i]);
@@ -584,6 +596,10 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     if (du <= rtolPrimal && dl <= rtolDual) {
       sol->converged = true;
       break;
+    }
+    if (mixed) {
+      vstate_ = vmix;
+      std::swap(sol->v, vstate_); // the next input; the QP solution is kept in vstate_
     }
   }
   if (!sol->converged) {
