@@ -202,6 +202,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   og.name = "gap";
   PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &ok));
   PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &og));
+  if (wrank != 0) ok.monitor = og.monitor = false; // every rank runs the same greedy: one prints
   EIMResult  ek, eg;
   PetscReal  spreadK, spreadG;
   rm.kappaConst = Constant(Sk, (size_t)Q * N, ms, &spreadK);
