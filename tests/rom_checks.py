@@ -263,6 +263,9 @@ def eim_select(args):
     run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", d + "/moved/rom2.h5", "-test_size", "2", "-validate_repeat", "2", "-report", d + "/val.json"])
     check(report(d + "/val.json")["test"]["n"] == 2, "validate reads the bases file beside a moved ROM file")
     expect_error(args, common + ["-eim_select_slack", "-1", "-rom", d + "/bad.h5"], ["-eim_select_slack", "-1"], "negative -eim_select_slack", stage="offline")
+    # checked before the snapshots: a fresh snapshot file is not even created
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-snapshots", d + "/s_new.h5", "-eim_heldout_type", "file", "-eim_heldout_file", d + "/nosuch.txt", "-rom", d + "/bad.h5"], ["nosuch.txt", "-eim_heldout_file"], "missing held-out parameter file", stage="offline")
+    check(not os.path.exists(d + "/s_new.h5"), "bad held-out options refused before any snapshot")
     shutil.rmtree(d, ignore_errors=True)
 
 

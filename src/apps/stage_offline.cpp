@@ -127,6 +127,12 @@ PetscErrorCode StageOffline(MPI_Comm world)
     PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
     PetscCheck(slack >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_select_slack %g must be >= 0", (double)slack);
+    PetscBool held = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &held));
+    if (held) {
+      ParameterSet hs;
+      PetscCall(ParameterSetFromOptions(world, scene.params, "eim_heldout_", &hs));
+    }
   }
 
   // Groups of ranks, each solving its share of the parameters. Default: one group per rank for a
