@@ -132,7 +132,6 @@ private:
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
   AndersonMixing         aa_;
-  std::vector<PetscReal> vstate_;
 };
 
 // Writes the online part of a model (everything Open reads) to w.

@@ -570,10 +570,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     }
     // Anderson mixing: the next contact terms at the mixed input; sol->v stays the QP's solution
     // (consistent with sol->lambda) until the test below has passed
-    bool mixed = false;
-    if (anderson > 0) {
-      mixed = aa_.Mix(vprev.data(), sol->v.data(), vmix.data()) > 0;
-    }
+    const bool mixed = anderson > 0 && aa_.Mix(vprev.data(), sol->v.data(), vmix.data()) > 0;
     PetscInt nact = 0;
     for (PetscInt i = 0; i < r; ++i) {
       sol->lambda[i] = lprev[i] + relaxation * (sol->lambda[i] - lprev[i]);
@@ -597,10 +594,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
       sol->converged = true;
       break;
     }
-    if (mixed) {
-      vstate_ = vmix;
-      std::swap(sol->v, vstate_); // the next input; the QP solution is kept in vstate_
-    }
+    if (mixed) sol->v = vmix; // the next input (the contact terms are evaluated there)
   }
   if (!sol->converged) {
     std::ostringstream o;
