@@ -22,6 +22,7 @@ private:
   bool                   have_ = false;
   PetscReal              fnPrev_ = 0;
   std::vector<PetscReal> f_, fPrev_, gPrev_, dF_, dG_, q_, r_, gamma_; // dF_, dG_: n x m, newest column last
+  std::vector<char>      keep_; // history column used in the least-squares fit
 };
 
 } // namespace rbc

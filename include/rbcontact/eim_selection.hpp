@@ -19,11 +19,17 @@ struct EIMSelection {
   PetscReal              err = 0;            // error at the chosen sizes
 };
 
+// A held-out parameter's reference: the reduced solution with exact contact terms and A^(mu).
+struct HeldOutReference {
+  ReducedSolution        sol;
+  std::vector<PetscReal> A; // N x N: the energy norm of the u error
+};
+
 // Held-out error of the EIM at sizes (mk, mg): the max over the parameters of max(rel. error of u in
-// the reduced energy norm v'A^(mu)v, rel. error of lambda in W'W) against the exact-contact solutions
-// ref (v then lambda per parameter); a non-converged solve counts as +inf. The parameters are split
-// over the ranks of comm (every rank holds the same model); the result is the same on every rank.
-PetscErrorCode EIMHeldOutError(MPI_Comm comm, ReducedModel &rm, const std::vector<std::vector<PetscReal>> &mus, const std::vector<ReducedSolution> &ref, PetscInt mk, PetscInt mg, PetscReal *err);
+// the reduced energy norm v'A^(mu)v, rel. error of lambda in W'W) against the references ref (one per
+// parameter); a non-converged solve counts as +inf. The parameters are split over the ranks of comm
+// (every rank holds the same model); the result is the same on every rank.
+PetscErrorCode EIMHeldOutError(MPI_Comm comm, ReducedModel &rm, const std::vector<std::vector<PetscReal>> &mus, const std::vector<HeldOutReference> &ref, PetscInt mk, PetscInt mg, PetscReal *err);
 
 // rm: a complete model (EIM terms, patch, warm starts, exact contact terms set by SetExactContact).
 // Solves the exact-contact references, scans Mk = 1..MkFull (Mg = MgFull), then Mg = 1..MgFull, and

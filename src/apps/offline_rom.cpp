@@ -30,6 +30,15 @@ static void Append(const ContactPatch &P, std::vector<PetscReal> *Sk, std::vecto
   for (PetscInt p = 0; p < Q; ++p) (*hits)[p].insert((*hit)[p]);
 }
 
+// Position of p in list, appended if absent.
+static PetscInt Intern(std::vector<PetscInt> *list, PetscInt p)
+{
+  auto it = std::find(list->begin(), list->end(), p);
+  if (it != list->end()) return (PetscInt)(it - list->begin());
+  list->push_back(p);
+  return (PetscInt)list->size() - 1;
+}
+
 // Is every snapshot (n x m, column-major) equal to the first one (to round-off)?
 static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscReal *spread)
 {
@@ -208,12 +217,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   rm.kappaConst = Constant(Sk, (size_t)Q * N, ms, &spreadK);
   rm.gapConst   = Constant(Sg, Q, ms, &spreadG);
   std::vector<PetscInt> keep; // restricted patch points
-  auto keepPoint = [&](PetscInt p) {
-    auto it = std::find(keep.begin(), keep.end(), p);
-    if (it != keep.end()) return (PetscInt)(it - keep.begin());
-    keep.push_back(p);
-    return (PetscInt)keep.size() - 1;
-  };
+  auto keepPoint = [&](PetscInt p) { return Intern(&keep, p); };
   if (rm.kappaConst) {
     rm.kConstant.assign((size_t)N * R, 0.0);
     for (PetscInt n = 0; n < N; ++n)
@@ -289,12 +293,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select_keep_all", &keepAll, NULL));
     if (!keepAll) { // keep only the terms in use, and the local data of their points
       std::vector<PetscInt> keep2, kP, gP;
-      auto                  at = [&](PetscInt p) {
-        auto it = std::find(keep2.begin(), keep2.end(), p);
-        if (it != keep2.end()) return (PetscInt)(it - keep2.begin());
-        keep2.push_back(p);
-        return (PetscInt)keep2.size() - 1;
-      };
+      auto                  at = [&](PetscInt p) { return Intern(&keep2, p); };
       const PetscInt mk = rm.kappaConst ? 0 : esel.Mk, mg = rm.gapConst ? 0 : esel.Mg;
       for (PetscInt j = 0; j < mk; ++j) kP.push_back(at(keep[rm.kPoint[j]]));
       for (PetscInt j = 0; j < mg; ++j) gP.push_back(at(keep[rm.gPoint[j]]));

@@ -16,6 +16,7 @@ void AndersonMixing::Setup(PetscInt n, PetscInt m)
   q_.assign((size_t)n * m, 0.0);
   r_.assign((size_t)m * m, 0.0);
   gamma_.assign(m, 0.0);
+  keep_.reserve(m);
   Reset();
 }
 
@@ -52,8 +53,9 @@ PetscInt AndersonMixing::Mix(const PetscReal *x, const PetscReal *g, PetscReal *
   have_   = true;
   // least squares min ||f - dF gamma|| by modified Gram-Schmidt; a column (numerically) in the span
   // of the previous ones is skipped (gamma_j = 0)
-  PetscInt used = 0;
-  std::vector<char> keep(cols_, 0);
+  PetscInt   used = 0;
+  std::vector<char> &keep = keep_;
+  keep.assign(cols_, 0);
   for (PetscInt j = 0; j < cols_; ++j) {
     PetscReal *q = &q_[(size_t)j * n_], n0 = 0, nn = 0;
     for (PetscInt i = 0; i < n_; ++i) {

@@ -23,11 +23,10 @@ static PetscReal RelErr(const std::vector<PetscReal> &G, PetscInt ld, const Pets
   return nb > 0 ? std::sqrt(d / nb) : std::sqrt(d);
 }
 
-PetscErrorCode EIMHeldOutError(MPI_Comm comm, ReducedModel &rm, const std::vector<std::vector<PetscReal>> &mus, const std::vector<ReducedSolution> &ref, PetscInt mk, PetscInt mg, PetscReal *err)
+PetscErrorCode EIMHeldOutError(MPI_Comm comm, ReducedModel &rm, const std::vector<std::vector<PetscReal>> &mus, const std::vector<HeldOutReference> &ref, PetscInt mk, PetscInt mg, PetscReal *err)
 {
-  PetscMPIInt            rank, size;
-  std::vector<PetscReal> A, f;
-  PetscReal              e = 0;
+  PetscMPIInt rank, size;
+  PetscReal   e = 0;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
@@ -41,9 +40,8 @@ PetscErrorCode EIMHeldOutError(MPI_Comm comm, ReducedModel &rm, const std::vecto
       e = std::numeric_limits<PetscReal>::infinity();
       break;
     }
-    rm.Operators(mus[k], &A, &f);
-    const PetscReal eu = RelErr(A, N, sol.v.data(), ref[k].v.data(), N);
-    const PetscReal el = RelErr(rm.dualGram, rm.Rfull, sol.lambda.data(), ref[k].lambda.data(), R);
+    const PetscReal eu = RelErr(ref[k].A, N, sol.v.data(), ref[k].sol.v.data(), N);
+    const PetscReal el = RelErr(rm.dualGram, rm.Rfull, sol.lambda.data(), ref[k].sol.lambda.data(), R);
     e = std::max(e, std::max(eu, el));
     if (!(e < PETSC_MAX_REAL)) {
       e = std::numeric_limits<PetscReal>::infinity();
@@ -74,12 +72,14 @@ PetscErrorCode SelectEIMSizes(MPI_Comm comm, ReducedModel &rm, const std::vector
   sel->Mg      = rm.MgFull;
   rm.MkDefault = rm.MgDefault = -1;
   // references: the reduced model with exact contact terms (all terms, every rank: cheap)
-  std::vector<ReducedSolution> ref(mus.size());
+  std::vector<HeldOutReference> ref(mus.size());
+  std::vector<PetscReal>        f;
   rm.SetContactMode(ReducedModel::ContactMode::Exact);
   PetscCall(rm.Truncate(-1, -1, -1, -1));
   for (size_t k = 0; k < mus.size(); ++k) {
-    PetscCall(rm.Solve(mus[k], &ref[k]));
-    PetscCheck(ref[k].converged, comm, PETSC_ERR_NOT_CONVERGED, "offline: the reduced model with exact contact terms fails at held-out parameter %zu (%g...): %s", k, (double)mus[k][0], ref[k].message.c_str());
+    PetscCall(rm.Solve(mus[k], &ref[k].sol));
+    PetscCheck(ref[k].sol.converged, comm, PETSC_ERR_NOT_CONVERGED, "offline: the reduced model with exact contact terms fails at held-out parameter %zu (%g...): %s", k, (double)mus[k][0], ref[k].sol.message.c_str());
+    rm.Operators(mus[k], &ref[k].A, &f);
   }
   rm.SetContactMode(ReducedModel::ContactMode::EIM);
   if (!mus.empty()) {
