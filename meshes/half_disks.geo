@@ -22,7 +22,8 @@
 //   Rl        radius of the lower disk (default 1.0, range 0.7..1.3)
 //   lc_slave  upper mesh size on "slave"            (default 0.018)
 //   lc_upper  upper mesh size at the flat edge      (default 0.045)
-//   lc_master lower mesh size on "master" (at Rl=1) (default 0.027 = 1.5 x lc_slave)
+//   lc_master lower mesh size on "master" (at Rl=1) (default 0.012 = lc_slave / 1.5)
+//             (master 1.5x finer than the slave: non-matching; a master coarser than the slave makes the P1 pressure oscillate, docs/contact.md)
 //   lc_lower  lower mesh size at the flat edge      (default 0.06, at Rl=1)
 // All sizes are multiplied by -clscale.
 // Mesh: gmsh -2 meshes/half_disks.geo -o half_disks.msh -format msh22
@@ -32,7 +33,7 @@ DefineConstant[
   Rl        = {1.0,    Min 0.7,  Max 1.3,  Step 0.01, Name "Parameters/Rl"},
   lc_slave  = {0.018,  Min 1e-4, Max 1,    Name "Parameters/lc_slave"},
   lc_upper  = {0.045,  Min 1e-4, Max 1,    Name "Parameters/lc_upper"},
-  lc_master = {0.027,  Min 1e-4, Max 1,    Name "Parameters/lc_master"},
+  lc_master = {0.012,  Min 1e-4, Max 1,    Name "Parameters/lc_master"},
   lc_lower  = {0.06,   Min 1e-4, Max 1,    Name "Parameters/lc_lower"}
 ];
 

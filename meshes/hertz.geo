@@ -19,18 +19,18 @@
 // Mesh sizes: Distance+Threshold fields around (0,0), restricted per body:
 //   cylinder  : h = h_slave  for r < d_fine, growing linearly to hmax_cyl at r = d_cyl
 //   foundation: h = h_master for r < d_fine, growing linearly to hmax_fnd at r = d_fnd
-//   h_master = 1.5 h_slave (non-matching interface).  Sizes are absolute (do not scale
+//   h_master = h_slave / 1.5 (master 1.5x finer than the slave: non-matching; a master coarser than the slave makes the P1 pressure oscillate, docs/contact.md).  Sizes are absolute (do not scale
 //   with R) and are multiplied by -clscale.
 //
 // Parameters (gmsh -setnumber NAME value):
-//   R (1.0), h_slave (0.01), h_master (0.015), d_fine (0.15),
+//   R (1.0), h_slave (0.01), h_master (0.0067), d_fine (0.15),
 //   hmax_cyl (0.1), d_cyl (1.5), hmax_fnd (0.5), d_fnd (5.0)
 // Mesh: gmsh -2 meshes/hertz.geo -o hertz.msh -format msh22
 
 DefineConstant[
   R        = {1.0,   Min 0.1,  Max 5,  Name "Parameters/R"},
   h_slave  = {0.01,  Min 1e-4, Max 1,  Name "Parameters/h_slave"},
-  h_master = {0.015, Min 1e-4, Max 1,  Name "Parameters/h_master"},
+  h_master = {0.0067,Min 1e-4, Max 1,  Name "Parameters/h_master"},
   d_fine   = {0.15,  Min 0,    Max 5,  Name "Parameters/d_fine"},
   hmax_cyl = {0.1,   Min 1e-4, Max 1,  Name "Parameters/hmax_cyl"},
   d_cyl    = {1.5,   Min 0,    Max 10, Name "Parameters/d_cyl"},

@@ -23,7 +23,8 @@
 //   g0        initial gap (default 0.005)
 //   lc_slave  ring mesh size on "slave"           (at Ro = 1)
 //   lc_ring   ring mesh size away from "slave"    (at Ro = 1)
-//   lc_master block mesh size on "master" (~1.5 x lc_slave -> non-matching interface)
+//   lc_master block mesh size on "master" (lc_slave / 1.5 = 0.0167)
+//             (master 1.5x finer than the slave: non-matching; a master coarser than the slave makes the P1 pressure oscillate, docs/contact.md)
 //   lc_block  block mesh size at the block corners
 // All sizes are multiplied by -clscale.  Defaults: ~1590 nodes per body, ~50 on "slave".
 // Mesh: gmsh -2 meshes/ring_on_block.geo -o ring_on_block.msh -format msh22
@@ -33,7 +34,7 @@ DefineConstant[
   g0        = {0.005, Min 0.0,  Max 0.1, Name "Parameters/g0"},
   lc_slave  = {0.025, Min 1e-4, Max 1, Name "Parameters/lc_slave"},
   lc_ring   = {0.0203, Min 1e-4, Max 1, Name "Parameters/lc_ring"},
-  lc_master = {0.0375,Min 1e-4, Max 1, Name "Parameters/lc_master"},
+  lc_master = {0.0167,Min 1e-4, Max 1, Name "Parameters/lc_master"},
   lc_block  = {0.0575, Min 1e-4, Max 1, Name "Parameters/lc_block"}
 ];
 

@@ -77,8 +77,29 @@ def hertz(args):
         check(r["converged"] and r["kacanov_iterations"] <= 15, "Kacanov converged in %d <= 15 iterations" % r["kacanov_iterations"])
     check(ea[-1] <= 0.03, "finest mesh: relative error of a %.3f%% <= 3%%" % (100 * ea[-1]))
     check(ep[-1] <= 0.05, "finest mesh: relative error of p0 %.3f%% <= 5%%" % (100 * ep[-1]))
-    check(all(ea[i + 1] < ea[i] for i in range(len(ea) - 1)), "error of a decreases: %s" % ["%.2e" % e for e in ea])
-    check(all(ep[i + 1] < ep[i] for i in range(len(ep) - 1)), "error of p0 decreases: %s" % ["%.2e" % e for e in ep])
+    # With dual multipliers and a master finer than the slave the errors are at the floor of Hertz's
+    # half-space model (0.1-0.3 % on all three meshes, docs/contact.md), so they no longer decrease
+    # monotonically: every level is held to the accuracy targets (a 1 %, p0 2 %) instead.
+    check(max(ea) <= 0.01, "every mesh: relative error of a <= 1%%: %s" % ["%.2e" % e for e in ea])
+    check(max(ep) <= 0.02, "every mesh: relative error of p0 <= 2%%: %s" % ["%.2e" % e for e in ep])
+
+
+def smooth(args):
+    """ring_on_block, default mesh, P1: the dual multipliers give a smooth pressure (roughness <= 0.1, the
+    standard ones 0.1-0.5), the same force, and a peak within 4 % of P2's on the same mesh (reference)."""
+    print("Smooth multipliers: ring_on_block P1 dual vs standard vs P2")
+    rd, _ = run(args, args.np, "runs/ring_on_block.opts", args.extra, "ring_dual")
+    rs, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_multiplier", "standard"] + args.extra, "ring_std")
+    r2, _ = run(args, args.np, "runs/ring_on_block.opts", ["-fem_degree", "2"] + args.extra, "ring_p2")
+    print("  roughness dual %.3f standard %.3f P2 %.3f; max pressure %.4f / %.4f / %.4f; force %.5f / %.5f / %.5f"
+          % (rd["pressure_roughness"], rs["pressure_roughness"], r2["pressure_roughness"], rd["max_pressure"], rs["max_pressure"],
+             r2["max_pressure"], rd["contact_force"], rs["contact_force"], r2["contact_force"]))
+    check(rd["pressure_roughness"] <= 0.1, "dual multipliers: roughness %.3f <= 0.1" % rd["pressure_roughness"])
+    check(rd["pressure_roughness"] < rs["pressure_roughness"], "dual smoother than standard (%.3f < %.3f)" % (rd["pressure_roughness"], rs["pressure_roughness"]))
+    check(abs(rd["max_pressure"] / r2["max_pressure"] - 1) <= 0.04, "dual P1 peak %.4f within 4%% of P2's %.4f" % (rd["max_pressure"], r2["max_pressure"]))
+    check(abs(rd["contact_force"] / rs["contact_force"] - 1) <= 1e-3, "force dual / standard - 1 = %.1e <= 1e-3" % (rd["contact_force"] / rs["contact_force"] - 1))
+    for r in (rd, rs, r2):
+        check_kkt(r)
 
 
 def flat_punch(args):
@@ -212,7 +233,7 @@ def dual_shell(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

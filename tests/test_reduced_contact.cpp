@@ -209,14 +209,14 @@ static PetscErrorCode Run()
   const std::vector<PetscInt> all = Iota(Q);
   Eval                        e0;
   EvaluatePatch(full, all, &e0);
-  // psi sums: (KV)_{i n} = sum_p b_k kappa(p, n), g_i = sum_p b_k gamma(p) (canonical multiplier rows)
+  // psi sums: (KV)_{i n} = sum_p psi_k kappa(p, n), g_i = sum_p psi_k gamma(p) (canonical multiplier rows)
   std::vector<PetscReal> KVp((size_t)R * N, 0.0), gp(R, 0.0); // KVp: R x N row-major
   PetscInt               badRows = 0;
   std::vector<char>      seen(R, 0);
   for (PetscInt p = 0; p < Q; ++p)
     for (PetscInt k = 0; k < dim; ++k) {
       const PetscInt  i = full.points[p].row[k];
-      const PetscReal b = full.points[p].b[k];
+      const PetscReal b = MultiplierShape(map.multiplier, dim, full.points[p].b, k); // psi_k (dual or standard)
       if (i < 0 || i >= R) {
         ++badRows;
         continue;

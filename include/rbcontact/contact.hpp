@@ -93,10 +93,18 @@ struct ContactSystem {
 // points, used by the reduced model); Nodal: collocation at the slave nodes.
 enum class ContactQuadrature { Gauss, Composite, Nodal };
 
+// Multiplier shape functions on a slave facet (nv vertices, barycentric b): the standard P1 hats
+// psi_k = b_k, or the dual (biorthogonal) ones psi_k = (nv + 1) b_k - 1, for which
+// int psi_k phi_j = delta_kj int phi_j on every facet (Wohlmuth): the slave block of K is diagonal
+// (lumped), and lambda_i is still the nodal pressure with int psi_i = int phi_i (docs/contact.md).
+enum class ContactMultiplier { Standard, Dual };
+inline PetscReal MultiplierShape(ContactMultiplier m, PetscInt nv, const PetscReal b[], PetscInt k) { return m == ContactMultiplier::Dual ? (nv + 1) * b[k] - 1 : b[k]; }
+
 // The contact map: slave/master surfaces of a scene and the assembly of K(u), g(u).
 class ContactMap {
 public:
-  // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet.
+  // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet,
+  // -contact_multiplier dual|standard (nodal quadrature: standard, collocation is already diagonal).
   PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
   // Moves both surfaces to the physical configuration at mu (reference configuration + map).
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
@@ -115,6 +123,7 @@ public:
   PetscInt          nquad      = 4;
   PetscInt          nsub       = 4;
   bool              smoothNormal = true;
+  ContactMultiplier multiplier   = ContactMultiplier::Dual;
 
 private:
   PetscErrorCode NumberMultipliers(const Elasticity &elas);

@@ -68,6 +68,7 @@ struct ContactSummary {
   PetscReal force = 0, forceVec[3] = {0, 0, 0}, maxPressure = 0, halfwidth = 0;
   PetscReal halfwidthMoment = 0; // 2D: 2 sqrt(int p x^2 / int p), x from the pressure centroid (= a for a Hertz profile)
   PetscReal pressureSpread = 0; // 2D: max/min - 1 of the nodal pressure over the active nodes but the two ends
+  PetscReal pressureRoughness = 0; // 2D: RMS of the second difference of the nodal pressure over the active nodes but the two ends, / their mean (node-to-node oscillation)
 };
 // Rows of K restricted to the sorted global dofs D: dense R x nD, column-major, on every rank.
 PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD);

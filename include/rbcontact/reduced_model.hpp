@@ -60,11 +60,14 @@ struct ReducedSolution {
 
 class ReducedModel {
 public:
-  enum class ContactMode { EIM, Exact };
+  // EIM: empirical interpolation of kappa and gamma (the seed's); Cubature: the exact pointwise kernel
+  // at a few points with nonnegative weights (ECSW, empirical_cubature.hpp); Exact: every point.
+  enum class ContactMode { EIM, Exact, Cubature };
 
   // Reads a ROM file (any rank; no collective call). Errors name the file and the dataset.
   PetscErrorCode Open(const std::string &file);
-  // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation).
+  // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation),
+  // -rom_hyper eim|ecsw (the hyper-reduction among those stored; default: the offline stage's first choice).
   PetscErrorCode SetFromOptions();
   // Uses the leading n POD modes (and the supremizers of the leading r dual vectors), r dual vectors,
   // mk and mg EIM terms (-1: all for n and r, MkDefault/MgDefault for mk and mg). Rebuilds the active operators.
@@ -86,6 +89,10 @@ public:
   PetscInt R() const { return r_; }
   PetscInt Mk() const { return mk_; }
   PetscInt Mg() const { return mg_; }
+  PetscInt Mc() const { return (PetscInt)cPoint.size(); }
+  ContactMode Mode() const { return mode_; }
+  bool HasEIM() const { return kappaConst || gapConst || MkFull > 0 || MgFull > 0; }
+  bool HasCubature() const { return !cPoint.empty(); }
   // POD column (index into the stored primal basis) of each active reduced coordinate.
   const std::vector<PetscInt> &Columns() const { return cols_; }
   // Reduced A^(mu) (N x N, column-major) and f^(mu).
@@ -104,7 +111,10 @@ public:
   std::vector<PetscInt>  kPoint, kMode, gPoint;      // EIM points: patch point (and mode for kappa)
   std::vector<PetscReal> kB, kC, gB, gC;             // B (M x M, column-major); C_j: Mk x Nfull x Rfull, Mg x Rfull
   std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull
-  ContactPatch           patch;                      // local data around the EIM points
+  std::vector<PetscInt>  cPoint;                     // cubature (ECSW) points: patch points
+  std::vector<PetscReal> cPw;                        // Rfull x Mc, row-major: xi_p (W' Psi)(:, p)
+  ContactMode            hyperDefault = ContactMode::EIM; // the method used unless -rom_hyper
+  ContactPatch           patch;                      // local data around the EIM and cubature points
   std::vector<PetscReal> warmMu, warmV, warmL;       // training parameters and their reduced solutions
   std::vector<PetscReal> dualGram;                   // W'W (Rfull x Rfull): the Kacanov change of lambda = W lambda^ is measured in it
   // options

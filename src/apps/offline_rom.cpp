@@ -8,6 +8,7 @@
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
 #include "rbcontact/eim.hpp"
+#include "rbcontact/empirical_cubature.hpp"
 #include "rbcontact/eim_selection.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/training_set.hpp"
@@ -48,6 +49,23 @@ static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscR
     for (size_t i = 0; i < n; ++i) d = std::max(d, std::abs(S[i + j * n] - S[i]));
   *spread = scale > 0 ? d / scale : 0;
   return *spread <= 1e-13;
+}
+
+PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h)
+{
+  char            buf[64] = "ecsw";
+  CubatureOptions co;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_hyper", buf, sizeof buf, NULL));
+  const std::string s(buf);
+  if (s == "ecsw") *h = {false, true, true};
+  else if (s == "eim") *h = {true, false, false};
+  else if (s == "ecsw,eim") *h = {true, true, true};
+  else if (s == "eim,ecsw") *h = {true, true, false};
+  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (ecsw, eim, ecsw,eim or eim,ecsw: the first is the online default)", buf);
+  PetscCall(CubatureOptionsFromOptions(comm, "ecsw_", &co));
+  PetscFunctionReturn(0);
 }
 
 PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
@@ -206,6 +224,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscCall(PetscTime(&t1));
 
   // --- EIM of kappa and gamma (or their exact constant form)
+  HyperChoice hyper;
+  PetscCall(HyperChoiceFromOptions(world, &hyper));
   EIMOptions ok, og;
   ok.name = "kappa";
   og.name = "gap";
@@ -216,6 +236,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscReal  spreadK, spreadG;
   rm.kappaConst = Constant(Sk, (size_t)Q * N, ms, &spreadK);
   rm.gapConst   = Constant(Sg, Q, ms, &spreadG);
+  if (rm.kappaConst && rm.gapConst) hyper = {true, false, false}; // exact constant terms: nothing to hyper-reduce
+  const bool eimKappa = hyper.eim && !rm.kappaConst, eimGap = hyper.eim && !rm.gapConst;
   std::vector<PetscInt> keep; // restricted patch points
   auto keepPoint = [&](PetscInt p) { return Intern(&keep, p); };
   if (rm.kappaConst) {
@@ -226,7 +248,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
         for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * Sk[(size_t)p * N + n];
         rm.kConstant[(size_t)n * R + r] = s;
       }
-  } else {
+  } else if (eimKappa) {
     PetscCall(EIMGreedy(Sk, Q * N, ms, ok, &ek));
     rm.MkFull = ek.M;
     rm.kB     = ek.B;
@@ -246,7 +268,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     rm.gConstant.assign(R, 0.0);
     for (PetscInt r = 0; r < R; ++r)
       for (PetscInt p = 0; p < Q; ++p) rm.gConstant[r] += P[(size_t)r * Q + p] * Sg[p];
-  } else {
+  } else if (eimGap) {
     PetscCall(EIMGreedy(Sg, Q, ms, og, &eg));
     rm.MgFull = eg.M;
     rm.gB     = eg.B;
@@ -275,6 +297,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   std::vector<std::vector<PetscReal>> held;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select", &select, NULL));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+  if (!eimKappa && !eimGap) select = PETSC_FALSE; // no EIM term to size
   if (select) {
     PetscBool heldSet = PETSC_FALSE;
     PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &heldSet));
@@ -316,7 +339,56 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       full->Restrict(keep, hitv, rings, &rm.patch);
     }
   }
-  rm.SetContactMode(ReducedModel::ContactMode::EIM);
+  // --- the empirical cubature (ECSW) of the exact reduced terms on the same states (docs/hyper_reduction.md)
+  CubatureOptions co;
+  CubatureResult  cr;
+  std::vector<PetscReal> errK, errG;
+  if (hyper.ecsw) {
+    std::vector<PetscReal> H;
+    PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
+    if (wrank != 0) co.monitor = false;
+    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
+    PetscCall(EmpiricalCubature(H, Q, co, &cr));
+    PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
+    rm.cPoint.clear();
+    rm.cPw.assign((size_t)R * cr.points.size(), 0.0);
+    const PetscInt M = (PetscInt)cr.points.size();
+    for (PetscInt j = 0; j < M; ++j) {
+      rm.cPoint.push_back(keepPoint(cr.points[j]));
+      for (PetscInt r = 0; r < R; ++r) rm.cPw[(size_t)r * M + j] = cr.weights[j] * P[(size_t)r * Q + cr.points[j]];
+    }
+    full->Restrict(keep, hitv, rings, &rm.patch);
+    // the fit on every training state: relative errors of K^ and g^ (Frobenius / l2)
+    std::vector<PetscReal> Ke((size_t)R * N), Kc((size_t)R * N), ge(R), gc(R);
+    for (PetscInt s = 0; s < ms; ++s) {
+      const PetscReal *kap0 = &Sk[(size_t)s * Q * N], *gam0 = &Sg[(size_t)s * Q];
+      std::fill(Ke.begin(), Ke.end(), 0.0);
+      std::fill(Kc.begin(), Kc.end(), 0.0);
+      std::fill(ge.begin(), ge.end(), 0.0);
+      std::fill(gc.begin(), gc.end(), 0.0);
+      for (PetscInt r = 0; r < R; ++r) {
+        for (PetscInt p = 0; p < Q; ++p) {
+          const PetscReal pr = P[(size_t)r * Q + p];
+          if (pr == 0.0) continue;
+          ge[r] += pr * gam0[p];
+          for (PetscInt n = 0; n < N; ++n) Ke[(size_t)r * N + n] += pr * kap0[(size_t)p * N + n];
+        }
+        for (PetscInt j = 0; j < M; ++j) {
+          const PetscInt  p  = cr.points[j];
+          const PetscReal pr = cr.weights[j] * P[(size_t)r * Q + p];
+          gc[r] += pr * gam0[p];
+          for (PetscInt n = 0; n < N; ++n) Kc[(size_t)r * N + n] += pr * kap0[(size_t)p * N + n];
+        }
+      }
+      PetscReal dk = 0, nk = 0, dg = 0, ng = 0;
+      for (size_t i = 0; i < Ke.size(); ++i) { dk += PetscSqr(Kc[i] - Ke[i]); nk += PetscSqr(Ke[i]); }
+      for (PetscInt i = 0; i < R; ++i) { dg += PetscSqr(gc[i] - ge[i]); ng += PetscSqr(ge[i]); }
+      errK.push_back(nk > 0 ? std::sqrt(dk / nk) : std::sqrt(dk));
+      errG.push_back(ng > 0 ? std::sqrt(dg / ng) : std::sqrt(dg));
+    }
+  }
+  rm.hyperDefault = hyper.ecsw && (hyper.ecswFirst || !hyper.eim) ? ReducedModel::ContactMode::Cubature : ReducedModel::ContactMode::EIM;
+  rm.SetContactMode(rm.hyperDefault);
   PetscCall(rm.Truncate(-1, -1, -1, -1)); // the sizes in use (report)
   // self-check: the restricted patch reproduces the full one at its points on every stored evaluation
   // state of the last training parameter
@@ -374,6 +446,20 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     g["tol_abs"] = (double)eg.tolAbs;
     g["scale"]   = (double)eg.scale;
   }
+  if (hyper.ecsw) {
+    JsonValue &c = rep->root["ecsw"];
+    c["M"]            = (long long)cr.points.size();
+    c["tol"]          = (double)co.tol;
+    c["residual"]     = (double)cr.residual;
+    c["history"]      = cr.history;
+    c["iterations"]   = (long long)cr.iterations;
+    c["weights"]      = cr.weights;
+    c["states"]       = (long long)ms;
+    c["train_err_K"]  = errK;
+    c["train_err_g"]  = errG;
+    c["train_max_err_K"] = errK.empty() ? 0.0 : (double)*std::max_element(errK.begin(), errK.end());
+    c["train_max_err_g"] = errG.empty() ? 0.0 : (double)*std::max_element(errG.begin(), errG.end());
+  }
   JsonValue &se = e["select"];
   se["enabled"] = (bool)select;
   if (select) {
@@ -400,6 +486,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["R"]    = (long long)R;
   ro["Mk"]   = (long long)rm.Mk(); // the sizes in use by default
   ro["Mg"]   = (long long)rm.Mg();
+  ro["hyper"] = rm.hyperDefault == ReducedModel::ContactMode::Cubature ? "ecsw" : "eim";
+  ro["hyper_stored"] = std::string(hyper.ecsw ? "ecsw" : "") + (hyper.ecsw && hyper.eim ? "," : "") + (hyper.eim ? "eim" : "");
+  ro["Mc"] = (long long)rm.Mc();
   ro["Mk_stored"] = (long long)rm.MkFull;
   ro["Mg_stored"] = (long long)rm.MgFull;
   ro["affine_A"] = (long long)rm.par.NumA();

@@ -12,6 +12,13 @@
 
 namespace rbc {
 
+// -rom_hyper ecsw|eim|ecsw,eim|eim,ecsw (default ecsw): the hyper-reductions of the contact terms to
+// build; the first is the ROM's default online. Checks -ecsw_* too (before the snapshots).
+struct HyperChoice {
+  bool eim = false, ecsw = true, ecswFirst = true;
+};
+PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h);
+
 // V: the primal basis (Npod POD modes then nsup supremizers) on fom's DM; modes: the same, N x ndofs
 // row-major in canonical order, on every rank of fom's communicator. order's multipliers are numbered
 // here when a resumed run solved no snapshot. Report keys eim {...}, rom {...}.

@@ -88,7 +88,7 @@ PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrde
   for (PetscInt p = 0; p < Q; ++p)
     for (PetscInt k = 0; k < fom.elas.dim; ++k) {
       const PetscInt  row = (*full)->points[p].row[k];
-      const PetscReal b   = (*full)->points[p].b[k];
+      const PetscReal b   = MultiplierShape(cmap.multiplier, fom.elas.dim, (*full)->points[p].b, k);
       if (row < 0 || b == 0) continue;
       for (PetscInt q = 0; q < r; ++q) (*P)[(size_t)q * Q + p] += b * Wt[(size_t)q * Rfom + row];
     }

@@ -66,6 +66,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["max_pressure"]       = (double)cs.maxPressure;
     rep.root["contact_halfwidth"]  = (double)cs.halfwidth;
     rep.root["pressure_spread"]    = (double)cs.pressureSpread;
+    rep.root["pressure_roughness"] = (double)cs.pressureRoughness;
     JsonValue &k                   = rep.root["kkt"];
     k["primal_infeas"]             = (double)kacanov.kkt.primal;
     k["dual_infeas"]               = (double)kacanov.kkt.dual;

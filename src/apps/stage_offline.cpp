@@ -4,6 +4,7 @@
 // file (SnapshotFile) before the next round starts; -snapshots_restart resumes a killed job.
 #include "stages.hpp"
 #include "offline_bases.hpp"
+#include "offline_rom.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/fom.hpp"
@@ -121,8 +122,10 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
   if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
-    EIMOptions eo;
-    PetscReal  slack = 0;
+    EIMOptions  eo;
+    PetscReal   slack = 0;
+    HyperChoice hc;
+    PetscCall(HyperChoiceFromOptions(world, &hc));
     PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
     PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));

@@ -86,7 +86,7 @@ PetscErrorCode ContactMap::NumberMultipliers(const Elasticity &elas)
 PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slave, const std::string &master)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)elas.dm);
-  char      quad[64] = "gauss", nrm[64] = "smooth";
+  char      quad[64] = "gauss", nrm[64] = "smooth", mult[64] = "dual";
   PetscBool flg;
 
   PetscFunctionBeginUser;
@@ -103,6 +103,11 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   if (!strcmp(nrm, "smooth")) smoothNormal = true;
   else if (!strcmp(nrm, "facet")) smoothNormal = false;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_normal: unknown value '%s' (smooth or facet)", nrm);
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_multiplier", mult, sizeof mult, NULL));
+  if (!strcmp(mult, "dual")) multiplier = ContactMultiplier::Dual;
+  else if (!strcmp(mult, "standard")) multiplier = ContactMultiplier::Standard;
+  else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_multiplier: unknown value '%s' (dual or standard)", mult);
+  if (quadrature == ContactQuadrature::Nodal) multiplier = ContactMultiplier::Standard; // collocation: already diagonal
 
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));
@@ -310,9 +315,13 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       const SurfaceFacet &M = masterAll_[e.m];
       const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2, gap = e.gap;
       for (PetscInt k = 0; k < nv; ++k) {
-        const PetscReal psi = b[k];
+        const PetscReal psi = MultiplierShape(multiplier, nv, b, k);
+        const PetscInt  r   = rows[k];
+        if (b[k] != 0.0) { // weight and mean normal with the (positive) hat b_k: int psi_i = int b_i for both multipliers
+          PetscCall(VecSetValue(sys->weight, r, w * b[k], ADD_VALUES));
+          for (PetscInt d = 0; d < dim; ++d) PetscCall(VecSetValue(sys->normal[d], r, w * b[k] * n2[d], ADD_VALUES));
+        }
         if (psi == 0.0) continue;
-        const PetscInt r = rows[k];
         PetscScalar    gk = w * psi * gap;
         cols.clear();
         vals.clear();
@@ -330,8 +339,6 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
           }
         PetscCall(MatSetValues(sys->K, 1, &r, (PetscInt)cols.size(), cols.data(), vals.data(), ADD_VALUES));
         PetscCall(VecSetValue(sys->g, r, gk, ADD_VALUES));
-        PetscCall(VecSetValue(sys->weight, r, w * psi, ADD_VALUES));
-        for (PetscInt d = 0; d < dim; ++d) PetscCall(VecSetValue(sys->normal[d], r, w * psi * n2[d], ADD_VALUES));
       }
     }
     for (PetscInt k = 0; k < nv; ++k)

@@ -426,6 +426,13 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
       }
       s->pressureSpread = pmin > 0 ? pmax / pmin - 1 : PETSC_INFINITY;
     }
+    if (active.size() >= 5) { // interior nodes 1..n-2, second differences at 2..n-3
+      PetscReal mean = 0, d2 = 0;
+      for (size_t i = 1; i + 1 < active.size(); ++i) mean += active[i].second;
+      mean /= (PetscReal)(active.size() - 2);
+      for (size_t i = 2; i + 2 < active.size(); ++i) d2 += PetscSqr(active[i - 1].second - 2 * active[i].second + active[i + 1].second);
+      s->pressureRoughness = mean > 0 ? std::sqrt(d2 / (PetscReal)(active.size() - 4)) / mean : 0;
+    }
   }
   PetscFunctionReturn(0);
 }

@@ -195,6 +195,11 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
     w->Dataset("/online/gap/C", {(U64)m.MgFull, R}, m.gC);
   }
   w->Dataset("/online/dual_gram", {R, R}, m.dualGram);
+  if (!m.cPoint.empty()) {
+    w->Dataset("/online/ecsw/points", {(U64)m.cPoint.size()}, std::vector<double>(m.cPoint.begin(), m.cPoint.end()));
+    w->Dataset("/online/ecsw/Pw", {R, (U64)m.cPoint.size()}, m.cPw);
+  }
+  w->Dataset("/online/hyper_default", {1}, {m.hyperDefault == ReducedModel::ContactMode::Cubature ? 1.0 : 0.0});
   if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
   std::vector<std::pair<std::string, std::pair<std::vector<U64>, std::vector<double>>>> items;
   m.patch.Serialize(&items);
@@ -276,6 +281,30 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       PetscCall(ReadChecked(path, "/online/warm/lambda", nw * R, &warmL));
     }
   }
+  // optional (files of before 2026-11-23 hold the EIM only): the empirical cubature and the default method
+  cPoint.clear();
+  cPw.clear();
+  hyperDefault = ContactMode::EIM;
+  {
+    std::vector<U64> dims;
+    PetscErrorCode   ierr;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = RomReadDataset(path, "/online/ecsw/points", &dims, &d);
+    PetscCall(PetscPopErrorHandler());
+    if (!ierr) {
+      cPoint = ToInt(d);
+      for (PetscInt p : cPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw/points out of range", path.c_str());
+      PetscCall(ReadChecked(path, "/online/ecsw/Pw", R * cPoint.size(), &cPw));
+    }
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = RomReadDataset(path, "/online/hyper_default", &dims, &d);
+    PetscCall(PetscPopErrorHandler());
+    if (!ierr) {
+      PetscCheck(d.size() == 1 && (d[0] == 0 || d[0] == 1) && (d[0] == 0 || !cPoint.empty()), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default is malformed", path.c_str());
+      hyperDefault = d[0] == 1 ? ContactMode::Cubature : ContactMode::EIM;
+    }
+  }
+  mode_ = hyperDefault;
   MkDefault = MgDefault = -1;
   { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
     std::vector<U64> dims;
@@ -312,6 +341,23 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCheck(relaxation > 0 && relaxation <= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
+  {
+    char      hyper[64] = "";
+    PetscBool set       = PETSC_FALSE;
+    // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
+    if (!file.empty()) PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_hyper", hyper, sizeof hyper, &set));
+    if (set) {
+      std::string h(hyper);
+      h = h.substr(0, h.find(',')); // a list (the offline stage's form): its first entry
+      if (h == "ecsw") {
+        PetscCheck(HasCubature(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper ecsw: the ROM file %s holds no empirical cubature (build it with offline -rom_hyper ecsw)", file.c_str());
+        SetContactMode(ContactMode::Cubature);
+      } else if (h == "eim") {
+        PetscCheck(HasEIM(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper eim: the ROM file %s holds no EIM (build it with offline -rom_hyper eim or ecsw,eim)", file.c_str());
+        SetContactMode(ContactMode::EIM);
+      } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
+    }
+  }
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_N", &n, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_R", &r, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mk", &mk, NULL));
@@ -370,7 +416,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
   }
-  const size_t np = std::max<size_t>(evalPoints_.size(), full_ ? full_->points.size() : 0);
+  const size_t np = std::max<size_t>(std::max(evalPoints_.size(), cPoint.size()), full_ ? full_->points.size() : 0);
   kap_.assign(np * Nfull, 0.0);
   gam_.assign(np, 0.0);
   phi_.assign(std::max(mk, mg) + 1, 0.0);
@@ -441,6 +487,28 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       for (PetscInt c = 0; c < Na; ++c) {
         PetscReal s = 0;
         for (PetscInt p = 0; p < Q; ++p) s += pr[p] * kap_[(size_t)p * Nfull + cols_[c]];
+        K[i + (size_t)r * c] = s;
+      }
+    }
+    return out;
+  }
+  if (mode_ == ContactMode::Cubature) {
+    // K^ = sum_p xi_p (W'Psi)(:, p) kappa(p, :), g^ likewise, at the cubature points only
+    const PetscInt M = (PetscInt)cPoint.size();
+    if (geomMu_ != mu) {
+      patch.SetGeometry(&par.map, mu);
+      geomMu_ = mu;
+    }
+    patch.SetReduced(vfull.data());
+    out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr);
+    for (PetscInt i = 0; i < r; ++i) {
+      const PetscReal *pr = &cPw[(size_t)i * M];
+      PetscReal        gs = 0;
+      for (PetscInt p = 0; p < M; ++p) gs += pr[p] * gam_[p];
+      g[i] = gs;
+      for (PetscInt c = 0; c < Na; ++c) {
+        PetscReal s = 0;
+        for (PetscInt p = 0; p < M; ++p) s += pr[p] * kap_[(size_t)p * Nfull + cols_[c]];
         K[i + (size_t)r * c] = s;
       }
     }

@@ -1,0 +1,183 @@
+// src/reduction/empirical_cubature.cpp: the Gram matrix of the cubature fit and the sparse NNLS
+// (Lawson-Hanson in Gram form, stopped at the tolerance) that picks the points and their weights.
+// See include/rbcontact/empirical_cubature.hpp and docs/hyper_reduction.md.
+#include "rbcontact/empirical_cubature.hpp"
+#include <petscblaslapack.h>
+#include <algorithm>
+#include <cmath>
+
+namespace rbc {
+
+PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, CubatureOptions *opt)
+{
+  PetscBool flg = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, pre, "Empirical cubature of the reduced contact terms", "rbcontact");
+  PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
+  PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
+  flg = opt->monitor ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-monitor", "print the residual per added point", "", flg, &flg, NULL));
+  opt->monitor = flg;
+  PetscOptionsEnd();
+  PetscCheck(opt->tol > 0 && opt->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%stol %g must lie in (0, 1)", pre, (double)opt->tol);
+  PetscCheck(opt->maxPoints >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%smax_points %" PetscInt_FMT " must be >= 1", pre, opt->maxPoints);
+  PetscFunctionReturn(0);
+}
+
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H)
+{
+  const PetscInt         nc = N + 1;
+  std::vector<PetscReal> Z((size_t)Q * ms * nc, 0.0), Kh((size_t)R * N), gh(R);
+  for (PetscInt s = 0; s < ms; ++s) {
+    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    // exact reduced terms of this state, for its scaling
+    std::fill(Kh.begin(), Kh.end(), 0.0);
+    std::fill(gh.begin(), gh.end(), 0.0);
+    for (PetscInt r = 0; r < R; ++r) {
+      const PetscReal *pr = &P[(size_t)r * Q];
+      for (PetscInt p = 0; p < Q; ++p) {
+        if (pr[p] == 0.0) continue;
+        for (PetscInt n = 0; n < N; ++n) Kh[(size_t)r * N + n] += pr[p] * kap[(size_t)p * N + n];
+        gh[r] += pr[p] * gam[p];
+      }
+    }
+    PetscReal nk = 0, ng = 0;
+    for (PetscReal v : Kh) nk += v * v;
+    for (PetscReal v : gh) ng += v * v;
+    const PetscReal sk = nk > 0 ? 1 / std::sqrt(nk) : 0, sg = ng > 0 ? 1 / std::sqrt(ng) : 0;
+    for (PetscInt n = 0; n < N; ++n) {
+      PetscReal *z = &Z[(size_t)(s * nc + n) * Q];
+      for (PetscInt p = 0; p < Q; ++p) z[p] = sk * kap[(size_t)p * N + n];
+    }
+    PetscReal *z = &Z[(size_t)(s * nc + N) * Q];
+    for (PetscInt p = 0; p < Q; ++p) z[p] = sg * gam[p];
+  }
+  // kernel Gram KG = Z Z' and P'P (P row-major R x Q = column-major Q x R), then the Hadamard product
+  std::vector<PetscReal> KG((size_t)Q * Q, 0.0);
+  H->assign((size_t)Q * Q, 0.0);
+  const PetscBLASInt q = (PetscBLASInt)Q, kz = (PetscBLASInt)(ms * nc), kr = (PetscBLASInt)R;
+  const PetscReal    one = 1, zero = 0;
+  if (kz > 0) BLASgemm_("N", "T", &q, &q, &kz, &one, Z.data(), &q, Z.data(), &q, &zero, KG.data(), &q);
+  if (kr > 0) BLASgemm_("N", "T", &q, &q, &kr, &one, P.data(), &q, P.data(), &q, &zero, H->data(), &q);
+  for (size_t i = 0; i < KG.size(); ++i) (*H)[i] *= KG[i];
+}
+
+namespace {
+// Cholesky solve of H(S, S) z = b(S); false if H(S, S) is not (numerically) positive definite.
+bool SolveOnSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *z)
+{
+  const PetscInt         k = (PetscInt)S.size();
+  std::vector<PetscReal> A((size_t)k * k);
+  PetscReal              dmax = 0;
+  for (PetscInt j = 0; j < k; ++j)
+    for (PetscInt i = 0; i < k; ++i) A[i + (size_t)k * j] = H[(size_t)S[i] * Q + S[j]];
+  for (PetscInt i = 0; i < k; ++i) dmax = std::max(dmax, A[i + (size_t)k * i]);
+  z->resize(k);
+  for (PetscInt i = 0; i < k; ++i) (*z)[i] = b[S[i]];
+  PetscBLASInt n = (PetscBLASInt)k, one = 1, info = 0;
+  LAPACKpotrf_("L", &n, A.data(), &n, &info);
+  if (info != 0) return false;
+  // a pivot far below the largest diagonal entry: the new point is (numerically) a combination of the others
+  for (PetscInt i = 0; i < k; ++i)
+    if (!(A[i + (size_t)k * i] * A[i + (size_t)k * i] > 1e-13 * dmax)) return false;
+  LAPACKpotrs_("L", &n, &one, A.data(), &n, z->data(), &n, &info);
+  return info == 0;
+}
+} // namespace
+
+PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(Q >= 1 && H.size() == (size_t)Q * Q, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "EmpiricalCubature: Gram matrix of %zu entries for Q = %" PetscInt_FMT " points", H.size(), Q);
+  for (PetscReal v : H) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FP, "EmpiricalCubature: the Gram matrix of the contact terms holds a non-finite value");
+  *res = CubatureResult();
+  // target b = H 1, c = 1' H 1 (= ||G 1||^2)
+  std::vector<PetscReal> b(Q, 0.0), x(Q, 0.0), grad, z, Hx(Q, 0.0);
+  PetscReal              c = 0;
+  for (PetscInt p = 0; p < Q; ++p) {
+    for (PetscInt q = 0; q < Q; ++q) b[p] += H[(size_t)p * Q + q];
+    c += b[p];
+  }
+  if (!(c > 0)) { // nothing to fit: no contact term at any state
+    res->residual = 0;
+    res->history  = {0};
+    PetscFunctionReturn(0);
+  }
+  std::vector<PetscInt> S;
+  std::vector<char>     in(Q, 0), banned(Q, 0);
+  grad                   = b;
+  PetscReal        rel   = 1;
+  const PetscReal  gtiny = 1e-14 * *std::max_element(b.begin(), b.end());
+  res->history.push_back(1);
+  auto residual = [&]() { // sqrt((x - 1)' H (x - 1) / c) from x' H x - 2 b' x + c
+    PetscReal xHx = 0, bx = 0;
+    for (PetscInt p : S) {
+      xHx += x[p] * Hx[p];
+      bx += b[p] * x[p];
+    }
+    return std::sqrt(std::max<PetscReal>(xHx - 2 * bx + c, 0) / c);
+  };
+  while (rel > opt.tol && (PetscInt)S.size() < opt.maxPoints) {
+    PetscInt  j = -1;
+    PetscReal gmax = gtiny;
+    for (PetscInt p = 0; p < Q; ++p)
+      if (!in[p] && !banned[p] && grad[p] > gmax) {
+        gmax = grad[p];
+        j    = p;
+      }
+    if (j < 0) break; // KKT point of the NNLS: no point improves the fit
+    S.push_back(j);
+    in[j] = 1;
+    for (;;) {
+      ++res->iterations;
+      if (!SolveOnSupport(H, Q, S, b, &z)) { // j adds nothing independent: drop it for good
+        S.erase(std::find(S.begin(), S.end(), j));
+        in[j] = 0;
+        banned[j] = 1;
+        break;
+      }
+      PetscReal alpha = 1;
+      PetscInt  hit   = -1;
+      for (size_t i = 0; i < S.size(); ++i)
+        if (z[i] <= 0) {
+          const PetscReal a = x[S[i]] / (x[S[i]] - z[i]);
+          if (a < alpha) { alpha = a; hit = (PetscInt)i; }
+        }
+      if (hit < 0) {
+        for (size_t i = 0; i < S.size(); ++i) x[S[i]] = z[i];
+        break;
+      }
+      for (size_t i = 0; i < S.size(); ++i) x[S[i]] += alpha * (z[i] - x[S[i]]);
+      x[S[hit]] = 0;
+      std::vector<PetscInt> keep;
+      for (PetscInt p : S) {
+        if (x[p] > 0) keep.push_back(p);
+        else {
+          x[p]  = 0;
+          in[p] = 0;
+        }
+      }
+      S = keep;
+      if (S.empty()) break;
+    }
+    // gradient b - H x, and H x on the support for the residual
+    for (PetscInt p = 0; p < Q; ++p) {
+      PetscReal s = 0;
+      for (PetscInt q : S) s += H[(size_t)p * Q + q] * x[q];
+      Hx[p] = s;
+    }
+    grad.assign(Q, 0.0);
+    for (PetscInt p = 0; p < Q; ++p) grad[p] = b[p] - Hx[p];
+    rel = residual();
+    res->history.push_back(rel);
+    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature M = %3zu  rel residual = %.3e\n", S.size(), (double)rel));
+  }
+  res->residual = rel;
+  res->points   = S;
+  res->weights.clear();
+  for (PetscInt p : S) res->weights.push_back(x[p]);
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
