@@ -63,7 +63,8 @@ def offline(args, d, opts="runs/ring_on_block.opts", np_=2, extra=()):
 
 def pipeline(args):
     d = tempfile.mkdtemp(prefix="rbc_rom_")
-    rom, off = offline(args, d)
+    # both hyper-reductions in one file (ECSW the default online, EIM selectable by -rom_hyper eim)
+    rom, off = offline(args, d, extra=["-rom_hyper", "ecsw,eim"])
     ro = off["rom"]
     ndofs = off["ndofs"]
     print("  ROM: N %d (POD %d + %d supremizers), R %d, Mk %d, Mg %d; ndofs %d, R_fom %d" % (ro["N"], ro["Npod"], ro["supremizers"], ro["R"], ro["Mk"], ro["Mg"], ndofs, off["ncontact"]))
@@ -75,21 +76,49 @@ def pipeline(args):
     # the same scene on a refined mesh: the ROM file must not grow with the mesh
     d1 = d + "/refine1"
     os.makedirs(d1)
-    rom1, off1 = offline(args, d1, extra=["-mesh_refine", "1"])
+    rom1, off1 = offline(args, d1, extra=["-mesh_refine", "1", "-rom_hyper", "ecsw,eim"])
     ds1 = datasets(rom1)
     big1 = max(int(np.prod(s)) for s in ds1.values())
     longest1 = max(max(s) if s else 0 for s in ds1.values())
     # the sizes are those of the reduced model (N, R, M), not of the mesh: the largest array is C (Mk x N x R)
     # or B (M x M); R itself grows somewhat with the mesh at a fixed dual tolerance (more nodes enter the
     # contact zone one by one over the parameter range)
-    def expected(o):  # the EIM terms in the file (Mk_stored; Mk, Mg: the sizes used by default)
+    def expected(o):  # the EIM terms in the file (Mk_stored; Mk, Mg: the sizes used by default), the cubature's R x Mc
         r = o["rom"]
-        return max(r["Mk_stored"] * r["N"] * r["R"], r["Mk_stored"] ** 2, r["Mg_stored"] ** 2, r["Mg_stored"] * r["R"])
-    check(big == expected(off) and big1 == expected(off1), "largest ROM array = max(Mk N R, Mk^2, Mg^2): %d and %d (refined)" % (big, big1))
+        return max(r["Mk_stored"] * r["N"] * r["R"], r["Mk_stored"] ** 2, r["Mg_stored"] ** 2, r["Mg_stored"] * r["R"], r["Mc"] * r["R"])
+    check(big == expected(off) and big1 == expected(off1), "largest ROM array = max(Mk N R, Mk^2, Mg^2, Mc R): %d and %d (refined)" % (big, big1))
     check(off1["ndofs"] > 3 * ndofs and big1 / big < 0.5 * off1["ndofs"] / ndofs and longest1 / longest < 0.5 * off1["ndofs"] / ndofs,
           "mesh refined (ndofs x%.2f): largest ROM array x%.2f (R %d -> %d), longest dimension %d -> %d" % (off1["ndofs"] / ndofs, big1 / big, off["rom"]["R"], off1["rom"]["R"], longest, longest1))
     check(off["eim"]["kappa"]["kind"] == "eim" and off["eim"]["kappa"]["depends_on_u"], "kappa depends on u (measured %.2e): EIM" % off["eim"]["kappa"]["u_sensitivity"])
-    check(off["eim"]["patch"]["check_max_diff"] <= 1e-12, "local contact data = full contact map at the EIM points (%.1e)" % off["eim"]["patch"]["check_max_diff"])
+    check(off["eim"]["patch"]["check_max_diff"] <= 1e-12, "local contact data = full contact map at the EIM and cubature points (%.1e)" % off["eim"]["patch"]["check_max_diff"])
+    # the empirical cubature: nonnegative weights, the fit reached, and the reported residual = the RMS of
+    # the relative errors of K^ and g^ over the training states (recomputed offline from the fitted terms)
+    c = off["ecsw"]
+    eK, eg = np.array(c["train_err_K"]), np.array(c["train_err_g"])
+    rms = np.sqrt(np.mean(eK ** 2 + eg ** 2) / 2)
+    print("  ECSW: Mc %d of %d points, residual %.2e (tol %.0e); per state max err K^ %.2e, g^ %.2e" % (c["M"], off["eim"]["quadrature_points"], c["residual"], c["tol"], eK.max(), eg.max()))
+    check(off["rom"]["hyper"] == "ecsw" and c["M"] == off["rom"]["Mc"] and 0 < c["M"] < off["eim"]["quadrature_points"], "ECSW is the default and uses %d < %d points" % (c["M"], off["eim"]["quadrature_points"]))
+    check(min(c["weights"]) > 0, "cubature weights > 0 (min %.3e)" % min(c["weights"]))
+    check(c["residual"] <= c["tol"] and len(eK) == c["states"], "cubature residual %.2e <= tol %.0e on %d training states" % (c["residual"], c["tol"], c["states"]))
+    check(abs(rms - c["residual"]) <= 1e-3 * c["residual"], "training states: RMS of the K^, g^ errors %.4e = reported residual %.4e" % (rms, c["residual"]))
+    # the same offline stage on 1 rank: the same ROM
+    d2 = d + "/np1"
+    os.makedirs(d2)
+    rom2, off2 = offline(args, d2, np_=1, extra=["-rom_hyper", "ecsw,eim"])
+    with h5py.File(rom, "r") as f, h5py.File(rom2, "r") as g:
+        same = all(np.array_equal(np.array(f[k]), np.array(g[k])) for k in ("online/ecsw/points", "online/ecsw/Pw", "online/affine/A", "online/kappa/C"))
+        dpw = np.abs(np.array(f["online/ecsw/Pw"]) - np.array(g["online/ecsw/Pw"])).max() if f["online/ecsw/Pw"].shape == g["online/ecsw/Pw"].shape else np.inf
+    check(same, "offline on 1 and 2 ranks: identical cubature points and weights, affine terms, EIM (max |dPw| %.1e)" % dpw)
+    # a ROM file of the format before the cubature (no /online/ecsw, no /online/hyper_default) is still read: EIM
+    old = d + "/old.h5"
+    shutil.copy(rom, old)
+    with h5py.File(old, "a") as f:
+        del f["online/ecsw"]
+        del f["online/hyper_default"]
+    p = run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", old, "-rom_basis", d + "/rom.basis.h5", "-test_size", "3", "-validate_repeat", "1", "-report", d + "/val_old.json"])
+    check(report(d + "/val_old.json")["rom"]["hyper"] == "eim", "a ROM file without the cubature (older format) is read and solved with its EIM")
+    p = run(args, 1, "online", ["-rom", old, "-mu", "1.02", "-rom_hyper", "ecsw"], expect_ok=False)
+    check(p.returncode != 0 and "holds no empirical cubature" in p.stdout, "-rom_hyper ecsw on an EIM-only file: refused with a clear message")
 
     # online: 1 vs 2 ranks on the same file, TAO cross-check
     on = {}
@@ -118,6 +147,13 @@ def pipeline(args):
         a, b = val[1]["test"][k], val[2]["test"][k]
         check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
     check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
+    e = val[1]["test"]
+    x = val[1]["test_exact"]
+    check(val[1]["rom"]["hyper"] == "ecsw" and e["max_rel_err_u"] <= 1.5 * x["max_rel_err_u"] and e["max_rel_err_lambda"] <= 1.5 * x["max_rel_err_lambda"],
+          "ECSW errors within 1.5x of the exact-contact ROM's: u %.2e / %.2e, lambda %.2e / %.2e" % (e["max_rel_err_u"], x["max_rel_err_u"], e["max_rel_err_lambda"], x["max_rel_err_lambda"]))
+    run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-rom_hyper", "eim", "-validate_repeat", "2", "-report", d + "/val_eim.json"])
+    ve = report(d + "/val_eim.json")
+    check(ve["rom"]["hyper"] == "eim" and ve["test"]["max_rel_err_u"] <= 1e-3, "-rom_hyper eim on the same file: EIM (u %.2e, lambda %.2e)" % (ve["test"]["max_rel_err_u"], ve["test"]["max_rel_err_lambda"]))
     check(val[1]["speedup_median"] > 10, "speedup %.0f (online median %.2e s, FOM %.2e s)" % (val[1]["speedup_median"], val[1]["online_time_s"]["median"], val[1]["fom_time_s"]["median"]))
     with open(d + "/val1_sweep.json") as f:
         sw = json.load(f)
@@ -149,7 +185,7 @@ def expect_error(args, extra, words, what, stage="online", np_=1):
 
 def bad_input(args):
     d = tempfile.mkdtemp(prefix="rbc_rom_bad_")
-    rom, _ = offline(args, d, np_=1, extra=["-train_size", "7", "-eim_max", "10"])
+    rom, _ = offline(args, d, np_=1, extra=["-train_size", "7", "-eim_max", "10", "-rom_hyper", "eim"])
     expect_error(args, ["-mu", "1.02"], ["-rom"], "missing -rom")
     expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5", "does not exist"], "missing ROM file")
     expect_error(args, ["-rom", rom, "-mu", "1.3"], ["radius", "1.3", "outside its box"], "mu outside the box")
@@ -201,7 +237,7 @@ def eim_train(args):
     for extra in ([], ["-eim_train_type", "grid", "-eim_train_size", "41"]):
         tag = "extra" if extra else "base"
         rom = "%s/rom_%s.h5" % (d, tag)
-        run(args, 2, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-eim_select", "0", "-snapshots", d + "/s.h5", "-rom", rom, "-report", "%s/off_%s.json" % (d, tag)] + extra)
+        run(args, 2, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-eim_select", "0", "-rom_hyper", "eim", "-snapshots", d + "/s.h5", "-rom", rom, "-report", "%s/off_%s.json" % (d, tag)] + extra)
         off = report("%s/off_%s.json" % (d, tag))
         check(off["eim"]["extra_parameters"] == (41 if extra else 0), "%s: %d extra EIM parameters" % (tag, off["eim"]["extra_parameters"]))
         run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "6", "-validate_repeat", "3", "-report", "%s/val_%s.json" % (d, tag)])
@@ -215,7 +251,7 @@ def eim_train(args):
 def eim_select(args):
     """Default EIM sizes chosen on held-out parameters (docs/eim.md): the rule, the file, 1 vs 2 ranks."""
     d = tempfile.mkdtemp(prefix="rbc_rom_sel_")
-    common = ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-snapshots", d + "/s.h5"]
+    common = ["-options_file", "runs/ring_on_block.opts", "-train_size", "11", "-rom_hyper", "eim", "-snapshots", d + "/s.h5"]
     offs = {}
     for np_ in (1, 2):
         run(args, np_, "offline", common + ["-rom", "%s/rom%d.h5" % (d, np_), "-report", "%s/off%d.json" % (d, np_)])

@@ -7,3 +7,7 @@ rbc_add_mpi_test(NAME reduced_contact RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FIL
 #                          a LAPACK solve, iteration counts vs the plain iteration, the restart safeguard
 rbc_test_exe(test_anderson)
 rbc_add_mpi_test(NAME test_anderson RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_anderson> LABELS rom)
+#   test_empirical_cubature  the ECSW fit (-rom_hyper ecsw): Gram matrix vs explicit rows, Caratheodory bound on
+#                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
+rbc_test_exe(test_empirical_cubature)
+rbc_add_mpi_test(NAME test_empirical_cubature RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_empirical_cubature> LABELS rom)

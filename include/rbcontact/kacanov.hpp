@@ -73,6 +73,9 @@ struct ContactSummary {
 // Rows of K restricted to the sorted global dofs D: dense R x nD, column-major, on every rank.
 PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD);
 
+// The whole of a parallel Vec on every rank (global order).
+PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full);
+
 PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s);
 
 } // namespace rbc

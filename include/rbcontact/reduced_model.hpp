@@ -139,6 +139,7 @@ private:
   std::shared_ptr<ContactPatch> full_;
   ContactPatch           fullActive_;
   std::vector<PetscReal> P_, Pact_;
+  std::vector<PetscReal> cPwT_;                       // cubature weights of the active rows, M x r (point-major)
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
   AndersonMixing         aa_;

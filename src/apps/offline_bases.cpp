@@ -5,6 +5,8 @@
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "offline_rom.hpp"
+#include "rom_fields.hpp"
+#include "rbcontact/kacanov.hpp"
 #include <cmath>
 #include <filesystem>
 #include <cstring>
@@ -114,7 +116,28 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     L.Resize(R, m);
     for (PetscInt j = 0; j < m; ++j)
       for (PetscInt i = 0; i < R; ++i) L(i, j) = snaps[j].lambda[i];
+    // -dual_mass_weighted (default off; needs the contact map): the greedy's errors in the slave-mass
+    // weighted norm of the reported lambda error, ||x||_M^2 = sum_i int psi_i x_i^2 (reference
+    // configuration): rows scaled by sqrt(int psi_i), the basis unscaled after (nonnegativity kept).
+    PetscBool massWeighted = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-dual_mass_weighted", &massWeighted, NULL));
+    PetscCheck(!massWeighted || cmap, world, PETSC_ERR_ARG_INCOMP, "-dual_mass_weighted needs the scene's contact surfaces (-contact_slave, -contact_master)");
+    std::vector<PetscReal> sw(R, 1.0);
+    if (massWeighted) {
+      ContactSystem          sys;
+      std::vector<PetscReal> w;
+      PetscCall(AssembleReferenceContact(fom, *cmap, order, &sys));
+      PetscCall(GatherVec(sys.weight, &w));
+      PetscCheck((PetscInt)w.size() == R, world, PETSC_ERR_PLIB, "slave mass of %zu entries for %" PetscInt_FMT " multipliers", w.size(), R);
+      for (PetscInt i = 0; i < R; ++i) sw[order.CanonicalMultiplier(i)] = std::sqrt(std::max<PetscReal>(w[i], 0));
+      for (PetscInt j = 0; j < m; ++j)
+        for (PetscInt i = 0; i < R; ++i) L(i, j) *= sw[i];
+    }
     PetscCall(BuildDualBasis(L, &dual));
+    if (massWeighted)
+      for (PetscInt k = 0; k < dual.W.cols; ++k)
+        for (PetscInt i = 0; i < R; ++i) dual.W(i, k) = sw[i] > 0 ? dual.W(i, k) / sw[i] : 0.0;
+    rep->root["dual_mass_weighted"] = (bool)massWeighted;
   }
   PetscCall(PetscTime(&t2));
 

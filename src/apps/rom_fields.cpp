@@ -60,10 +60,9 @@ void RomBases::Multipliers(const ReducedModel &model, const std::vector<PetscRea
     for (PetscInt i = 0; i < R; ++i) (*lambda)[i] += lhat[k] * W[(size_t)k * R + i];
 }
 
-PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P)
+PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys)
 {
-  ContactSystem sys;
-  Vec           zero, uloc;
+  Vec zero, uloc;
 
   PetscFunctionBeginUser;
   PetscCall(fom.SetMu(ParamValues(fom.scene)));
@@ -73,9 +72,18 @@ PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrde
   PetscCall(DMGetLocalVector(fom.dm, &uloc));
   PetscCall(fom.elas.GlobalToLocalWithBC(zero, uloc));
   PetscCall(DMRestoreGlobalVector(fom.dm, &zero));
-  PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
+  PetscCall(cmap.Assemble(fom.elas, uloc, sys));
   PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys.coordRef, fom.elas.dim));
+  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys->coordRef, fom.elas.dim));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P)
+{
+  ContactSystem sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(AssembleReferenceContact(fom, cmap, order, &sys));
   const PetscInt    Rfom = cmap.NumMultipliers();
   std::vector<char> support(Rfom, 0);
   for (PetscInt k = 0; k < r; ++k)

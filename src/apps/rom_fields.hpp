@@ -29,6 +29,9 @@ public:
 // row-major, canonical) with the primal basis modes (N x ndofs, canonical), nsub composite pieces, and
 // P = W' Psi (r x Q, row-major). The surfaces are assembled at the default parameter with u = 0 (they
 // then carry the Dirichlet values); numbers order's multipliers if not done yet. Collective on fom.
+// The contact system at the default parameter and u = 0 (Dirichlet values lifted); numbers order's
+// multipliers if needed. Its weight is the slave mass int psi_i of the reference configuration.
+PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys);
 PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P);
 // lambda (canonical multiplier order) into the distributed multiplier vector v (rows of K).
 PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::vector<PetscReal> &lambda, Vec v);

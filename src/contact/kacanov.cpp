@@ -48,7 +48,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full)
+PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full)
 {
   VecScatter         sc;
   Vec                all;

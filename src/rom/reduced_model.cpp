@@ -412,6 +412,10 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   for (PetscInt j = 0; j < mk; ++j) kPos_[j] = pos(kPoint[j]);
   nkEval_ = (PetscInt)evalPoints_.size(); // the points needing kappa come first
   for (PetscInt j = 0; j < mg; ++j) gPos_[j] = pos(gPoint[j]);
+  // cubature weights of the active rows, point by point (M x r)
+  cPwT_.assign(cPoint.size() * (size_t)r, 0.0);
+  for (size_t p = 0; p < cPoint.size(); ++p)
+    for (PetscInt i = 0; i < r; ++i) cPwT_[p * r + i] = cPw[(size_t)i * cPoint.size() + p];
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
@@ -501,15 +505,17 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     }
     patch.SetReduced(vfull.data());
     out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr);
-    for (PetscInt i = 0; i < r; ++i) {
-      const PetscReal *pr = &cPw[(size_t)i * M];
-      PetscReal        gs = 0;
-      for (PetscInt p = 0; p < M; ++p) gs += pr[p] * gam_[p];
-      g[i] = gs;
+    // one rank-1 update per point, contiguous in the rows: K(:, c) += kappa(p, c) Pw(0:r, p)
+    std::fill(K, K + (size_t)r * Na, 0.0);
+    std::fill(g, g + r, 0.0);
+    for (PetscInt p = 0; p < M; ++p) {
+      const PetscReal *pw = &cPwT_[(size_t)p * r], *kp = &kap_[(size_t)p * Nfull];
+      const PetscReal  gp = gam_[p];
+      for (PetscInt i = 0; i < r; ++i) g[i] += pw[i] * gp;
       for (PetscInt c = 0; c < Na; ++c) {
-        PetscReal s = 0;
-        for (PetscInt p = 0; p < M; ++p) s += pr[p] * kap_[(size_t)p * Nfull + cols_[c]];
-        K[i + (size_t)r * c] = s;
+        const PetscReal kv = kp[cols_[c]];
+        PetscReal      *Kc = K + (size_t)r * c;
+        for (PetscInt i = 0; i < r; ++i) Kc[i] += pw[i] * kv;
       }
     }
     return out;

@@ -1,0 +1,151 @@
+// tests/test_empirical_cubature.cpp: the empirical cubature (src/reduction/empirical_cubature.cpp)
+// against independent references:
+//  1. CubatureGram against the Gram matrix of the explicitly stacked fitting rows (each state's K^ and
+//     g^ entries as functions of the weights, scaled to unit norm), on random data.
+//  2. Caratheodory/Tchakaloff: moments of degree 0..4 of a 60-point rule on [0, 1] are reproduced by a
+//     nonnegative rule on at most 5 of its points; the sparse NNLS finds one (weights > 0, support <= 5,
+//     residual <= 1e-9) and the moments it gives match the full rule's.
+//  3. Random reduced terms (R = 4, N = 3, 12 states, Q = 80): weights >= 0, the final residual <= tol,
+//     the residual recomputed from the fitted terms state by state equals the reported one, the history
+//     decreases to it, and fewer points than Q are used.
+#include "rbcontact/empirical_cubature.hpp"
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+using namespace rbc;
+
+static int failures = 0;
+static void Check(bool ok, const char *what, double val, double bound)
+{
+  PetscCallAbort(PETSC_COMM_WORLD, PetscPrintf(PETSC_COMM_WORLD, "  %-5s %-72s %.3e (bound %.1e)\n", ok ? "ok" : "FAIL", what, val, bound));
+  if (!ok) ++failures;
+}
+
+// Fitted terms of state s with weights xi: K (R x N) and g (R), and the exact ones (xi = 1).
+static void Terms(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt s, const std::vector<PetscReal> &xi, std::vector<PetscReal> *K, std::vector<PetscReal> *g)
+{
+  K->assign((size_t)R * N, 0.0);
+  g->assign(R, 0.0);
+  for (PetscInt r = 0; r < R; ++r)
+    for (PetscInt p = 0; p < Q; ++p) {
+      const PetscReal w = xi[p] * P[(size_t)r * Q + p];
+      (*g)[r] += w * Sg[(size_t)s * Q + p];
+      for (PetscInt n = 0; n < N; ++n) (*K)[(size_t)r * N + n] += w * Sk[((size_t)s * Q + p) * N + n];
+    }
+}
+
+static PetscReal Norm2(const std::vector<PetscReal> &v)
+{
+  PetscReal s = 0;
+  for (PetscReal x : v) s += x * x;
+  return s;
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, NULL, "test_empirical_cubature"));
+  std::mt19937_64                        gen(3);
+  std::uniform_real_distribution<double> U(-1, 1);
+
+  { // 1. Gram matrix against the explicit rows
+    const PetscInt         R = 3, Q = 17, N = 2, ms = 4;
+    std::vector<PetscReal> P((size_t)R * Q), Sk((size_t)ms * Q * N), Sg((size_t)ms * Q), H;
+    for (auto &x : P) x = std::abs(U(gen));
+    for (auto &x : Sk) x = U(gen);
+    for (auto &x : Sg) x = U(gen);
+    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
+    std::vector<PetscReal> G; // rows x Q, row-major
+    std::vector<PetscReal> K, g, one(Q, 1.0);
+    for (PetscInt s = 0; s < ms; ++s) {
+      Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
+      const PetscReal sk = 1 / std::sqrt(Norm2(K)), sg = 1 / std::sqrt(Norm2(g));
+      for (PetscInt r = 0; r < R; ++r) {
+        for (PetscInt n = 0; n < N; ++n)
+          for (PetscInt p = 0; p < Q; ++p) G.push_back(sk * P[(size_t)r * Q + p] * Sk[((size_t)s * Q + p) * N + n]);
+        for (PetscInt p = 0; p < Q; ++p) G.push_back(sg * P[(size_t)r * Q + p] * Sg[(size_t)s * Q + p]);
+      }
+    }
+    const size_t rows = G.size() / Q;
+    PetscReal    d = 0, sc = 0;
+    for (PetscInt p = 0; p < Q; ++p)
+      for (PetscInt q = 0; q < Q; ++q) {
+        PetscReal h = 0;
+        for (size_t i = 0; i < rows; ++i) h += G[i * Q + p] * G[i * Q + q];
+        d  = std::max(d, std::abs(h - H[(size_t)p * Q + q]));
+        sc = std::max(sc, std::abs(h));
+      }
+    Check(d <= 1e-13 * sc, "CubatureGram = G'G of the explicit fitting rows (max |diff| / max |G'G|)", d / sc, 1e-13);
+  }
+
+  { // 2. moments 0..4 of a 60-point rule: a nonnegative rule on <= 5 of its points
+    const PetscInt         Q = 60, N = 4, R = 1;
+    std::vector<PetscReal> P(Q), Sk((size_t)Q * N), Sg(Q), H;
+    for (PetscInt p = 0; p < Q; ++p) {
+      const PetscReal x = (p + 0.5) / Q;
+      P[p] = 1.0 / Q; // midpoint rule
+      for (PetscInt n = 0; n < N; ++n) Sk[(size_t)p * N + n] = std::pow(x, n);
+      Sg[p] = std::pow(x, 4);
+    }
+    CubatureGram(P, R, Q, N, Sk, Sg, 1, &H);
+    CubatureOptions opt;
+    opt.tol = 1e-9;
+    CubatureResult res;
+    PetscCall(EmpiricalCubature(H, Q, opt, &res));
+    PetscReal wmin = PETSC_MAX_REAL;
+    for (PetscReal w : res.weights) wmin = std::min(wmin, w);
+    Check(res.residual <= 1e-9, "moments 0..4: relative residual", res.residual, 1e-9);
+    Check(res.points.size() <= 5 && !res.points.empty(), "moments 0..4: number of points (Caratheodory: <= 5)", (double)res.points.size(), 5);
+    Check(wmin > 0, "moments 0..4: every weight > 0 (min weight)", wmin, 0);
+    PetscReal merr = 0;
+    for (PetscInt n = 0; n <= 4; ++n) {
+      PetscReal full = 0, cub = 0;
+      for (PetscInt p = 0; p < Q; ++p) full += P[p] * std::pow((p + 0.5) / Q, n);
+      for (size_t j = 0; j < res.points.size(); ++j) cub += res.weights[j] * P[res.points[j]] * std::pow((res.points[j] + 0.5) / Q, n);
+      merr = std::max(merr, std::abs(cub - full) / full);
+    }
+    Check(merr <= 1e-8, "moments 0..4: max relative moment error of the sparse rule", merr, 1e-8);
+  }
+
+  { // 3. random reduced terms: the reported fit equals the fit recomputed state by state
+    const PetscInt         R = 4, N = 3, ms = 12, Q = 80;
+    std::vector<PetscReal> P((size_t)R * Q), Sk((size_t)ms * Q * N), Sg((size_t)ms * Q), H;
+    for (PetscInt r = 0; r < R; ++r) // smooth nonnegative "dual vectors" times hats
+      for (PetscInt p = 0; p < Q; ++p) P[(size_t)r * Q + p] = std::exp(-PetscSqr((p / (PetscReal)Q - 0.25 * r - 0.1) / 0.2));
+    for (PetscInt s = 0; s < ms; ++s) // smooth state-dependent kernels
+      for (PetscInt p = 0; p < Q; ++p) {
+        const PetscReal x = p / (PetscReal)Q, a = 1 + 0.1 * s;
+        for (PetscInt n = 0; n < N; ++n) Sk[((size_t)s * Q + p) * N + n] = std::sin(a * (n + 1) * x) + 0.1 * n;
+        Sg[(size_t)s * Q + p] = std::cos(a * x) - 0.5 * x * x;
+      }
+    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
+    CubatureOptions opt;
+    opt.tol = 1e-5;
+    CubatureResult res;
+    PetscCall(EmpiricalCubature(H, Q, opt, &res));
+    std::vector<PetscReal> xi(Q, 0.0), one(Q, 1.0), K, g, K0, g0;
+    PetscReal              wmin = PETSC_MAX_REAL;
+    for (size_t j = 0; j < res.points.size(); ++j) {
+      xi[res.points[j]] = res.weights[j];
+      wmin              = std::min(wmin, res.weights[j]);
+    }
+    PetscReal sum = 0;
+    for (PetscInt s = 0; s < ms; ++s) {
+      Terms(P, R, Q, N, Sk, Sg, s, xi, &K, &g);
+      Terms(P, R, Q, N, Sk, Sg, s, one, &K0, &g0);
+      std::vector<PetscReal> dK(K.size()), dg(g.size());
+      for (size_t i = 0; i < K.size(); ++i) dK[i] = K[i] - K0[i];
+      for (size_t i = 0; i < g.size(); ++i) dg[i] = g[i] - g0[i];
+      sum += Norm2(dK) / Norm2(K0) + Norm2(dg) / Norm2(g0);
+    }
+    const PetscReal rec = std::sqrt(sum / (2 * ms));
+    Check(wmin > 0, "random terms: every weight > 0 (min weight)", wmin, 0);
+    Check(res.residual <= opt.tol, "random terms: relative residual <= tol", res.residual, opt.tol);
+    Check(std::abs(rec - res.residual) <= 1e-6 * opt.tol + 1e-3 * res.residual, "random terms: residual recomputed from the fitted terms (|diff|)", std::abs(rec - res.residual), 1e-3 * res.residual);
+    Check((PetscInt)res.points.size() < Q, "random terms: points used (< Q)", (double)res.points.size(), Q);
+    Check(res.history.back() == res.residual && res.history.front() == 1.0, "random terms: history from 1 to the final residual (last - residual)", res.history.back() - res.residual, 0);
+  }
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, failures ? "test_empirical_cubature FAILED (%d failure(s))\n" : "test_empirical_cubature passed\n", failures));
+  PetscCall(PetscFinalize());
+  return failures ? 1 : 0;
+}
