@@ -15,7 +15,9 @@ each point labelled N,R,Mk,Mg; the FOM's median time as a vertical dashed line (
 the solver tolerance); a top axis with the speedup over the FOM; optional target error lines.
 Rows with failed solves are drawn as crosses at the top of the plot.
 
-Usage: /usr/bin/python3 share/plot_speed_error.py results/ring_on_block/sweep.json -o speed_error.png \
+Several tables (e.g. the ECSW and the EIM ROM, or two meshes) go into one picture, one colour pair each.
+
+Usage: /usr/bin/python3 share/plot_speed_error.py results/ring_on_block/sweep.json [more.json ...] -o speed_error.png \
            [--title ring_on_block] [--targets 1e-3,1e-2] [--dpi 150]
 Run it with Debian's /usr/bin/python3 (python3-matplotlib, python3-numpy).
 """
@@ -99,7 +101,8 @@ def read_table(path):
     tol = t.get("fom_tolerance", 1e-8)
     if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not tol > 0:
         fail("'%s': \"fom_tolerance\" is %r, expected a positive number" % (path, tol))
-    return out, (fom, float(tol)), t.get("scene"), t.get("ndofs")
+    mc = t.get("Mc")
+    return out, (fom, float(tol)), t.get("scene"), t.get("ndofs"), t.get("hyper"), int(mc) if isinstance(mc, (int, float)) else None
 
 
 def parse_targets(s):
@@ -122,7 +125,9 @@ def ok(v):
     return math.isfinite(v) and v > 0
 
 
-def label(r):
+def label(r, hyper=None):
+    if hyper == "ecsw":  # the cubature keeps its points under truncation: N,R only
+        return "%d,%d" % (r["N"], r["R"])
     return "%d,%d,%d,%d" % tuple(r[k] for k in SIZES)
 
 
@@ -184,62 +189,83 @@ def place_labels(fig, ax, labels, avoid):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description="Plot the max relative error against the online time per solve "
-                                            "of the ROM truncations in an rbcontact validate sweep table.")
-    p.add_argument("json", help="sweep table <stem>.json written by `rbcontact validate -validate_sweep "
-                                "-validate_sweep_output <stem>`")
-    p.add_argument("-o", "--output", help="PNG to write (default: <json without .json>.png)")
+                                            "of the ROM truncations in rbcontact validate sweep tables.")
+    p.add_argument("json", nargs="+", help="sweep table(s) <stem>.json written by `rbcontact validate -validate_sweep "
+                                           "-validate_sweep_output <stem>`; several tables (for instance the EIM and the "
+                                           "ECSW hyper-reduction, or two meshes) are drawn in one picture")
+    p.add_argument("-o", "--output", help="PNG to write (default: <first json without .json>.png)")
     p.add_argument("--title", default=None, help="scene name shown in the title (default: the table's \"scene\")")
     p.add_argument("--targets", default=None,
                    help="comma-separated target errors drawn as horizontal lines, e.g. 1e-3,1e-2")
     p.add_argument("--dpi", type=int, default=150, help="resolution (default 150)")
     a = p.parse_args(argv)
 
-    out = a.output or (a.json[:-5] if a.json.endswith(".json") else a.json) + ".png"
+    first = a.json[0]
+    out = a.output or (first[:-5] if first.endswith(".json") else first) + ".png"
     targets = parse_targets(a.targets) if a.targets else []
-    rows, (fom, fom_tol), scene, ndofs = read_table(a.json)
-    title = a.title or scene or os.path.basename(a.json)
+    tables = []
+    for path in a.json:
+        rows, (fom, fom_tol), scene, ndofs, hyper, mc = read_table(path)
+        tables.append(dict(path=path, rows=rows, fom=fom, fom_tol=fom_tol, scene=scene, ndofs=ndofs, hyper=hyper, mc=mc))
+    multi = len(tables) > 1
+    title = a.title or tables[0]["scene"] or os.path.basename(first)
+    palette = [("tab:blue", "tab:orange"), ("tab:green", "tab:red"), ("tab:purple", "tab:brown"), ("tab:cyan", "tab:olive"),
+               ("tab:gray", "tab:pink")]
 
-    series = [("max_rel_err_u", "u, energy norm", "o", "tab:blue"),
-              ("max_rel_err_lambda", "$\\lambda$, weighted $\\ell^2$", "s", "tab:orange")]
-    good = [r for r in rows if not r["failed"] and ok(r["online_median_s"])]
-    bad = [r for r in rows if r not in good]
-    ys = [r[k] for r in good for k, _, _, _ in series if ok(r[k])]
-    xs = [r["online_median_s"] for r in rows if ok(r["online_median_s"])]
-    if not ys and not bad:
-        fail("'%s': no row has a positive time and error to plot" % a.json)
-    if not ok(fom):
-        print("plot_speed_error.py: warning: '%s' has no FOM time (fom_median_s): no FOM line" % a.json)
-
-    fig, ax = plt.subplots(figsize=(8.5, 5.6), layout="constrained")
+    fig, ax = plt.subplots(figsize=(9.0, 6.2), layout="constrained")
     ax.set_xscale("log")
     ax.set_yscale("log")
     labels = []  # (x, y, text, color): placed once the axes are final
-    for key, name, marker, color in series:
-        pts = sorted((r["online_median_s"], r[key], i) for i, r in enumerate(good) if ok(r[key]))
-        if not pts:
-            continue
-        ax.plot([q[0] for q in pts], [q[1] for q in pts], "-", marker=marker, color=color, markersize=6,
-                linewidth=1.0, zorder=3, label="max rel. error of %s" % name)
-        labels += [(xi, yi, label(good[i]), color) for xi, yi, i in pts]
+    xs, ys, bad_all, foms = [], [], [], []
+    for ti, t in enumerate(tables):
+        cu, cl = palette[ti % len(palette)]
+        name = ""
+        if multi or t["hyper"]:
+            name = "%s%s: " % ((t["hyper"] or "").upper() + (" Mc %d" % t["mc"] if t["hyper"] == "ecsw" and t["mc"] else ""),
+                               (", %s dofs" % t["ndofs"]) if multi and t["ndofs"] is not None else "")
+        series = [("max_rel_err_u", "u, energy norm", "o", cu, "-"),
+                  ("max_rel_err_lambda", "$\\lambda$, weighted $\\ell^2$", "s", cl, "--")]
+        good = [r for r in t["rows"] if not r["failed"] and ok(r["online_median_s"])]
+        bad_all += [(r, t) for r in t["rows"] if r not in good]
+        ys += [r[k] for r in good for k, _, _, _, _ in series if ok(r[k])]
+        xs += [r["online_median_s"] for r in t["rows"] if ok(r["online_median_s"])]
+        for key, nm, marker, color, ls in series:
+            pts = sorted((r["online_median_s"], r[key], i) for i, r in enumerate(good) if ok(r[key]))
+            if not pts:
+                continue
+            ax.plot([q[0] for q in pts], [q[1] for q in pts], ls, marker=marker, color=color, markersize=6,
+                    linewidth=1.0, zorder=3, label="%smax rel. error of %s" % (name, nm))
+            labels += [(xi, yi, label(good[i], t["hyper"]), color) for xi, yi, i in pts]
+        if ok(t["fom"]):
+            foms.append((t["fom"], t["fom_tol"], t["ndofs"]))
+    if not ys and not bad_all:
+        fail("%s: no row has a positive time and error to plot" % ", ".join(a.json))
 
-    # limits: all times and the FOM line in x, all errors and targets in y (decades, with margins)
-    xall = xs + ([fom] if ok(fom) else [])
+    # limits: all times and the FOM lines in x, all errors and targets in y (decades, with margins)
+    xall = xs + [f[0] for f in foms]
     xlo, xhi = min(xall), max(xall)
     ax.set_xlim(xlo / 2.5, xhi * 4.0)
-    yall = ys + [tv for tv, _ in targets] + ([fom_tol] if ok(fom) else [])
+    yall = ys + [tv for tv, _ in targets] + [f[1] for f in foms]
     ylo, yhi = (min(yall), max(yall)) if yall else (1e-3, 1.0)
     ylo, yhi = 10 ** math.floor(math.log10(ylo) - 0.15), 10 ** math.ceil(math.log10(yhi) + 0.15)
     ax.set_ylim(ylo, yhi)
 
-    if ok(fom):
-        ax.axvline(fom, color="k", linestyle="--", linewidth=1.2, zorder=2,
-                   label="FOM (exact to solver tolerance), median %.3g s" % fom)
-        ax.text(fom, 0.98, "FOM (exact to solver tolerance) ", rotation=90, ha="right", va="top",
-                fontsize=8, transform=mtransforms.blended_transform_factory(ax.transData, ax.transAxes),
+    seen = set()
+    for fom, fom_tol, ndofs in foms:
+        key = (round(math.log10(fom), 2), ndofs)
+        if key in seen:
+            continue
+        seen.add(key)
+        tag = ("FOM, %s dofs" % ndofs) if (multi and ndofs is not None) else "FOM"
+        ax.axvline(fom, color="k", linestyle="--", linewidth=1.0, zorder=2)
+        ax.text(fom, 0.98, "%s (exact to solver tolerance) " % tag, rotation=90, ha="right", va="top",
+                fontsize=7.5, transform=mtransforms.blended_transform_factory(ax.transData, ax.transAxes),
                 bbox=dict(boxstyle="square,pad=0.05", facecolor="white", edgecolor="none", alpha=0.8))
         # the FOM as a point: its error is the solver's tolerance (Kacanov, KKT)
-        ax.plot([fom], [fom_tol], marker="*", color="k", markersize=13, linestyle="none", zorder=4,
-                label="FOM: median %.3g s, error ~ solver tolerance %.0e" % (fom, fom_tol))
+        ax.plot([fom], [fom_tol], marker="*", color="k", markersize=12, linestyle="none", zorder=4,
+                label="%s: median %.3g s, error ~ solver tolerance %.0e" % (tag, fom, fom_tol))
+    if len(foms) == 1 or (foms and not multi):
+        fom = foms[0][0]
         sec = ax.secondary_xaxis("top", functions=(lambda t: fom / np.maximum(t, 1e-300),
                                                    lambda s: fom / np.maximum(s, 1e-300)))
         sec.set_xlabel("speedup over the FOM (FOM median time / time per solve)", fontsize=9)
@@ -247,13 +273,13 @@ def main(argv=None):
         ax.axhline(tv, color="tab:green", linestyle=":", linewidth=1.2, zorder=1)
         ax.text(0.995, tv, "target %s" % tok, ha="right", va="bottom", fontsize=8, color="tab:green",
                 transform=mtransforms.blended_transform_factory(ax.transAxes, ax.transData))
-    if bad:  # failed truncations: crosses at the top edge (there is no error to plot)
+    if bad_all:  # failed truncations: crosses at the top edge (there is no error to plot)
         trans = mtransforms.blended_transform_factory(ax.transData, ax.transAxes)
-        for r in bad:
+        for r, t in bad_all:
             if ok(r["online_median_s"]):
                 ax.plot(r["online_median_s"], 0.97, "x", color="tab:red", markersize=8, mew=2, transform=trans,
                         clip_on=False, zorder=5)
-                ax.annotate(label(r) + " failed", (r["online_median_s"], 0.97), xycoords=trans, xytext=(5, -3),
+                ax.annotate(label(r, t["hyper"]) + " failed", (r["online_median_s"], 0.97), xycoords=trans, xytext=(5, -3),
                             textcoords="offset points", fontsize=7, color="tab:red", va="top")
         ax.plot([], [], "x", color="tab:red", mew=2, label="truncation with failed solves (no error)")
 
@@ -262,21 +288,23 @@ def main(argv=None):
     ax.grid(True, which="major", alpha=0.35)
     ax.grid(True, which="minor", alpha=0.12)
     # legend below the axes: the plot area is for the points and their labels
-    leg = ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=3, frameon=False)
+    leg = ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2, frameon=False)
     place_labels(fig, ax, labels, [leg])
-    sub = "point labels: N,R,Mk,Mg (reduced primal, dual, EIM kappa, EIM gap sizes); %d truncations" % len(rows)
-    if bad:
-        sub += ", %d with failed solves" % len(bad)
-    hidden = ["%s %s" % (label(r), "u" if k == "max_rel_err_u" else "lambda") for r in good for k, _, _, _ in series
-              if not ok(r[k])]
+    nrows = sum(len(t["rows"]) for t in tables)
+    sub = "point labels: N,R (ECSW: reduced primal and dual sizes) or N,R,Mk,Mg (EIM: + kappa and gap terms); %d truncations" % nrows
+    if bad_all:
+        sub += ", %d with failed solves" % len(bad_all)
+    hidden = ["%s %s" % (label(r, t["hyper"]), "u" if k == "max_rel_err_u" else "lambda") for t in tables for r in t["rows"]
+              if not r["failed"] and ok(r["online_median_s"]) for k in ("max_rel_err_u", "max_rel_err_lambda") if not ok(r[k])]
     if hidden:  # zero (exact) or missing errors have no place on a log axis
         sub += "\nnot drawn (error zero or missing): %s" % "; ".join(hidden)
-    if bad:
-        first = next((r["first_failure"] for r in bad if r["first_failure"]), "")
-        if first:
-            sub += "\nfirst failure: %s" % (first if len(first) <= 110 else first[:107] + "...")
+    if bad_all:
+        firstf = next((r["first_failure"] for r, _ in bad_all if r["first_failure"]), "")
+        if firstf:
+            sub += "\nfirst failure: %s" % (firstf if len(firstf) <= 110 else firstf[:107] + "...")
+    nd = tables[0]["ndofs"]
     fig.suptitle("%s: ROM speed against error%s\n%s"
-                 % (title, (", %s dofs" % ndofs) if ndofs is not None else "", sub), fontsize=10)
+                 % (title, (", %s dofs" % nd) if (nd is not None and not multi) else "", sub), fontsize=9.5)
 
     odir = os.path.dirname(os.path.abspath(out))
     if not os.path.isdir(odir):

@@ -77,10 +77,12 @@ MU_ONLINE=1.02
 # Extra options for the FOM run, e.g. CONTACT_OPTS=(-kacanov_monitor).
 CONTACT_OPTS=()
 
-speed_error() {
-  echo "+ $PYTHON share/plot_speed_error.py $1 -o $2 --targets 1e-3,1e-2"
-  "$PYTHON" share/plot_speed_error.py "$1" -o "$2" --targets 1e-3,1e-2 || die "plotting $1 failed"
-  PICTURES+=("$2")
+speed_error() { # speed_error out.png table.json [table.json ...]
+  local png="$1"
+  shift
+  echo "+ $PYTHON share/plot_speed_error.py $* -o $png --targets 1e-4,1e-2"
+  "$PYTHON" share/plot_speed_error.py "$@" -o "$png" --targets 1e-4,1e-2 || die "plotting $* failed"
+  PICTURES+=("$png")
 }
 
 main_job() {
@@ -89,19 +91,29 @@ main_job() {
   plot "$OUT/fom.h5" "$OUT/fom.png" "$SCENE"
   plot_pressure "$OUT/fom.h5" "$OUT/pressure.png" "$SCENE"
   # offline: resumes the snapshot file of an earlier (killed) run of the same problem
-  rbc offline "$OUT/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -snapshots_monitor
+  # (both hyper-reductions: the ECSW cubature, the default online, and the EIM, for the comparison)
+  rbc offline "$OUT/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -rom_hyper ecsw,eim -snapshots_monitor
   rbc online "$OUT/online.json" -rom "$OUT/rom.h5" -mu "$MU_ONLINE" -online_repeat 1000 -options_file "runs/$SCENE.opts" -rom_reconstruct "$OUT/online_fields.h5"
   plot "$OUT/online_fields.h5" "$OUT/deformed_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"
   plot_pressure "$OUT/online_fields.h5" "$OUT/pressure_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"
   rbc validate "$OUT/validate.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -validate_sweep -validate_sweep_output "$OUT/sweep"
-  speed_error "$OUT/sweep.json" "$OUT/speed_error.png"
+  rbc validate "$OUT/validate_eim.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -rom_hyper eim -validate_sweep -validate_sweep_output "$OUT/sweep_eim"
+  # the same on the mesh refined twice (the hard setting: where the EIM lost its accuracy), 10 test radii
+  rbc offline "$OUT/refine2/offline.json" -options_file "runs/$SCENE.opts" -mesh_refine 2 -rom "$OUT/refine2/rom.h5" -rom_hyper ecsw,eim
+  rbc validate "$OUT/refine2/validate.json" -options_file "runs/$SCENE.opts" -mesh_refine 2 -rom "$OUT/refine2/rom.h5" -test_size 10 -validate_sweep -validate_sweep_output "$OUT/refine2/sweep"
+  rbc validate "$OUT/refine2/validate_eim.json" -options_file "runs/$SCENE.opts" -mesh_refine 2 -rom "$OUT/refine2/rom.h5" -rom_hyper eim -test_size 10 -validate_sweep -validate_sweep_output "$OUT/refine2/sweep_eim"
+  speed_error "$OUT/speed_error.png" "$OUT/sweep.json" "$OUT/sweep_eim.json" "$OUT/refine2/sweep.json" "$OUT/refine2/sweep_eim.json"
   "$PYTHON" - "$OUT/validate.json" <<'PY' || die "reading the validation report failed"
-import json, sys
-r = json.load(open(sys.argv[1]))
-t, ro = r["test"], r["rom"]
-print("validation (%d random radii): ROM N %d R %d Mk %d Mg %d" % (t["n"], ro["N"], ro["R"], ro["Mk"], ro["Mg"]))
-print("  max rel err u %.2e (target 1e-3), lambda %.2e (target 1e-2), force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
-print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
+import json, os, sys
+d = os.path.dirname(sys.argv[1])
+for tag, path in (("refine 0", "validate.json"), ("refine 0", "validate_eim.json"), ("refine 2", "refine2/validate.json"), ("refine 2", "refine2/validate_eim.json")):
+    r = json.load(open(os.path.join(d, path)))
+    t, x, ro = r["test"], r["test_exact"], r["rom"]
+    sizes = "Mc %d" % ro["Mc"] if ro["hyper"] == "ecsw" else "Mk %d Mg %d" % (ro["Mk"], ro["Mg"])
+    print("validation %s, %s (%d random radii, %d dofs): ROM N %d R %d %s" % (tag, ro["hyper"].upper(), t["n"], ro["ndofs"], ro["N"], ro["R"], sizes))
+    print("  max rel err u %.2e (target 1e-4), lambda %.2e (target 1e-2), force %.2e (target 1e-3); exact contact terms: u %.2e lambda %.2e"
+          % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], x["max_rel_err_u"], x["max_rel_err_lambda"]))
+    print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
 PY
 }
 # ============================ END MAIN JOB ============================
@@ -113,5 +125,5 @@ for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
 echo "fields:  $ROOT/$OUT/fom.h5, $ROOT/$OUT/online_fields.h5 (ROM)"
 echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf (open them in ParaView)"
 echo "ROM:     $ROOT/$OUT/rom.h5 (online data), rom.basis.h5, rom.snapshots.h5"
-echo "sweep:   $ROOT/$OUT/sweep.csv"
+echo "sweep:   $ROOT/$OUT/sweep.csv, sweep_eim.csv, refine2/sweep.csv, refine2/sweep_eim.csv"
 for p in "${PICTURES[@]}"; do echo "picture: $ROOT/$p"; done

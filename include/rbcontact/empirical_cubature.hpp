@@ -22,7 +22,7 @@ namespace rbc {
 
 struct CubatureOptions {
   PetscReal tol       = 1e-4;  // stop when ||G (xi - 1)|| <= tol ||G 1|| (relative RMS error of the fitted terms)
-  PetscInt  maxPoints = 300;   // at most this many points
+  PetscInt  maxPoints = 1000;  // at most this many points (the tolerance decides; a safeguard)
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
 };
 

@@ -138,6 +138,11 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
       for (PetscInt k = 0; k < dual.W.cols; ++k)
         for (PetscInt i = 0; i < R; ++i) dual.W(i, k) = sw[i] > 0 ? dual.W(i, k) / sw[i] : 0.0;
     rep->root["dual_mass_weighted"] = (bool)massWeighted;
+    // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
+    // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
+    const bool tooCoarse = dual.W.cols >= m - 1 && m > 2;
+    rep->root["dual_kept_all_snapshots"] = tooCoarse;
+    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", dual.W.cols, m));
   }
   PetscCall(PetscTime(&t2));
 

@@ -427,21 +427,21 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   e["rom_kacanov_iterations"]["total"] = (long long)nRomIts;
   e["rom_kacanov_iterations"]["max"]   = (long long)maxRomIts;
   JsonValue &k = e["kappa"];
-  k["kind"]            = rm.kappaConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
+  k["kind"]            = rm.kappaConst ? "constant: independent of mu and u, stored exactly (no EIM)" : eimKappa ? "eim" : "none (-rom_hyper without eim)";
   k["M"]               = (long long)(rm.kappaConst ? 0 : ek.M); // the greedy's size (rom.Mk: in use)
   k["depends_on_u"]    = uDep > 1e-13;
   k["u_sensitivity"]   = (double)uDep;
   k["snapshot_spread"] = (double)spreadK;
-  if (!rm.kappaConst) {
+  if (eimKappa) {
     k["history"] = ek.history;
     k["tol_abs"] = (double)ek.tolAbs;
     k["scale"]   = (double)ek.scale;
   }
   JsonValue &g = e["gap"];
-  g["kind"]            = rm.gapConst ? "constant: independent of mu and u, stored exactly (no EIM)" : "eim";
+  g["kind"]            = rm.gapConst ? "constant: independent of mu and u, stored exactly (no EIM)" : eimGap ? "eim" : "none (-rom_hyper without eim)";
   g["M"]               = (long long)(rm.gapConst ? 0 : eg.M);
   g["snapshot_spread"] = (double)spreadG;
-  if (!rm.gapConst) {
+  if (eimGap) {
     g["history"] = eg.history;
     g["tol_abs"] = (double)eg.tolAbs;
     g["scale"]   = (double)eg.scale;

@@ -49,6 +49,12 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscCall(fom.AssembleAndFactor());
   if (scene.contact) PetscCall(kacanov.Solve(fom, map));
   else PetscCall(fom.SolveElastic());
+  { // never write a non-finite answer (nor over a good earlier output): the check comes before any output
+    PetscReal nu, nl = 0;
+    PetscCall(VecNorm(fom.u, NORM_INFINITY, &nu));
+    if (scene.contact) PetscCall(VecNorm(kacanov.lambda, NORM_INFINITY, &nl));
+    PetscCheck(std::isfinite(nu) && std::isfinite(nl), comm, PETSC_ERR_FP, "fom: the solution holds non-finite values (displacement %s, multipliers %s): check the scene's data (loads, materials, boundary values) and the solver's messages; nothing was written", std::isfinite(nu) ? "finite" : "NOT finite", std::isfinite(nl) ? "finite" : "NOT finite");
+  }
   PetscCall(PetscTime(&t1));
   fom.times.total = t1 - t0;
   PetscCall(fom.FillReport(&rep));

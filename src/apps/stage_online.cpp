@@ -79,6 +79,8 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   r["R"]                         = (long long)model.R();
   r["Mk"]                        = (long long)model.Mk();
   r["Mg"]                        = (long long)model.Mg();
+  r["Mc"]                        = (long long)model.Mc();
+  r["hyper"]                     = model.Mode() == ReducedModel::ContactMode::Cubature ? "ecsw" : "eim";
   rep.root["time_s"]["open"]     = tOpen;
   rep.root["time_s"]["solve_median"] = times[times.size() / 2];
   rep.root["time_s"]["solve_min"]    = times.front();

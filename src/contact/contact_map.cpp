@@ -254,6 +254,17 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   // Current displacement on both surfaces; the master is gathered on every rank.
   PetscCall(slave_.Update(elas, uloc));
   PetscCall(master_.Update(elas, uloc));
+  { // a non-finite displacement would send the closest-point search out of its bins: refuse it here
+    PetscInt bad = 0;
+    for (const auto *surf : {&slave_, &master_})
+      for (const auto &F : surf->facets)
+      {
+        for (PetscInt i = 0; i < F.nnodes * dim; ++i) bad |= !std::isfinite(F.U[i]);
+        for (PetscInt i = 0; i < F.nv * dim; ++i) bad |= !std::isfinite(F.X[i]);
+      }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
+    PetscCheck(!bad, comm, PETSC_ERR_FP, "contact: the displacement or the geometry of the contact surfaces holds non-finite values (a NaN in the data, or a singular elastic solve): the contact map cannot be evaluated");
+  }
   PetscCall(master_.Gather(comm, &masterAll_));
   ClosestPoint cp;
   PetscCall(cp.Build(masterAll_, dim, true));

@@ -44,6 +44,12 @@ static PetscErrorCode GetRealArray(const char *name, std::vector<PetscReal> *v, 
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetRealArray(NULL, NULL, name, buf, &n, &flg));
+  // every rank reads the same options: a local error on each (no collective, no hang)
+  PetscBool has = PETSC_FALSE;
+  PetscCall(PetscOptionsHasName(NULL, NULL, name, &has));
+  PetscCheck(!has || (flg && n > 0), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "option %s is given without a value", name);
+  for (PetscInt i = 0; flg && i < n; ++i)
+    PetscCheck(std::isfinite(buf[i]), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "option %s: value %" PetscInt_FMT " is not a finite number", name, i + 1);
   if (flg) v->assign(buf, buf + n);
   if (set) *set = flg;
   PetscFunctionReturn(0);

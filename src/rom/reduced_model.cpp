@@ -56,6 +56,20 @@ PetscErrorCode ReadChecked(const std::string &file, const std::string &name, siz
   PetscFunctionReturn(0);
 }
 
+// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
+PetscErrorCode ReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found)
+{
+  std::vector<U64> dims;
+  PetscErrorCode   ierr;
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = RomReadDataset(file, name, &dims, data);
+  PetscCall(PetscPopErrorHandler());
+  *found = !ierr;
+  if (*found) PetscCall(ReadChecked(file, name, data->size(), data));
+  PetscFunctionReturn(0);
+}
+
 std::vector<PetscInt> ToInt(const std::vector<double> &d) { return std::vector<PetscInt>(d.begin(), d.end()); }
 } // namespace
 
@@ -269,12 +283,9 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   warmV.clear();
   warmL.clear();
   {
-    std::vector<U64> dims;
-    PetscErrorCode   ierr;
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = RomReadDataset(path, "/online/warm/mu", &dims, &warmMu);
-    PetscCall(PetscPopErrorHandler());
-    if (ierr) warmMu.clear();
+    bool found;
+    PetscCall(ReadOptional(path, "/online/warm/mu", &warmMu, &found));
+    if (!found) warmMu.clear();
     else {
       const size_t nw = warmMu.size() / std::max<size_t>(1, par.params.size());
       PetscCall(ReadChecked(path, "/online/warm/v", nw * N, &warmV));
@@ -286,20 +297,15 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   cPw.clear();
   hyperDefault = ContactMode::EIM;
   {
-    std::vector<U64> dims;
-    PetscErrorCode   ierr;
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = RomReadDataset(path, "/online/ecsw/points", &dims, &d);
-    PetscCall(PetscPopErrorHandler());
-    if (!ierr) {
+    bool found;
+    PetscCall(ReadOptional(path, "/online/ecsw/points", &d, &found));
+    if (found) {
       cPoint = ToInt(d);
       for (PetscInt p : cPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw/points out of range", path.c_str());
       PetscCall(ReadChecked(path, "/online/ecsw/Pw", R * cPoint.size(), &cPw));
     }
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = RomReadDataset(path, "/online/hyper_default", &dims, &d);
-    PetscCall(PetscPopErrorHandler());
-    if (!ierr) {
+    PetscCall(ReadOptional(path, "/online/hyper_default", &d, &found));
+    if (found) {
       PetscCheck(d.size() == 1 && (d[0] == 0 || d[0] == 1) && (d[0] == 0 || !cPoint.empty()), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default is malformed", path.c_str());
       hyperDefault = d[0] == 1 ? ContactMode::Cubature : ContactMode::EIM;
     }
@@ -307,12 +313,9 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   mode_ = hyperDefault;
   MkDefault = MgDefault = -1;
   { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
-    std::vector<U64> dims;
-    PetscErrorCode   ierr;
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = RomReadDataset(path, "/online/eim_default", &dims, &d);
-    PetscCall(PetscPopErrorHandler());
-    if (!ierr) {
+    bool found;
+    PetscCall(ReadOptional(path, "/online/eim_default", &d, &found));
+    if (found) {
       PetscCheck(d.size() == 2 && d[0] >= -1 && d[0] <= MkFull && d[1] >= -1 && d[1] <= MgFull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_default must hold 2 sizes within [-1, Mk = %" PetscInt_FMT "] and [-1, Mg = %" PetscInt_FMT "]", path.c_str(), MkFull, MgFull);
       MkDefault = (PetscInt)d[0];
       MgDefault = (PetscInt)d[1];
