@@ -321,9 +321,48 @@ def half_disks(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def files(args):
+    """Files that belong together are checked together: the ROM against the scene as configured now
+    (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
+    ROM and basis file byte-identical with no temporary file behind."""
+    import glob
+    import hashlib
+    d = tempfile.mkdtemp(prefix="rbc_files_")
+    small = ["-train_size", "7"]
+    rom, _ = offline(args, d, np_=2, extra=small)
+    sha = lambda p: hashlib.sha256(open(p, "rb").read()).hexdigest()
+    before = {p: sha(p) for p in (rom, d + "/rom.basis.h5")}
+    val = ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "2", "-validate_repeat", "1"]
+    # the scene changed after offline: refused, naming the cause
+    for np_ in (1, 2):
+        p = run(args, np_, "validate", val + ["-body_E", "200,100"], expect_ok=False)
+        check(p.returncode != 0 and "was built for another configuration of scene 'ring_on_block'" in p.stdout,
+              "validate with -body_E 200,100 on %d rank(s): refused (scene hash), exit %d" % (np_, p.returncode))
+    p = run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-bc_ring_top_u", "0,-0.05",
+                                "-rom_reconstruct", d + "/rec.h5"], expect_ok=False)
+    check(p.returncode != 0 and "another configuration" in p.stdout and not os.path.exists(d + "/rec.h5"),
+          "-rom_reconstruct with another load: refused, nothing written (exit %d)" % p.returncode)
+    # a basis file of another offline run of the same scene: refused (rom_id)
+    d2 = d + "/other"
+    os.makedirs(d2)
+    offline(args, d2, np_=1, extra=small)
+    p = run(args, 1, "validate", val + ["-rom_basis", d2 + "/rom.basis.h5"], expect_ok=False)
+    check(p.returncode != 0 and "was not written by the offline run of the ROM" in p.stdout, "basis file of another offline run: refused (rom_id), exit %d" % p.returncode)
+    # an offline run that fails in its last step leaves the previous pair as it was
+    for np_ in (1, 2):
+        p = run(args, np_, "offline", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-ecsw_max_points", "1"] + small, expect_ok=False)
+        after = {q: sha(q) for q in before}
+        left = glob.glob(d + "/*.tmp*") + glob.glob(d + "/.*tmp*")
+        check(p.returncode != 0 and "-ecsw_max_points" in p.stdout and after == before and not left,
+              "offline failing on %d rank(s) (-ecsw_max_points 1): ROM and basis file unchanged, no temporary file (%s)" % (np_, left))
+    p = run(args, 1, "validate", val)
+    check(p.returncode == 0, "the previous ROM and basis file still validate")
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -93,6 +93,9 @@ public:
   ContactMode Mode() const { return mode_; }
   bool HasEIM() const { return kappaConst || gapConst || MkFull > 0 || MgFull > 0; }
   bool HasCubature() const { return !cPoint.empty(); }
+  // "ecsw" or "eim" (the mode in use), and its sizes for messages: "ECSW Mc 110" or "EIM Mk 43 Mg 10"
+  const char *HyperName() const { return mode_ == ContactMode::Cubature ? "ecsw" : "eim"; }
+  std::string HyperSizes() const { return mode_ == ContactMode::Cubature ? "ECSW Mc " + std::to_string(Mc()) : "EIM Mk " + std::to_string(mk_) + " Mg " + std::to_string(mg_); }
   // POD column (index into the stored primal basis) of each active reduced coordinate.
   const std::vector<PetscInt> &Columns() const { return cols_; }
   // Reduced A^(mu) (N x N, column-major) and f^(mu).

@@ -7,7 +7,9 @@
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
+#include "rbcontact/mesh.hpp"
 #include <cmath>
+#include <unistd.h>
 #include <filesystem>
 #include <cstring>
 #include <sstream>
@@ -226,11 +228,22 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
   const std::string &bpath = cmap ? basisPath : romPath;
   RomWriter          w, wr;
-  auto               provenance = [&](RomWriter *x) {
+  // rom_id: one id for the files of this run (ROM and basis file), checked when they are read together
+  std::string romId;
+  {
+    std::ostringstream id;
+    PetscLogDouble     now;
+    PetscCall(PetscTime(&now));
+    id << std::hex << Fnv1a(std::to_string(header.sceneHash) + " " + std::to_string(now) + " " + std::to_string((long long)getpid()));
+    romId = id.str();
+    PetscCall(BcastString(world, &romId));
+  }
+  auto provenance = [&](RomWriter *x) {
     std::ostringstream hs;
     hs << std::hex << header.sceneHash;
     x->Attr("scene", header.scene);
     x->Attr("scene_hash", hs.str());
+    x->Attr("rom_id", romId);
     x->Attr("code_version", header.codeVersion);
     x->Attr("snapshots", snapPath);
     x->Attr("options", header.optionsText);
@@ -245,7 +258,9 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     w.Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
     if (R > 0) WriteDualBasis(dual, &w, true);
   }
-  PetscCall(w.Write(world, bpath));
+  // the bases alone (-offline_stop bases) are written now; with the online ROM, after it is built, so
+  // that a failed run leaves the previous ROM and basis file together (and rom_id tells a torn pair)
+  if (!cmap) PetscCall(w.Write(world, bpath));
   if (cmap) {
     // the online ROM: everything the online stage needs, nothing of the size of the mesh
     MPI_Comm    fcomm = PetscObjectComm((PetscObject)fom.dm);
@@ -263,6 +278,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
       WriteDualBasis(dual, &wr, false);
     }
     PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep));
+    PetscCall(w.Write(world, bpath));
     PetscCall(wr.Write(world, romPath));
     unsigned long long big[2] = {0, 0};
     std::string        bigName;

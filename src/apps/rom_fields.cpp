@@ -3,8 +3,64 @@
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_file.hpp"
 #include <filesystem>
+#include <sstream>
+#include "rbcontact/mesh.hpp"
 
 namespace rbc {
+
+// Everything that defines the problem (not the run): the snapshot file's scene hash.
+std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map)
+{
+  std::ostringstream o;
+  o.precision(17);
+  o << "scene " << s.name << "|mesh " << s.mesh.file << " " << s.mesh.clscale;
+  for (const auto &g : s.mesh.geoNumbers) o << " " << g.first << "=" << g.second;
+  o << "|degree " << s.degree;
+  for (const auto &b : s.bodies) o << "|body " << b.name << " " << b.E << " " << b.nu << " " << b.paramE << " " << b.paramNu;
+  for (const auto &d : s.dirichlet) {
+    o << "|dirichlet " << d.label << " " << d.param;
+    for (auto v : d.values) o << " " << v;
+    for (auto c : d.comps) o << " c" << c;
+  }
+  for (const auto &t : s.tractions) {
+    o << "|traction " << t.label << " " << t.param;
+    for (auto v : t.traction) o << " " << v;
+  }
+  for (auto v : s.bodyForce) o << "|bf " << v;
+  o << "|contact " << s.contact << " " << s.slave << " " << s.master;
+  for (const auto &p : s.params) o << "|param " << p.name << " " << p.min << " " << p.max << " " << p.def;
+  o << "|map " << map.Describe(s);
+  { // the multiplier functions change the problem; always in the hash (files of the standard default differ)
+    char mult[64] = "dual";
+    (void)PetscOptionsGetString(NULL, NULL, "-contact_multiplier", mult, sizeof mult, NULL);
+    o << "|multiplier " << mult;
+  }
+  for (const char *opt : {"-contact_quadrature", "-contact_quadrature_points", "-contact_normal"}) {
+    char      v[256] = "";
+    PetscBool set;
+    if (!PetscOptionsGetString(NULL, NULL, opt, v, sizeof v, &set) && set) o << "|" << opt << " " << v;
+  }
+  return o.str();
+}
+
+std::string SceneHashHex(const SceneSpec &s, const GeometryMap &map)
+{
+  std::ostringstream hs;
+  hs << std::hex << Fnv1a(SceneFingerprint(s, map));
+  return hs.str();
+}
+
+PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const SceneSpec &scene, const GeometryMap &map)
+{
+  std::string stored, romScene;
+  PetscFunctionBeginUser;
+  PetscCall(RomReadAttr(romPath, "scene", &romScene));
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), romPath.c_str(), romScene.c_str(), romScene.c_str());
+  PetscCall(RomReadAttr(romPath, "scene_hash", &stored));
+  const std::string now = SceneHashHex(scene, map);
+  PetscCheck(stored == now, comm, PETSC_ERR_USER_INPUT, "the ROM %s was built for another configuration of scene '%s' (scene hash %s; the options now give %s): materials, loads, boundary conditions, parameters, maps, mesh or contact options differ. Rebuild it with offline, or run with the options it was built with (stored in its attribute 'options')", romPath.c_str(), scene.name.c_str(), stored.c_str(), now.c_str());
+  PetscFunctionReturn(0);
+}
 
 PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt nd)
 {
@@ -22,6 +78,15 @@ PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const st
     const std::filesystem::path p(path), beside = std::filesystem::path(romPath).parent_path() / p;
     std::error_code             ec;
     if (p.is_relative() && std::filesystem::exists(beside, ec)) path = beside.string();
+  }
+  { // the pair written by one offline run (files of before 2026-11-23 have no rom_id: not checked)
+    std::string idRom, idBasis;
+    PetscErrorCode e1, e2;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    e1 = RomReadAttr(romPath, "rom_id", &idRom);
+    e2 = RomReadAttr(path, "rom_id", &idBasis);
+    PetscCall(PetscPopErrorHandler());
+    PetscCheck(e1 || e2 || idRom == idBasis, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s (rom_id %s) was not written by the offline run of the ROM %s (rom_id %s): a mismatched or half-replaced pair; rerun offline (or give the right file with -rom_basis)", path.c_str(), idBasis.c_str(), romPath.c_str(), idRom.c_str());
   }
   PetscCall(RomReadDataset(path, "/pod/modes", &dims, &modes));
   PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Nfull && (PetscInt)dims[1] == nd, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /pod/modes is %llu x %llu, the ROM %s has N = %" PetscInt_FMT " and the scene %" PetscInt_FMT " dofs (another scene or mesh?)", path.c_str(), dims.size() > 0 ? dims[0] : 0ULL, dims.size() > 1 ? dims[1] : 0ULL, romPath.c_str(), model.Nfull, nd);
@@ -131,6 +196,7 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   PetscCall(RomReadAttr(model.file, "scene", &romScene));
   PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "-rom_reconstruct: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), model.file.c_str(), romScene.c_str(), romScene.c_str());
   PetscCall(fom.Create(comm, scene));
+  PetscCall(CheckRomScene(comm, model.file, scene, fom.map));
   PetscCall(fom.SetupAffine());
   PetscCall(fom.SetMu(mu));
   PetscCall(order.BuildDofs(fom.elas));

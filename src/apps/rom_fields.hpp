@@ -25,13 +25,20 @@ public:
   std::vector<double>    modes, W; // N x ndofs, r x R (row-major, canonical)
 };
 
+// Everything that defines the problem (not the run): scene, mesh, materials, loads, parameters, maps,
+// contact options (the multiplier functions always). Its FNV-1a hash (hex) is the files' scene_hash.
+std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map);
+std::string SceneHashHex(const SceneSpec &s, const GeometryMap &map);
+// The ROM at romPath belongs to this scene as configured now (name and scene_hash); else a clear error.
+PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const SceneSpec &scene, const GeometryMap &map);
+
+// The contact system at the default parameter and u = 0 (Dirichlet values lifted); numbers order's
+// multipliers if needed. Its weight is the slave mass int psi_i of the reference configuration.
+PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys);
 // The full contact patch (ContactPatch::BuildFull) on the support of the dual basis Wt (r x R_fom,
 // row-major, canonical) with the primal basis modes (N x ndofs, canonical), nsub composite pieces, and
 // P = W' Psi (r x Q, row-major). The surfaces are assembled at the default parameter with u = 0 (they
 // then carry the Dirichlet values); numbers order's multipliers if not done yet. Collective on fom.
-// The contact system at the default parameter and u = 0 (Dirichlet values lifted); numbers order's
-// multipliers if needed. Its weight is the slave mass int psi_i of the reference configuration.
-PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys);
 PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P);
 // lambda (canonical multiplier order) into the distributed multiplier vector v (rows of K).
 PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::vector<PetscReal> &lambda, Vec v);

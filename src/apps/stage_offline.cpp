@@ -5,6 +5,7 @@
 #include "stages.hpp"
 #include "offline_bases.hpp"
 #include "offline_rom.hpp"
+#include "rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/fom.hpp"
@@ -25,35 +26,6 @@ namespace rbc {
 
 static PetscLogEvent OFF_Snapshots = 0;
 
-// Everything that defines the problem (not the run): the snapshot file's scene hash.
-static std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map)
-{
-  std::ostringstream o;
-  o.precision(17);
-  o << "scene " << s.name << "|mesh " << s.mesh.file << " " << s.mesh.clscale;
-  for (const auto &g : s.mesh.geoNumbers) o << " " << g.first << "=" << g.second;
-  o << "|degree " << s.degree;
-  for (const auto &b : s.bodies) o << "|body " << b.name << " " << b.E << " " << b.nu << " " << b.paramE << " " << b.paramNu;
-  for (const auto &d : s.dirichlet) {
-    o << "|dirichlet " << d.label << " " << d.param;
-    for (auto v : d.values) o << " " << v;
-    for (auto c : d.comps) o << " c" << c;
-  }
-  for (const auto &t : s.tractions) {
-    o << "|traction " << t.label << " " << t.param;
-    for (auto v : t.traction) o << " " << v;
-  }
-  for (auto v : s.bodyForce) o << "|bf " << v;
-  o << "|contact " << s.contact << " " << s.slave << " " << s.master;
-  for (const auto &p : s.params) o << "|param " << p.name << " " << p.min << " " << p.max << " " << p.def;
-  o << "|map " << map.Describe(s);
-  for (const char *opt : {"-contact_quadrature", "-contact_quadrature_points", "-contact_normal"}) {
-    char      v[256] = "";
-    PetscBool set;
-    if (!PetscOptionsGetString(NULL, NULL, opt, v, sizeof v, &set) && set) o << "|" << opt << " " << v;
-  }
-  return o.str();
-}
 
 // Rank 0 reads the mesh file: its checksum and node count (msh22: the line after $Nodes).
 static PetscErrorCode MeshFacts(MPI_Comm comm, const SceneSpec &scene, unsigned long long *checksum, PetscInt *nnodes)

@@ -80,7 +80,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   r["Mk"]                        = (long long)model.Mk();
   r["Mg"]                        = (long long)model.Mg();
   r["Mc"]                        = (long long)model.Mc();
-  r["hyper"]                     = model.Mode() == ReducedModel::ContactMode::Cubature ? "ecsw" : "eim";
+  r["hyper"]                     = model.HyperName();
   rep.root["time_s"]["open"]     = tOpen;
   rep.root["time_s"]["solve_median"] = times[times.size() / 2];
   rep.root["time_s"]["solve_min"]    = times.front();
@@ -90,7 +90,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     PetscCall(ReconstructFields(comm, model, sol, mu, recPath, &rep));
     rep.root["reconstruct"] = recPath;
   }
-  PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " Mk %" PetscInt_FMT " Mg %" PetscInt_FMT ", %" PetscInt_FMT " Kacanov iterations, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.Mk(), model.Mg(), sol.iterations, times[times.size() / 2], repeat));
+  PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " %s, %" PetscInt_FMT " Kacanov iterations, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.HyperSizes().c_str(), sol.iterations, times[times.size() / 2], repeat));
   PetscCall(rep.Write(comm, reportPath));
   PetscFunctionReturn(0);
 }

@@ -153,13 +153,14 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   PetscCall(model.Open(romPath));
   PetscCall(model.SetFromOptions());
   PetscCall(RomReadAttr(romPath, "scene", &romScene));
-  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s'", scene.name.c_str(), romPath, romScene.c_str());
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), romPath, romScene.c_str(), romScene.c_str());
   ParameterSet test;
   PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
   for (const auto &mu : test.points) PetscCall(model.par.CheckBox(comm, mu));
 
   // the FOM of the scene (reference configuration, affine terms) and the bases
   PetscCall(fom.Create(comm, scene));
+  PetscCall(CheckRomScene(comm, romPath, scene, fom.map)); // the same materials, loads, maps, mesh as offline
   PetscCall(fom.SetupAffine());
   PetscCall(order.BuildDofs(fom.elas));
   PetscCall(bases.Read(comm, model, romPath, order.NumDofs()));
@@ -304,7 +305,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   ro["Mk"] = (long long)model.Mk();
   ro["Mg"] = (long long)model.Mg();
   ro["Mc"] = (long long)model.Mc();
-  ro["hyper"] = model.Mode() == ReducedModel::ContactMode::Cubature ? "ecsw" : "eim";
+  ro["hyper"] = model.HyperName();
   ro["ndofs"] = (long long)order.NumDofs();
 
   // speed against error over truncations of the same ROM
@@ -344,14 +345,14 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     table["fom_median_s"]    = fomMedian;
     table["fom_tolerance"]   = (double)std::max(kac.rtolPrimal, kac.rtolDual);
     table["scene"]           = scene.name;
-    table["hyper"]           = model.Mode() == ReducedModel::ContactMode::Cubature ? "ecsw" : "eim";
+    table["hyper"]           = model.HyperName();
     table["Mc"]              = (long long)model.Mc();
     table["ndofs"]           = (long long)order.NumDofs();
     PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".csv", csv.str()));
     PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".json", table.Dump()));
     rep.root["sweep_files"] = std::string(sweepOut) + ".{csv,json}";
   }
-  PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " %s: max rel err u %.3e lambda %.3e force %.3e (exact contact terms: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), (model.Mode() == ReducedModel::ContactMode::Cubature ? "ECSW Mc " + std::to_string(model.Mc()) : "EIM Mk " + std::to_string(model.Mk()) + " Mg " + std::to_string(model.Mg())).c_str(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
+  PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " %s: max rel err u %.3e lambda %.3e force %.3e (exact contact terms: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), model.HyperSizes().c_str(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
   PetscCall(rep.Write(comm, reportPath));
   for (auto &s : F) {
     PetscCall(VecDestroy(&s.u));
