@@ -230,7 +230,10 @@ def main(argv=None):
         ys += [r[k] for r in good for k, _, _, _, _ in series if ok(r[k])]
         xs += [r["online_median_s"] for r in t["rows"] if ok(r["online_median_s"])]
         for key, nm, marker, color, ls in series:
-            pts = sorted((r["online_median_s"], r[key], i) for i, r in enumerate(good) if ok(r[key]))
+            # along the truncation path (sizes increasing): the cubature keeps its points under truncation,
+            # so its time is not monotone in the sizes
+            order = sorted((i for i, r in enumerate(good) if ok(r[key])), key=lambda i: (good[i]["N"], good[i]["R"], good[i]["Mk"], good[i]["Mg"]))
+            pts = [(good[i]["online_median_s"], good[i][key], i) for i in order]
             if not pts:
                 continue
             ax.plot([q[0] for q in pts], [q[1] for q in pts], ls, marker=marker, color=color, markersize=6,
@@ -252,7 +255,7 @@ def main(argv=None):
 
     seen = set()
     for fom, fom_tol, ndofs in foms:
-        key = (round(math.log10(fom), 2), ndofs)
+        key = ndofs if ndofs is not None else round(math.log10(fom), 2)  # one FOM per mesh (its first table's time)
         if key in seen:
             continue
         seen.add(key)

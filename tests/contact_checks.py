@@ -255,9 +255,23 @@ def nan_input(args):
     check(p.returncode != 0 and "option -mu is given without a value" in p.stdout, "-mu without a value: an error naming it (exit %d)" % p.returncode)
 
 
+def floating(args):
+    """A body without Dirichlet values in some direction is refused before the solve, naming it (before:
+    -contact 0 gave |u| 8e11 and a negative energy with exit 0; with contact 'Schur complement not SPD')."""
+    print("Floating bodies: refused naming the body and the direction")
+    for extra, why in ((["-contact", "0", "-bc_dirichlet", "block_bottom", "-body_force", "0,-1"], "it floats"),
+                       (["-bc_dirichlet", "block_bottom"], "frictionless contact cannot hold it"),
+                       (["-bc_dirichlet", "ring_top,block_bottom", "-bc_block_bottom_comps", "1"], "body 'block' has no Dirichlet condition on its x displacement")):
+        cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts"] + extra
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        who = "body 'ring'" in p.stdout or "body 'block'" in p.stdout
+        check(p.returncode != 0 and who and why in p.stdout and re.search(r"SEGV|Segmentation|Caught signal", p.stdout) is None,
+              "%s: refused, '%s' (exit %d)" % (" ".join(extra), why, p.returncode))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

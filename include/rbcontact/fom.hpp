@@ -45,6 +45,9 @@ public:
   PetscInt GlobalSize() const;
   // Checks the factorization after KSPSetUp (diagnosis, one retry on a MUMPS workspace shortage).
   PetscErrorCode CheckFactorization();
+  // A clear error for a body with no Dirichlet value in some component (it floats: its translation in
+  // that direction is a null mode of A; frictionless contact cannot hold it). Collective.
+  PetscErrorCode CheckBodiesHeld() const;
 
   SceneSpec  scene;
   GeometryMap map;          // h(mu) per body (-map_<body> ...)
@@ -58,6 +61,9 @@ public:
   Vec        u   = nullptr;
   KSP        ksp = nullptr;
   FomTimes   times;
+
+private:
+  bool residualChecked_ = false; // the first solve after a factorization checks ||A x - rhs||
 };
 
 // One attribute of an XDMF grid: display name, HDF5 dataset path, components, node or cell centred.

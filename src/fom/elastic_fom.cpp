@@ -1,6 +1,8 @@
 // src/fom/elastic_fom.cpp: assembly, factorization and solve of the elastic full-order model.
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
+#include <cmath>
+#include <string>
 
 namespace rbc {
 
@@ -50,6 +52,7 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   PetscCall(map.SetFromOptions(PetscObjectComm((PetscObject)dm), scene));
   elas.SetGeometryMap(&map);
   PetscCall(elas.Setup(dm, scene));
+  PetscCall(CheckBodiesHeld());
   PetscCall(KSPCreate(PetscObjectComm((PetscObject)dm), &ksp));
   PetscCall(KSPSetOptionsPrefix(ksp, "fom_"));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
@@ -158,6 +161,7 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
     PetscCall(MatNullSpaceDestroy(&nsp));
   }
   PetscCall(KSPSetOperators(ksp, A, A));
+  residualChecked_ = false;
   PetscCall(PetscLogEventBegin(FOM_Factor, 0, 0, 0, 0));
   PetscCall(KSPSetUp(ksp));
   PetscCall(RefactorIfMumpsOutOfMemory(ksp, A));
@@ -166,6 +170,43 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   times.factorization += t0 - t1;
   if (!u) PetscCall(VecDuplicate(f, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ElasticFOM::CheckBodiesHeld() const
+{
+  const PetscInt nb = (PetscInt)scene.bodies.size(), dim = elas.dim;
+  PetscSection   s;
+  PetscInt       cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  if (nb == 0) PetscFunctionReturn(0);
+  PetscCall(DMGetLocalSection(dm, &s));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  std::vector<PetscInt> held((size_t)nb * dim, 0); // constrained dofs per body and component
+  const auto           &cb = elas.CellBody();
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    const PetscInt b = c - cStart < (PetscInt)cb.size() ? cb[c - cStart] : -1;
+    if (b < 0 || b >= nb) continue;
+    PetscInt *cl = NULL, ncl;
+    PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    for (PetscInt k = 0; k < ncl; ++k) {
+      PetscInt        ncd;
+      const PetscInt *idx;
+      PetscCall(PetscSectionGetConstraintDof(s, cl[2 * k], &ncd));
+      if (!ncd) continue;
+      PetscCall(PetscSectionGetConstraintIndices(s, cl[2 * k], &idx));
+      for (PetscInt j = 0; j < ncd; ++j) ++held[(size_t)b * dim + idx[j] % dim];
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, held.data(), (int)held.size(), MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  const char *axis[] = {"x", "y", "z"};
+  for (PetscInt b = 0; b < nb; ++b)
+    for (PetscInt d = 0; d < dim; ++d)
+      PetscCheck(held[(size_t)b * dim + d] > 0, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
+                 "body '%s' has no Dirichlet condition on its %s displacement: it floats (a rigid translation is a null mode of the stiffness%s). Constrain it with -bc_dirichlet (and -bc_<name>_comps)",
+                 scene.bodies[b].name.c_str(), axis[d], scene.contact ? "; frictionless contact cannot hold it" : "");
   PetscFunctionReturn(0);
 }
 
@@ -189,6 +230,18 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
     SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-bc_dirichlet)", PCFailedReasons[pcr]);
   }
   PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-bc_dirichlet)", KSPConvergedReasons[reason]);
+  if (!residualChecked_) { // the first solve with a new factorization: a direct solver on a singular A says nothing
+    Vec       r;
+    PetscReal nr, nb;
+    PetscCall(VecDuplicate(rhs, &r));
+    PetscCall(MatMult(A, x, r));
+    PetscCall(VecAXPY(r, -1.0, rhs));
+    PetscCall(VecNorm(r, NORM_2, &nr));
+    PetscCall(VecNorm(rhs, NORM_2, &nb));
+    PetscCall(VecDestroy(&r));
+    PetscCheck(std::isfinite(nr) && nr <= 1e-6 * nb, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) is inaccurate: relative residual %s. The stiffness is singular or nearly so: a body may rotate or move freely (too few Dirichlet conditions, -bc_dirichlet), or the materials are degenerate", std::isfinite(nr) && nb > 0 ? std::to_string(nr / nb).c_str() : "not finite");
+    residualChecked_ = true;
+  }
   PetscFunctionReturn(0);
 }
 
