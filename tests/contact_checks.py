@@ -269,9 +269,25 @@ def floating(args):
               "%s: refused, '%s' (exit %d)" % (" ".join(extra), why, p.returncode))
 
 
+def warnings(args):
+    """Warnings in the report (key warnings) and on the terminal: none on the shipped scene; the contact
+    zone reaching the ends of the slave surface (a push of 0.3); P1 with nu = 0.4999 (locking)."""
+    print("Warnings: contact past the slave surface, near-incompressible P1")
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", args.extra, "plain")
+    check(r["warnings"] == [], "shipped ring_on_block: no warning (%s)" % r["warnings"])
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-bc_ring_top_u", "0,-0.3"] + args.extra, "deep")
+    w = [s for s in r["warnings"] if "reaches the end of the slave surface" in s]
+    check(len(w) == 2 and r["nactive"] == r["ncontact"], "push 0.3: the whole slave surface in contact (%d/%d), 2 end warnings (%d)" % (r["nactive"], r["ncontact"], len(w)))
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999"] + args.extra, "nu")
+    w = [s for s in r["warnings"] if "-fem_degree 2" in s and "lock" in s]
+    check(len(w) == 2, "P1, nu = 0.4999: a locking warning per body (%d)" % len(w))
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999", "-fem_degree", "2"] + args.extra, "nu_p2")
+    check(not any("lock" in s for s in r["warnings"]), "P2, nu = 0.4999: no locking warning")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

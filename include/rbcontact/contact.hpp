@@ -114,6 +114,9 @@ public:
   // The free global dofs the constraint rows can touch (slave and master facet closures), sorted,
   // the same on every rank.
   PetscErrorCode SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const;
+  // Multiplier rows of the slave vertices that end the slave surface (2D: the vertices of a single
+  // slave facet; 3D: none yet), the same on every rank. Collective.
+  PetscErrorCode SlaveEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const;
   const ContactSurface &Slave() const { return slave_; }
   const ContactSurface &Master() const { return master_; }
   // Reference facet rule: barycentric points (dim per point) and weights summing to 1.

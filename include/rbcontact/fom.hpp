@@ -48,6 +48,9 @@ public:
   // A clear error for a body with no Dirichlet value in some component (it floats: its translation in
   // that direction is a null mode of A; frictionless contact cannot hold it). Collective.
   PetscErrorCode CheckBodiesHeld() const;
+  // A warning: printed once (rank 0 of the mesh's communicator) and kept for the report (key warnings).
+  PetscErrorCode Warn(const std::string &msg);
+  std::vector<std::string> warnings;
 
   SceneSpec  scene;
   GeometryMap map;          // h(mu) per body (-map_<body> ...)

@@ -73,6 +73,10 @@ struct ContactSummary {
 // Rows of K restricted to the sorted global dofs D: dense R x nD, column-major, on every rank.
 PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD);
 
+// Warnings about a converged contact solution (collective): the contact zone reaching an end of the
+// declared slave surface (contact beyond it is not enforced: the slave may penetrate there).
+PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, Vec lambda, std::vector<std::string> *warnings);
+
 // The whole of a parallel Vec on every rank (global order).
 PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full);
 

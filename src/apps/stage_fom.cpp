@@ -47,8 +47,12 @@ PetscErrorCode StageFom(MPI_Comm comm)
     map.SetGeometry(&fom.map, fom.mu);
   }
   PetscCall(fom.AssembleAndFactor());
-  if (scene.contact) PetscCall(kacanov.Solve(fom, map));
-  else PetscCall(fom.SolveElastic());
+  if (scene.contact) {
+    std::vector<std::string> w;
+    PetscCall(kacanov.Solve(fom, map));
+    PetscCall(ContactSurfaceWarnings(comm, map, kacanov.sys, kacanov.lambda, &w));
+    for (const auto &s : w) PetscCall(fom.Warn(s));
+  } else PetscCall(fom.SolveElastic());
   { // never write a non-finite answer (nor over a good earlier output): the check comes before any output
     PetscReal nu, nl = 0;
     PetscCall(VecNorm(fom.u, NORM_INFINITY, &nu));

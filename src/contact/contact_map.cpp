@@ -179,6 +179,22 @@ PetscErrorCode ContactMap::SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) 
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ContactMap::SlaveEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const
+{
+  std::vector<PetscInt> count(R_, 0);
+
+  PetscFunctionBeginUser;
+  rows->clear();
+  if (slave_.dim != 2) PetscFunctionReturn(0);
+  for (const auto &F : slave_.facets)
+    for (PetscInt k = 0; k < F.nv; ++k)
+      if (F.row[k] >= 0 && F.row[k] < R_) ++count[F.row[k]];
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count.data(), (int)R_, MPIU_INT, MPI_SUM, comm));
+  for (PetscInt r = 0; r < R_; ++r)
+    if (count[r] == 1) rows->push_back(r);
+  PetscFunctionReturn(0);
+}
+
 // Deformed position of the slave point at barycentric b.
 static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[], PetscReal zdef[])
 {

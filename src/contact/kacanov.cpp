@@ -377,6 +377,29 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, Vec lambda, std::vector<std::string> *warnings)
+{
+  std::vector<PetscInt>  ends;
+  std::vector<PetscReal> lam, x[3];
+
+  PetscFunctionBeginUser;
+  PetscCall(map.SlaveEndRows(comm, &ends));
+  if (ends.empty()) PetscFunctionReturn(0);
+  PetscCall(GatherVec(lambda, &lam));
+  PetscCall(GatherVec(sys.coord[0], &x[0]));
+  PetscCall(GatherVec(sys.coord[1], &x[1]));
+  PetscReal lmax = 0;
+  for (PetscReal l : lam) lmax = std::max(lmax, l);
+  for (PetscInt r : ends)
+    if (lmax > 0 && lam[r] > 1e-10 * lmax) {
+      std::ostringstream o;
+      o << "the contact zone reaches the end of the slave surface at (" << x[0][r] << ", " << x[1][r] << ") (pressure " << lam[r] << " there, max " << lmax
+        << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
+      warnings->push_back(o.str());
+    }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s)
 {
   std::vector<PetscReal> lam, w, n[3], x[3];

@@ -2,6 +2,7 @@
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace rbc {
@@ -53,6 +54,12 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   elas.SetGeometryMap(&map);
   PetscCall(elas.Setup(dm, scene));
   PetscCall(CheckBodiesHeld());
+  for (const auto &b : scene.bodies) // P1 locks as nu -> 1/2 (measured: nu 0.499999, contact force +52 % against P2)
+    if (elas.degree == 1 && b.nu > 0.49) {
+      std::ostringstream o;
+      o << "body '" << b.name << "' has nu = " << b.nu << " with P1 elements: linear triangles/tetrahedra lock as nu -> 0.5 (stiffness, stresses and contact forces overestimated); use -fem_degree 2";
+      PetscCall(Warn(o.str()));
+    }
   PetscCall(KSPCreate(PetscObjectComm((PetscObject)dm), &ksp));
   PetscCall(KSPSetOptionsPrefix(ksp, "fom_"));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
@@ -173,6 +180,14 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ElasticFOM::Warn(const std::string &msg)
+{
+  PetscFunctionBeginUser;
+  warnings.push_back(msg);
+  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm), "rbcontact: warning: %s\n", msg.c_str()));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ElasticFOM::CheckBodiesHeld() const
 {
   const PetscInt nb = (PetscInt)scene.bodies.size(), dim = elas.dim;
@@ -277,6 +292,9 @@ PetscErrorCode ElasticFOM::FillReport(Report *rep)
   t["contact"]         = (double)times.contact;
   t["solve"]           = (double)times.solve;
   t["total"]           = (double)times.total;
+  JsonValue &w         = rep->root["warnings"];
+  w                    = std::vector<double>{}; // an array, empty when all is well
+  for (const auto &s : warnings) w.Push(JsonValue::String(s));
   PetscFunctionReturn(0);
 }
 
