@@ -43,6 +43,9 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
 // whose K^ or g^ vanishes contributes nothing for that term).
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H);
 
+// Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
+void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);
+
 // Sparse NNLS in Gram form: min over xi >= 0 of (xi - 1)' H (xi - 1), points added greedily (largest
 // gradient) until the relative residual sqrt((xi - 1)' H (xi - 1) / 1' H 1) <= opt.tol.
 // Errors: H not Q x Q or non-finite -> PETSC_ERR_ARG_*; tolerance not reached within maxPoints or

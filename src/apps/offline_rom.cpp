@@ -358,34 +358,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       for (PetscInt r = 0; r < R; ++r) rm.cPw[(size_t)r * M + j] = cr.weights[j] * P[(size_t)r * Q + cr.points[j]];
     }
     full->Restrict(keep, hitv, rings, &rm.patch);
-    // the fit on every training state: relative errors of K^ and g^ (Frobenius / l2)
-    std::vector<PetscReal> Ke((size_t)R * N), Kc((size_t)R * N), ge(R), gc(R);
-    for (PetscInt s = 0; s < ms; ++s) {
-      const PetscReal *kap0 = &Sk[(size_t)s * Q * N], *gam0 = &Sg[(size_t)s * Q];
-      std::fill(Ke.begin(), Ke.end(), 0.0);
-      std::fill(Kc.begin(), Kc.end(), 0.0);
-      std::fill(ge.begin(), ge.end(), 0.0);
-      std::fill(gc.begin(), gc.end(), 0.0);
-      for (PetscInt r = 0; r < R; ++r) {
-        for (PetscInt p = 0; p < Q; ++p) {
-          const PetscReal pr = P[(size_t)r * Q + p];
-          if (pr == 0.0) continue;
-          ge[r] += pr * gam0[p];
-          for (PetscInt n = 0; n < N; ++n) Ke[(size_t)r * N + n] += pr * kap0[(size_t)p * N + n];
-        }
-        for (PetscInt j = 0; j < M; ++j) {
-          const PetscInt  p  = cr.points[j];
-          const PetscReal pr = cr.weights[j] * P[(size_t)r * Q + p];
-          gc[r] += pr * gam0[p];
-          for (PetscInt n = 0; n < N; ++n) Kc[(size_t)r * N + n] += pr * kap0[(size_t)p * N + n];
-        }
-      }
-      PetscReal dk = 0, nk = 0, dg = 0, ng = 0;
-      for (size_t i = 0; i < Ke.size(); ++i) { dk += PetscSqr(Kc[i] - Ke[i]); nk += PetscSqr(Ke[i]); }
-      for (PetscInt i = 0; i < R; ++i) { dg += PetscSqr(gc[i] - ge[i]); ng += PetscSqr(ge[i]); }
-      errK.push_back(nk > 0 ? std::sqrt(dk / nk) : std::sqrt(dk));
-      errG.push_back(ng > 0 ? std::sqrt(dg / ng) : std::sqrt(dg));
-    }
+    CubatureStateErrors(P, R, Q, N, Sk, Sg, ms, cr, &errK, &errG); // the fit on every training state
   }
   rm.hyperDefault = hyper.ecsw && (hyper.ecswFirst || !hyper.eim) ? ReducedModel::ContactMode::Cubature : ReducedModel::ContactMode::EIM;
   rm.SetContactMode(rm.hyperDefault);

@@ -25,26 +25,57 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   PetscFunctionReturn(0);
 }
 
+namespace {
+// The reduced terms of one state, K (R x N, row-major) = sum_p xi_p P(:, p) kappa(p, :) and g likewise,
+// over the points pts with weights xi (pts empty: every point, xi = 1).
+void ReducedTerms(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const PetscReal *kap, const PetscReal *gam, const std::vector<PetscInt> &pts, const std::vector<PetscReal> &xi, std::vector<PetscReal> *K, std::vector<PetscReal> *g)
+{
+  K->assign((size_t)R * N, 0.0);
+  g->assign(R, 0.0);
+  const PetscInt M = pts.empty() ? Q : (PetscInt)pts.size();
+  for (PetscInt r = 0; r < R; ++r)
+    for (PetscInt j = 0; j < M; ++j) {
+      const PetscInt  p  = pts.empty() ? j : pts[j];
+      const PetscReal pr = (pts.empty() ? 1.0 : xi[j]) * P[(size_t)r * Q + p];
+      if (pr == 0.0) continue;
+      (*g)[r] += pr * gam[p];
+      for (PetscInt n = 0; n < N; ++n) (*K)[(size_t)r * N + n] += pr * kap[(size_t)p * N + n];
+    }
+}
+
+PetscReal SumSquares(const std::vector<PetscReal> &v)
+{
+  PetscReal s = 0;
+  for (PetscReal x : v) s += x * x;
+  return s;
+}
+} // namespace
+
+void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
+{
+  std::vector<PetscReal> Ke, ge, Kc, gc;
+  errK->clear();
+  errG->clear();
+  for (PetscInt s = 0; s < ms; ++s) {
+    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Ke, &ge);
+    ReducedTerms(P, R, Q, N, kap, gam, res.points, res.weights, &Kc, &gc);
+    for (size_t i = 0; i < Kc.size(); ++i) Kc[i] -= Ke[i];
+    for (size_t i = 0; i < gc.size(); ++i) gc[i] -= ge[i];
+    const PetscReal nk = SumSquares(Ke), ng = SumSquares(ge);
+    errK->push_back(std::sqrt(nk > 0 ? SumSquares(Kc) / nk : SumSquares(Kc)));
+    errG->push_back(std::sqrt(ng > 0 ? SumSquares(gc) / ng : SumSquares(gc)));
+  }
+}
+
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H)
 {
   const PetscInt         nc = N + 1;
-  std::vector<PetscReal> Z((size_t)Q * ms * nc, 0.0), Kh((size_t)R * N), gh(R);
+  std::vector<PetscReal> Z((size_t)Q * ms * nc, 0.0), Kh, gh;
   for (PetscInt s = 0; s < ms; ++s) {
     const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
-    // exact reduced terms of this state, for its scaling
-    std::fill(Kh.begin(), Kh.end(), 0.0);
-    std::fill(gh.begin(), gh.end(), 0.0);
-    for (PetscInt r = 0; r < R; ++r) {
-      const PetscReal *pr = &P[(size_t)r * Q];
-      for (PetscInt p = 0; p < Q; ++p) {
-        if (pr[p] == 0.0) continue;
-        for (PetscInt n = 0; n < N; ++n) Kh[(size_t)r * N + n] += pr[p] * kap[(size_t)p * N + n];
-        gh[r] += pr[p] * gam[p];
-      }
-    }
-    PetscReal nk = 0, ng = 0;
-    for (PetscReal v : Kh) nk += v * v;
-    for (PetscReal v : gh) ng += v * v;
+    ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh); // exact reduced terms of this state, for its scaling
+    const PetscReal nk = SumSquares(Kh), ng = SumSquares(gh);
     const PetscReal sk = nk > 0 ? 1 / std::sqrt(nk) : 0, sg = ng > 0 ? 1 / std::sqrt(ng) : 0;
     for (PetscInt n = 0; n < N; ++n) {
       PetscReal *z = &Z[(size_t)(s * nc + n) * Q];
