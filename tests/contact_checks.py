@@ -275,6 +275,8 @@ def warnings(args):
     print("Warnings: contact past the slave surface, near-incompressible P1")
     r, _ = run(args, args.np, "runs/ring_on_block.opts", args.extra, "plain")
     check(r["warnings"] == [], "shipped ring_on_block: no warning (%s)" % r["warnings"])
+    r, _ = run(args, args.np, "runs/flat_punch.opts", args.extra, "punch")
+    check(r["nactive"] == r["ncontact"] and r["warnings"] == [], "flat punch, whole face in contact, surface ending at the body's corners: no warning (%s)" % r["warnings"])
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-bc_ring_top_u", "0,-0.3"] + args.extra, "deep")
     w = [s for s in r["warnings"] if "reaches the end of the slave surface" in s]
     check(len(w) == 2 and r["nactive"] == r["ncontact"], "push 0.3: the whole slave surface in contact (%d/%d), 2 end warnings (%d)" % (r["nactive"], r["ncontact"], len(w)))

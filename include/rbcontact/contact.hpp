@@ -115,8 +115,10 @@ public:
   // the same on every rank.
   PetscErrorCode SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const;
   // Multiplier rows of the slave vertices that end the slave surface (2D: the vertices of a single
-  // slave facet; 3D: none yet), the same on every rank. Collective.
-  PetscErrorCode SlaveEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const;
+  // slave facet; 3D: none yet) and, per such row, the unit outward normal (reference mesh) of the body's
+  // boundary facet that continues the surface there (zero if none), the same on every rank (from Setup).
+  const std::vector<PetscInt> &SlaveEndRows() const { return endRows_; }
+  const std::vector<std::array<PetscReal, 2>> &SlaveEndNextNormals() const { return endNext_; }
   const ContactSurface &Slave() const { return slave_; }
   const ContactSurface &Master() const { return master_; }
   // Reference facet rule: barycentric points (dim per point) and weights summing to 1.
@@ -130,6 +132,7 @@ public:
 
 private:
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
+  PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);
   void           SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const;
   ContactSurface        slave_, master_;
   std::vector<PetscInt> vertexRow_;  // local vertex point - vStart -> multiplier row (-1: not a slave vertex)
@@ -137,6 +140,8 @@ private:
   PetscInt              vStart_ = 0;
   std::vector<PetscReal> quadPoints_, quadWeights_; // reference facet rule (barycentric, nv per point)
   std::vector<SurfaceFacet> masterAll_;
+  std::vector<PetscInt>     endRows_;
+  std::vector<std::array<PetscReal, 2>> endNext_;
 };
 
 } // namespace rbc

@@ -16,6 +16,56 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
                            "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md, eim.md, online.md).\n";
 
+// Option families a shared scene file (runs/<scene>.opts) may carry for the stages that consume them:
+// an unused option of a family this stage does not consume is not reported (no false positives from
+// the other stages' settings); any other unused option is (a misspelling: -kacanov_max_iter).
+static bool OtherStagesOption(const std::string &stage, const std::string &name)
+{
+  struct Family {
+    const char *prefix, *stages;
+  };
+  static const Family fam[] = {{"train_", "offline"},      {"snapshots", "offline dualbasis"}, {"offline_", "offline"}, {"pod_", "offline"},
+                               {"dual_", "offline dualbasis"}, {"nnls_", "offline dualbasis"}, {"mcpg_", "offline dualbasis"}, {"nmf_", "offline dualbasis"},
+                               {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate"}, {"online_", "online"},
+                               {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"}};
+  std::string skipped; // families of the offline steps -offline_stop leaves out
+  if (stage == "offline") {
+    char      stop[32] = "";
+    PetscBool set      = PETSC_FALSE;
+    (void)PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, &set);
+    if (set && !std::strcmp(stop, "snapshots")) skipped = " pod_ dual_ nnls_ mcpg_ nmf_ eim_ ecsw_ rom_ ";
+    else if (set && !std::strcmp(stop, "bases")) skipped = " eim_ ecsw_ rom_ ";
+  }
+  for (const auto &f : fam)
+    if (name.compare(0, std::strlen(f.prefix), f.prefix) == 0)
+      return (" " + std::string(f.stages) + " ").find(" " + stage + " ") == std::string::npos || skipped.find(" " + std::string(f.prefix) + " ") != std::string::npos;
+  // online and dualbasis read their own families only (plus the scene with -rom_reconstruct)
+  if (stage == "dualbasis") return true;
+  if (stage == "online") {
+    PetscBool rec = PETSC_FALSE;
+    (void)PetscOptionsHasName(NULL, NULL, "-rom_reconstruct", &rec);
+    return !rec;
+  }
+  return false;
+}
+
+// After a successful stage: a warning per option nobody read (misspelled, or for another solver).
+static PetscErrorCode WarnUnusedOptions(const std::string &stage)
+{
+  PetscInt n;
+  char   **names, **values;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
+  for (PetscInt i = 0; i < n; ++i) {
+    const std::string name = names[i][0] == '-' ? names[i] + 1 : names[i];
+    if (OtherStagesOption(stage, name)) continue;
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: warning: option -%s%s%s was not used by the %s stage (misspelled? `rbcontact %s -help` lists the options)\n", name.c_str(), values[i] ? " " : "", values[i] ? values[i] : "", stage.c_str(), stage.c_str()));
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
+  PetscFunctionReturn(0);
+}
+
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
 // names the option, file or value at fault (every check in rbcontact says which).
 static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
@@ -59,6 +109,7 @@ int main(int argc, char **argv)
     (void)SlepcFinalize();
     return (int)ierr;
   }
+  PetscCall(WarnUnusedOptions(stage));
   PetscCall(SlepcFinalize());
   return 0;
 }

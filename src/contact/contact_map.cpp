@@ -127,6 +127,7 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nm, 1, MPIU_INT, MPI_SUM, comm));
     PetscCheck(nm > 0, comm, PETSC_ERR_USER_INPUT, "Contact master surface '%s' (-contact_master) has no facets", master.c_str());
   }
+  PetscCall(FindSlaveEnds(elas, slave));
   // Reference facet rule in barycentric coordinates, weights normalized to sum 1.
   const PetscInt  fdim = elas.dim - 1;
   PetscQuadrature q;
@@ -179,19 +180,68 @@ PetscErrorCode ContactMap::SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ContactMap::SlaveEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const
+PetscErrorCode ContactMap::FindSlaveEnds(const Elasticity &elas, const std::string &slave)
 {
+  DM                    dm   = elas.dm;
+  MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
   std::vector<PetscInt> count(R_, 0);
 
   PetscFunctionBeginUser;
-  rows->clear();
-  if (slave_.dim != 2) PetscFunctionReturn(0);
+  endRows_.clear();
+  endNext_.clear();
+  if (elas.dim != 2) PetscFunctionReturn(0);
   for (const auto &F : slave_.facets)
     for (PetscInt k = 0; k < F.nv; ++k)
       if (F.row[k] >= 0 && F.row[k] < R_) ++count[F.row[k]];
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count.data(), (int)R_, MPIU_INT, MPI_SUM, comm));
+  // the boundary edge (not slave) at each end vertex: its outward normal, from its cell's centroid
+  DMLabel      bd, sl;
+  DM           cdm;
+  Vec          coords;
+  PetscSection csec;
+  PetscInt     vStart, vEnd;
+  std::vector<PetscReal> next(2 * (size_t)R_, 0.0);
+  PetscCall(DMLabelCreate(PETSC_COMM_SELF, "rbc_true_boundary", &bd));
+  PetscCall(DMPlexMarkBoundaryFaces(dm, 1, bd));
+  PetscCall(DMGetLabel(dm, slave.c_str(), &sl));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt r = vertexRow_[v - vStart];
+    if (r < 0 || count[r] != 1) continue;
+    const PetscInt *supp;
+    PetscInt        ns;
+    PetscCall(DMPlexGetSupportSize(dm, v, &ns));
+    PetscCall(DMPlexGetSupport(dm, v, &supp));
+    for (PetscInt k = 0; k < ns; ++k) {
+      PetscInt isBd, isSlave = -1;
+      PetscCall(DMLabelGetValue(bd, supp[k], &isBd));
+      if (sl) PetscCall(DMLabelGetValue(sl, supp[k], &isSlave));
+      if (isBd != 1 || isSlave >= 0) continue;
+      const PetscInt *cells;
+      PetscScalar    *cv = NULL;
+      PetscInt        ncv;
+      PetscReal       cent[3], nrm[2];
+      PetscCall(DMPlexGetSupport(dm, supp[k], &cells));
+      PetscCall(DMPlexComputeCellGeometryFVM(dm, cells[0], NULL, cent, NULL));
+      PetscCall(DMPlexVecGetClosure(cdm, csec, coords, supp[k], &ncv, &cv));
+      nrm[0] = PetscRealPart(cv[3] - cv[1]);
+      nrm[1] = -PetscRealPart(cv[2] - cv[0]);
+      const PetscReal len = std::hypot(nrm[0], nrm[1]), side = nrm[0] * (PetscRealPart(cv[0]) - cent[0]) + nrm[1] * (PetscRealPart(cv[1]) - cent[1]);
+      PetscCall(DMPlexVecRestoreClosure(cdm, csec, coords, supp[k], &ncv, &cv));
+      for (int d = 0; d < 2; ++d) next[2 * r + d] += (side < 0 ? -1 : 1) * nrm[d] / len;
+    }
+  }
+  PetscCall(DMLabelDestroy(&bd));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, next.data(), (int)next.size(), MPIU_REAL, MPI_SUM, comm));
   for (PetscInt r = 0; r < R_; ++r)
-    if (count[r] == 1) rows->push_back(r);
+    if (count[r] == 1) {
+      const PetscReal n = std::hypot(next[2 * r], next[2 * r + 1]);
+      endRows_.push_back(r);
+      endNext_.push_back({n > 0 ? next[2 * r] / n : 0.0, n > 0 ? next[2 * r + 1] / n : 0.0});
+    }
   PetscFunctionReturn(0);
 }
 

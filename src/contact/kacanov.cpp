@@ -379,24 +379,32 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
 
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, Vec lambda, std::vector<std::string> *warnings)
 {
-  std::vector<PetscInt>  ends;
-  std::vector<PetscReal> lam, x[3];
+  std::vector<PetscReal> lam, x[2], n[2];
 
   PetscFunctionBeginUser;
-  PetscCall(map.SlaveEndRows(comm, &ends));
+  const auto &ends = map.SlaveEndRows();
+  const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
   PetscCall(GatherVec(lambda, &lam));
-  PetscCall(GatherVec(sys.coord[0], &x[0]));
-  PetscCall(GatherVec(sys.coord[1], &x[1]));
+  for (int d = 0; d < 2; ++d) {
+    PetscCall(GatherVec(sys.coord[d], &x[d]));
+    PetscCall(GatherVec(sys.normal[d], &n[d]));
+  }
   PetscReal lmax = 0;
   for (PetscReal l : lam) lmax = std::max(lmax, l);
-  for (PetscInt r : ends)
-    if (lmax > 0 && lam[r] > 1e-10 * lmax) {
+  for (size_t e = 0; e < ends.size(); ++e) {
+    const PetscInt r = ends[e];
+    // the body's boundary continuing past the end faces the master (its outward normal against the
+    // master's, which points to the slave): contact there is possible but not enforced. A surface that
+    // ends at a corner of its body (a flat punch's edge: the next side is parallel to the master normal) is not.
+    const bool facing = next[e][0] * n[0][r] + next[e][1] * n[1][r] < -0.5;
+    if (facing && lmax > 0 && lam[r] > 1e-10 * lmax) {
       std::ostringstream o;
       o << "the contact zone reaches the end of the slave surface at (" << x[0][r] << ", " << x[1][r] << ") (pressure " << lam[r] << " there, max " << lmax
         << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
       warnings->push_back(o.str());
     }
+  }
   PetscFunctionReturn(0);
 }
 
