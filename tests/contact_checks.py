@@ -275,6 +275,13 @@ def warnings(args):
     print("Warnings: contact past the slave surface, near-incompressible P1")
     r, _ = run(args, args.np, "runs/ring_on_block.opts", args.extra, "plain")
     check(r["warnings"] == [], "shipped ring_on_block: no warning (%s)" % r["warnings"])
+    # a misspelled option is named after the run; the other stages' settings of the scene file are not
+    base = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts"]
+    p = subprocess.run(base + ["-kacanov_max_iter", "3"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    q = subprocess.run(base, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode == 0 and p.stdout.count("option -kacanov_max_iter 3 was not used by the fom stage") == 1,
+          "-kacanov_max_iter 3 (misspelled): one warning naming it")
+    check(q.returncode == 0 and "was not used" not in q.stdout, "the same run without the typo: no unused-option warning (the file's -train_*, -pod_*, -test_* ... belong to other stages)")
     r, _ = run(args, args.np, "runs/flat_punch.opts", args.extra, "punch")
     check(r["nactive"] == r["ncontact"] and r["warnings"] == [], "flat punch, whole face in contact, surface ending at the body's corners: no warning (%s)" % r["warnings"])
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-bc_ring_top_u", "0,-0.3"] + args.extra, "deep")

@@ -191,29 +191,39 @@ PetscErrorCode ElasticFOM::Warn(const std::string &msg)
 PetscErrorCode ElasticFOM::CheckBodiesHeld() const
 {
   const PetscInt nb = (PetscInt)scene.bodies.size(), dim = elas.dim;
-  PetscSection   s;
-  PetscInt       cStart, cEnd;
+  PetscInt       cStart, cEnd, pStart, pEnd;
 
   PetscFunctionBeginUser;
   if (nb == 0) PetscFunctionReturn(0);
-  PetscCall(DMGetLocalSection(dm, &s));
+  // From the Dirichlet labels and the cells around their points (not the section: a DM's local
+  // section must not be created before every boundary is added)
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  std::vector<PetscInt> held((size_t)nb * dim, 0); // constrained dofs per body and component
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  std::vector<PetscInt> held((size_t)nb * dim, 0); // labelled points per body and constrained component
   const auto           &cb = elas.CellBody();
-  for (PetscInt c = cStart; c < cEnd; ++c) {
-    const PetscInt b = c - cStart < (PetscInt)cb.size() ? cb[c - cStart] : -1;
-    if (b < 0 || b >= nb) continue;
-    PetscInt *cl = NULL, ncl;
-    PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
-    for (PetscInt k = 0; k < ncl; ++k) {
-      PetscInt        ncd;
-      const PetscInt *idx;
-      PetscCall(PetscSectionGetConstraintDof(s, cl[2 * k], &ncd));
-      if (!ncd) continue;
-      PetscCall(PetscSectionGetConstraintIndices(s, cl[2 * k], &idx));
-      for (PetscInt j = 0; j < ncd; ++j) ++held[(size_t)b * dim + idx[j] % dim];
+  for (const auto &bc : scene.dirichlet) {
+    DMLabel label;
+    PetscCall(DMGetLabel(dm, bc.label.c_str(), &label));
+    if (!label) continue; // an unknown label is reported by the discretization's set-up
+    std::vector<PetscInt> comps = bc.comps;
+    if (comps.empty())
+      for (PetscInt d = 0; d < dim; ++d) comps.push_back(d);
+    for (PetscInt p = pStart; p < pEnd; ++p) {
+      PetscInt val;
+      PetscCall(DMLabelGetValue(label, p, &val));
+      if (val < 0) continue;
+      PetscInt *star = NULL, nst;
+      PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_FALSE, &nst, &star));
+      for (PetscInt k = 0; k < nst; ++k) {
+        const PetscInt c = star[2 * k];
+        if (c < cStart || c >= cEnd || c - cStart >= (PetscInt)cb.size()) continue;
+        const PetscInt b = cb[c - cStart];
+        if (b >= 0 && b < nb)
+          for (PetscInt d : comps)
+            if (d >= 0 && d < dim) ++held[(size_t)b * dim + d];
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_FALSE, &nst, &star));
     }
-    PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, held.data(), (int)held.size(), MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
   const char *axis[] = {"x", "y", "z"};
