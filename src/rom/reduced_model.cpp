@@ -66,7 +66,8 @@ PetscErrorCode ReadOptional(const std::string &file, const std::string &name, st
   ierr = RomReadDataset(file, name, &dims, data);
   PetscCall(PetscPopErrorHandler());
   *found = !ierr;
-  if (*found) PetscCall(ReadChecked(file, name, data->size(), data));
+  if (*found)
+    for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
   PetscFunctionReturn(0);
 }
 
