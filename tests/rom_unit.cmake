@@ -11,3 +11,9 @@ rbc_add_mpi_test(NAME test_anderson RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:tes
 #                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
 rbc_test_exe(test_empirical_cubature)
 rbc_add_mpi_test(NAME test_empirical_cubature RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_empirical_cubature> LABELS rom)
+#   test_dense_kernels     the online contact kernels (SumOfOuterProducts, CombineRows; AVX2+FMA where the CPU has
+#                          it) against plain loops, at sizes around the register blocking
+rbc_test_exe(test_dense_kernels)
+rbc_add_mpi_test(NAME test_dense_kernels RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dense_kernels> LABELS rom)
+rbc_add_mpi_test(NAME test_dense_kernels_portable RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dense_kernels> LABELS rom)
+set_property(TEST test_dense_kernels_portable_np1 APPEND PROPERTY ENVIRONMENT RBC_KERNELS_PORTABLE=1)

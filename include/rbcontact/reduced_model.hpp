@@ -144,7 +144,8 @@ private:
   std::shared_ptr<ContactPatch> full_;
   ContactPatch           fullActive_;
   std::vector<PetscReal> P_, Pact_;
-  std::vector<PetscReal> cPwT_;                       // cubature weights of the active rows, M x r (point-major)
+  std::vector<PetscReal> cPwT_;                       // cubature weights of the active rows, M x PaddedRows(r) (point-major, zero padded)
+  std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
   AndersonMixing         aa_;

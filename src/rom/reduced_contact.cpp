@@ -4,6 +4,7 @@
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "../contact/contact_point.hpp"
+#include "dense_kernels.hpp"
 #include <algorithm>
 #include <array>
 #include <map>
@@ -338,10 +339,11 @@ PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kap
             for (PetscInt kk = 0; kk < master[c[j]].nv; ++kk) shared += master[c[j]].vglobal[kk] == M.vglobal[k];
           if (shared < 2) ++outside;
         }
-    PetscReal *kp = kappa ? kappa + i * N : nullptr;
-    if (kp)
-      for (PetscInt n = 0; n < N; ++n) kp[n] = 0;
-    PetscReal g = e.gap;
+    // kappa = w sum_a coef_a theta_a over the slave and master nodal dofs (one combination kernel)
+    PetscReal        coefs[36]; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
+    const PetscReal *rows[36];
+    PetscInt         nt = 0;
+    PetscReal        g  = e.gap;
     for (PetscInt side = 0; side < 2; ++side) {
       const SurfaceFacet &G  = side ? M : F;
       const PetscReal    *Nb = side ? e.Nm : e.Ns;
@@ -352,14 +354,11 @@ PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kap
           if (coef == 0.0) continue;
           const PetscInt r = G.dof[a * dim + d];
           g -= coef * uD[r];
-          if (kp) {
-            const PetscReal *t = &theta[r * N];
-            for (PetscInt n = 0; n < N; ++n) kp[n] += coef * t[n];
-          }
+          coefs[nt]  = w * coef;
+          rows[nt++] = &theta[r * N];
         }
     }
-    if (kp)
-      for (PetscInt n = 0; n < N; ++n) kp[n] *= w;
+    if (kappa) CombineRows(nt, coefs, rows, N, kappa + i * N);
     if (gamma) gamma[i] = w * g;
   }
   return outside;

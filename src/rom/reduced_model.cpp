@@ -1,6 +1,7 @@
 // src/rom/reduced_model.cpp: the online stage's model: reading/writing its data (ROM file, format 2,
 // docs/rom_file.md), truncation, the EIM (or exact) reduced contact terms and the reduced Kacanov loop.
 #include "rbcontact/reduced_model.hpp"
+#include "dense_kernels.hpp"
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -417,9 +418,10 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   nkEval_ = (PetscInt)evalPoints_.size(); // the points needing kappa come first
   for (PetscInt j = 0; j < mg; ++j) gPos_[j] = pos(gPoint[j]);
   // cubature weights of the active rows, point by point (M x r)
-  cPwT_.assign(cPoint.size() * (size_t)r, 0.0);
+  const PetscInt rp = PaddedRows(r);
+  cPwT_.assign(cPoint.size() * (size_t)rp, 0.0);
   for (size_t p = 0; p < cPoint.size(); ++p)
-    for (PetscInt i = 0; i < r; ++i) cPwT_[p * r + i] = cPw[(size_t)i * cPoint.size() + p];
+    for (PetscInt i = 0; i < r; ++i) cPwT_[p * rp + i] = cPw[(size_t)i * cPoint.size() + p];
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
@@ -509,19 +511,18 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     }
     patch.SetReduced(vfull.data());
     out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr);
-    // one rank-1 update per point, contiguous in the rows: K(:, c) += kappa(p, c) Pw(0:r, p)
-    std::fill(K, K + (size_t)r * Na, 0.0);
-    std::fill(g, g + r, 0.0);
-    for (PetscInt p = 0; p < M; ++p) {
-      const PetscReal *pw = &cPwT_[(size_t)p * r], *kp = &kap_[(size_t)p * Nfull];
-      const PetscReal  gp = gam_[p];
-      for (PetscInt i = 0; i < r; ++i) g[i] += pw[i] * gp;
-      for (PetscInt c = 0; c < Na; ++c) {
-        const PetscReal kv = kp[cols_[c]];
-        PetscReal      *Kc = K + (size_t)r * c;
-        for (PetscInt i = 0; i < r; ++i) Kc[i] += pw[i] * kv;
-      }
+    // [K g] = sum_p Pw(:, p) [kappa(p, cols) gamma(p)]: the columns point-contiguous, one blocked kernel
+    const PetscInt rp = PaddedRows(r);
+    cX_.resize((size_t)(Na + 1) * M);
+    cK_.resize((size_t)rp * (Na + 1));
+    for (PetscInt c = 0; c < Na; ++c) {
+      PetscReal *x = &cX_[(size_t)c * M];
+      for (PetscInt p = 0; p < M; ++p) x[p] = kap_[(size_t)p * Nfull + cols_[c]];
     }
+    std::copy(gam_.begin(), gam_.begin() + M, cX_.begin() + (size_t)Na * M);
+    SumOfOuterProducts(M, rp, Na + 1, cPwT_.data(), cX_.data(), cK_.data());
+    for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
+    std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
     return out;
   }
   const PetscInt np = (PetscInt)evalPoints_.size();
