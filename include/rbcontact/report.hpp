@@ -66,6 +66,10 @@ PetscErrorCode BcastString(MPI_Comm comm, std::string *s);
 // Writes text to path atomically (path.tmp.<pid> then rename) on rank 0 of comm; errors name the file.
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text);
 
+// Checks, before any work, that path (given with option; empty: nothing to check) can be written:
+// its directory exists and is writable, and path is not a directory. Collective (rank 0 looks).
+PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option);
+
 // The report of one stage run: filled by the stage, written by Write() if -report was given.
 class Report {
 public:

@@ -74,5 +74,9 @@ void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G);
 
 // Splits "a,b,c" (no empty items).
 std::vector<std::string> SplitList(const std::string &s, char sep = ',');
+// The shortest decimal that reads back to x (1.1500000001, not 1.15 or 1.1500000000999999).
+std::string ShortestReal(double x);
+// "parameter 'radius' = 1.1500000001 is outside its box [0.95, 1.15]" (shortest round-trip digits)
+std::string OutOfBoxMessage(const ParamSpec &p, PetscReal value);
 
 } // namespace rbc

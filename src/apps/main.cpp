@@ -2,7 +2,9 @@
 // online, validate, dualbasis); PETSc options follow it. Each stage writes -report <file.json>.
 #include <petscsys.h>
 #include <slepcsys.h>
+#include <cctype>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include "stages.hpp"
 
@@ -68,11 +70,39 @@ static PetscErrorCode WarnUnusedOptions(const std::string &stage)
 
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
 // names the option, file or value at fault (every check in rbcontact says which).
+// PETSc's messages for a value that does not parse ("Input string 100abc has no numeric value",
+// "... has no integer value", "Unknown logical value: maybe") do not say which option: find the
+// options (command line or -options_file) whose value holds that word and name them.
+static std::string OptionsHoldingValue(const char *mess)
+{
+  std::string m = mess ? mess : "", word;
+  const std::string a = "Input string ", b = "Unknown logical value: ";
+  if (m.compare(0, a.size(), a) == 0) word = m.substr(a.size(), m.find(' ', a.size()) - a.size());
+  else if (m.compare(0, b.size(), b) == 0) word = m.substr(b.size());
+  if (word.empty()) return "";
+  char *all = nullptr;
+  if (PetscOptionsGetAll(NULL, &all) || !all) return "";
+  std::string found, name;
+  std::istringstream in(all);
+  for (std::string tok; in >> tok;) {
+    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
+    if (isName) {
+      name = tok;
+      continue;
+    }
+    std::istringstream vals(tok);
+    for (std::string v; std::getline(vals, v, ',');)
+      if (v == word && !name.empty()) found += (found.empty() ? "" : ", ") + name + " " + tok;
+  }
+  PetscFree(all);
+  return found.empty() ? "" : " (option " + found + ")";
+}
+
 static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
 {
   PetscMPIInt rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (p == PETSC_ERROR_INITIAL) std::fprintf(stderr, "[%d] rbcontact error: %s\n", (int)rank, mess ? mess : "(no message)");
+  if (p == PETSC_ERROR_INITIAL) std::fprintf(stderr, "[%d] rbcontact error: %s%s\n", (int)rank, mess ? mess : "(no message)", OptionsHoldingValue(mess).c_str());
   std::fprintf(stderr, "[%d]     in %s() at %s:%d\n", (int)rank, fun ? fun : "?", file ? file : "?", line);
   return n;
 }

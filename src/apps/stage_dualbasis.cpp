@@ -24,6 +24,8 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   PetscCheck(set && spec[0], comm, PETSC_ERR_USER_INPUT, "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)");
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_out", out, sizeof out, NULL));
+  PetscCall(CheckOutputPath(comm, reportPath, "-report"));
+  PetscCall(CheckOutputPath(comm, out, "-dual_out"));
   {
     // check the basis type before reading possibly large data
     char type[32] = "cpg";

@@ -31,6 +31,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-fom_output", outPath, sizeof outPath, NULL));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-hertz_radius", &hertzRadius, &hertz));
+  PetscCall(CheckOutputPath(comm, reportPath, "-report"));
+  PetscCall(CheckOutputPath(comm, outPath, "-fom_output"));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   ElasticFOM    fom;
   ContactMap    map;

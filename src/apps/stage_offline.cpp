@@ -84,6 +84,10 @@ PetscErrorCode StageOffline(MPI_Comm world)
   }
   PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", snapPath, sizeof snapPath, &set));
   PetscCheck(snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  PetscCall(CheckOutputPath(world, reportPath, "-report"));
+  if (bases) PetscCall(CheckOutputPath(world, romPath, "-rom"));
+  PetscCall(CheckOutputPath(world, snapPath, "-snapshots"));
+  if (full) PetscCall(CheckOutputPath(world, basisPath, "-rom_basis"));
   // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
   restart = bases;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_restart", &restart, NULL));

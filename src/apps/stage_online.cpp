@@ -26,6 +26,8 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "online: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
   PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_reconstruct", recPath, sizeof recPath, NULL));
+  PetscCall(CheckOutputPath(comm, reportPath, "-report"));
+  PetscCall(CheckOutputPath(comm, recPath, "-rom_reconstruct"));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-online_repeat", &repeat, NULL));
   PetscCheck(repeat >= 1 && repeat <= 10000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-online_repeat %" PetscInt_FMT " out of range [1, 1e7]", repeat);
   PetscCall(PetscTime(&t0));

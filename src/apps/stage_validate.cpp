@@ -149,6 +149,8 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     PetscCall(PetscStrncpy(sweepOut, (stem + "_sweep").c_str(), sizeof sweepOut));
     PetscCall(PetscOptionsGetString(NULL, NULL, "-validate_sweep_output", sweepOut, sizeof sweepOut, NULL));
   }
+  PetscCall(CheckOutputPath(comm, reportPath, "-report"));
+  if (sweep) PetscCall(CheckOutputPath(comm, std::string(sweepOut) + ".json", "-validate_sweep_output"));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   PetscCall(model.Open(romPath));
   PetscCall(model.SetFromOptions());

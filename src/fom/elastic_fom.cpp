@@ -89,7 +89,7 @@ PetscErrorCode ElasticFOM::SetMu(const std::vector<PetscReal> &m)
   PetscFunctionBeginUser;
   PetscCheck(m.size() == scene.params.size(), PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_SIZ, "Parameter vector of size %zu, the scene has %zu parameters", m.size(), scene.params.size());
   for (size_t i = 0; i < m.size(); ++i)
-    PetscCheck(m[i] >= scene.params[i].min && m[i] <= scene.params[i].max, PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_OUTOFRANGE, "Parameter '%s' = %g is outside its box [%g, %g]", scene.params[i].name.c_str(), (double)m[i], (double)scene.params[i].min, (double)scene.params[i].max);
+    PetscCheck(m[i] >= scene.params[i].min && m[i] <= scene.params[i].max, PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_OUTOFRANGE, "%s", OutOfBoxMessage(scene.params[i], m[i]).c_str());
   mu = m;
   PetscCall(elas.SetMu(mu));
   PetscFunctionReturn(0);

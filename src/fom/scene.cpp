@@ -1,6 +1,7 @@
 // src/fom/scene.cpp: parses a scene from the options database and checks its values.
 #include "rbcontact/scene.hpp"
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -68,6 +69,21 @@ static PetscErrorCode GetIntArray(const char *name, std::vector<PetscInt> *v, Pe
   PetscFunctionReturn(0);
 }
 
+std::string ShortestReal(double x)
+{
+  char buf[40];
+  for (int prec = 6; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+std::string OutOfBoxMessage(const ParamSpec &p, PetscReal value)
+{
+  return "parameter '" + p.name + "' = " + ShortestReal(value) + " is outside its box [" + ShortestReal(p.min) + ", " + ShortestReal(p.max) + "]";
+}
+
 PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
 {
   std::string s;
@@ -114,7 +130,9 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     const size_t np = pnames.size();
     PetscCheck(lo.size() == np && hi.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu_min and -mu_max need one value per parameter of -mu_names (%zu)", np);
     PetscCheck(def.empty() || def.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu_default needs one value per parameter (%zu)", np);
-    PetscCheck(!flg || val.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu has %zu values; the scene has %zu parameters (%s)", val.size(), np, s.c_str());
+    std::string plist;
+    for (const auto &n : pnames) plist += (plist.empty() ? "" : ", ") + n;
+    PetscCheck(!flg || val.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu has %zu values; the scene has %zu parameters (%s, in this order)", val.size(), np, plist.c_str());
     for (size_t i = 0; i < np; ++i) {
       ParamSpec p;
       p.name  = pnames[i];
@@ -123,7 +141,7 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
       p.def   = def.empty() ? 0.5 * (lo[i] + hi[i]) : def[i];
       p.value = flg ? val[i] : p.def;
       PetscCheck(lo[i] <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu_min %g > -mu_max %g for parameter '%s'", (double)lo[i], (double)hi[i], p.name.c_str());
-      PetscCheck(p.value >= lo[i] && p.value <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' = %g is outside its box [%g, %g]", p.name.c_str(), (double)p.value, (double)lo[i], (double)hi[i]);
+      PetscCheck(p.value >= lo[i] && p.value <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: %s", OutOfBoxMessage(p, p.value).c_str());
       if (i < geo.size() && geo[i] != "-") p.geoName = geo[i];
       if (!p.geoName.empty()) scene->mesh.geoNumbers.emplace_back(p.geoName, p.value);
       scene->params.push_back(p);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace rbc {
@@ -148,6 +149,28 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
   }
   PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
   PetscCheck(ok, comm, PETSC_ERR_FILE_OPEN, "Cannot write file '%s' (directory missing or not writable?)", path.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option)
+{
+  PetscMPIInt rank;
+  std::string why;
+
+  PetscFunctionBeginUser;
+  if (path.empty()) PetscFunctionReturn(0);
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    const size_t      slash = path.find_last_of('/');
+    const std::string dir   = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+    struct stat       st;
+    if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) why = "the directory '" + dir + "' does not exist";
+    else if (access(dir.c_str(), W_OK | X_OK) != 0) why = "the directory '" + dir + "' is not writable";
+    else if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) why = "it is a directory";
+    else if (stat(path.c_str(), &st) == 0 && access(path.c_str(), W_OK) != 0) why = "the file exists and is not writable";
+  }
+  PetscCall(BcastString(comm, &why));
+  PetscCheck(why.empty(), comm, PETSC_ERR_FILE_OPEN, "%s %s: cannot write there: %s (checked before any work; nothing was computed or written)", option, path.c_str(), why.c_str());
   PetscFunctionReturn(0);
 }
 

@@ -177,11 +177,15 @@ void ReducedParametrization::ThetaF(const std::vector<PetscReal> &mu, std::vecto
 PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const
 {
   PetscFunctionBeginUser;
-  PetscCheck(mu.size() == params.size(), comm, PETSC_ERR_ARG_SIZ, "-mu: %zu values given, the model has %zu parameters", mu.size(), params.size());
+  if (mu.size() != params.size()) {
+    std::string names;
+    for (const auto &p : params) names += (names.empty() ? "" : ", ") + p.name;
+    SETERRQ(comm, PETSC_ERR_ARG_SIZ, "-mu: %zu values given, the model has %zu parameters (%s, in this order)", mu.size(), params.size(), names.c_str());
+  }
   for (size_t i = 0; i < mu.size(); ++i) {
     PetscCheck(std::isfinite(mu[i]), comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' is not a finite number", params[i].name.c_str());
     const PetscReal tol = 1e-12 * std::max<PetscReal>(1.0, std::abs(params[i].max - params[i].min));
-    PetscCheck(mu[i] >= params[i].min - tol && mu[i] <= params[i].max + tol, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' = %g is outside its box [%g, %g] (the reduced model is trained there only)", params[i].name.c_str(), (double)mu[i], (double)params[i].min, (double)params[i].max);
+    PetscCheck(mu[i] >= params[i].min - tol && mu[i] <= params[i].max + tol, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: %s (the reduced model is trained there only)", OutOfBoxMessage(params[i], mu[i]).c_str());
   }
   PetscFunctionReturn(0);
 }
