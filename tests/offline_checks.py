@@ -12,6 +12,7 @@ import argparse
 import json
 import os
 import signal
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -147,6 +148,21 @@ def mismatch(args):
         check("Segmentation" not in p.stdout and "SEGV" not in p.stdout, "%s: no crash" % what)
     with h5py.File(d + "/s.h5", "r") as f:
         check(int(np.sum(np.array(f["snapshots/done"]))) == 3, "the refused file is untouched")
+    # a finished row holding a NaN (or inf): the bases step names the file, the dataset and the row
+    for ds, row, val in (("u", 1, np.nan), ("lambda", 2, np.inf)):
+        bad = d + "/bad_%s.h5" % ds
+        shutil.copy(d + "/s.h5", bad)
+        with h5py.File(bad, "r+") as f:
+            x = np.array(f["snapshots/" + ds][row])
+            x[len(x) // 2] = val
+            f["snapshots/" + ds][row] = x
+        p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
+                            "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        msg = [l for l in p.stdout.splitlines() if "error" in l.lower()][:1]
+        print("  non-finite row of %s -> exit %d: %s" % (ds, p.returncode, msg[0] if msg else p.stdout[-300:]))
+        check(p.returncode != 0 and ("bad_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and "non-finite" in p.stdout,
+              "non-finite value in a done row of /snapshots/%s: refused naming the file, the row and the dataset" % ds)
+        check(not os.path.exists(d + "/never.h5"), "no ROM written from the corrupt %s row" % ds)
 
 
 def bases(args):

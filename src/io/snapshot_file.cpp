@@ -566,6 +566,19 @@ PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapsh
         x.resize(extras[k].second);
         ok = RowIO(c, f.get(), "/snapshots/extra/" + extras[k].first, H5T_NATIVE_DOUBLE, i, x.size(), x.data(), false);
       }
+      // a finished row must be finite: name the row, the dataset and the entry (never NaN into a basis)
+      auto finite = [&](const std::string &name, const std::vector<PetscReal> &x) {
+        for (size_t k = 0; k < x.size(); ++k)
+          if (!std::isfinite(x[k])) {
+            std::ostringstream m;
+            m << "row " << i << " (training point " << i + 1 << " of " << done.size() << ") of " << name << " holds a non-finite value (entry " << k << ", " << x[k]
+              << ") although the row is marked done: the file is corrupt; recompute that snapshot (-snapshots_restart 0 recomputes all, or clear /snapshots/done[" << i << "])";
+            return c.Fail(m.str(), false);
+          }
+        return true;
+      };
+      ok = ok && finite("/snapshots/mu", s.mu) && finite("/snapshots/u", s.u) && finite("/snapshots/lambda", s.lambda);
+      for (const auto &e : s.extra) ok = ok && finite("/snapshots/extra/" + e.first, e.second);
       if (ok) snaps->push_back(std::move(s));
     }
     if (ok) ok = CloseFile(c, &f);
