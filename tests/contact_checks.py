@@ -271,7 +271,8 @@ def floating(args):
 
 def warnings(args):
     """Warnings in the report (key warnings) and on the terminal: none on the shipped scene; the contact
-    zone reaching the ends of the slave surface (a push of 0.3); P1 with nu = 0.4999 (locking)."""
+    zone reaching the ends of the slave surface (a push of 0.3); P1 with nu = 0.4999 (locking); an initial
+    overlap (and none at zero initial gap)."""
     print("Warnings: contact past the slave surface, near-incompressible P1")
     r, _ = run(args, args.np, "runs/ring_on_block.opts", args.extra, "plain")
     check(r["warnings"] == [], "shipped ring_on_block: no warning (%s)" % r["warnings"])
@@ -292,6 +293,13 @@ def warnings(args):
     check(len(w) == 2, "P1, nu = 0.4999: a locking warning per body (%d)" % len(w))
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999", "-fem_degree", "2"] + args.extra, "nu_p2")
     check(not any("lock" in s for s in r["warnings"]), "P2, nu = 0.4999: no locking warning")
+    # an initial overlap of 0.01 (ring moved down through the block top): warned, measured, still solved
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-mesh_geo_set", "g0=-0.01", "-map_ring_dilation_center", "0,-0.01"] + args.extra, "overlap")
+    w = [s for s in r["warnings"] if "initial overlap" in s and "interference fit" in s]
+    check(len(w) == 1 and abs(r["initial_overlap"]["max_penetration"] - 0.01) < 1e-6 and r["initial_overlap"]["nodes"] > 0,
+          "initial overlap 0.01: one warning, initial_overlap.max_penetration %.3g (0.01), %d nodes" % (r["initial_overlap"]["max_penetration"], r["initial_overlap"]["nodes"]))
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-mesh_geo_set", "g0=0", "-map_ring_dilation_center", "0,0"] + args.extra, "zero_gap")
+    check(r["initial_overlap"]["nodes"] == 0 and not any("overlap" in s for s in r["warnings"]), "zero initial gap (touching at one node): no overlap warning")
 
 
 def main():

@@ -55,9 +55,15 @@ public:
   std::string    dualMatrixOption = "auto"; // -fom_dual_matrix
   PetscInt       dualDenseMax     = 3000;   // -fom_dual_dense_max: auto = dense up to this R
   std::string    dualMatrix;                // used by the last Solve: "dense" or "shell" (report key dual_matrix)
+  // Initial overlap, measured at the first iterate (u = 0: the reference configuration at mu, imposed
+  // displacements of the contact surfaces included): the deepest penetration (weighted gap g_i / weight_i
+  // < 0, length units, 0 if none), the rows that penetrate, and where the deepest is (ContactSurfaceWarnings).
+  PetscReal      initialPenetration = 0, initialPenetrationAt[3] = {0, 0, 0};
+  PetscInt       initialPenetrating = 0;
 
 private:
   PetscErrorCode ComputeKKT(ElasticFOM &fom);
+  PetscErrorCode MeasureInitialOverlap(MPI_Comm comm);
   DualQPSolver    qp_;
   DualShellSolver shell_;
 };
@@ -75,7 +81,9 @@ PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vect
 
 // Warnings about a converged contact solution (collective): the contact zone reaching an end of the
 // declared slave surface (contact beyond it is not enforced: the slave may penetrate there).
-PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, Vec lambda, std::vector<std::string> *warnings);
+// An initial overlap (KacanovSolver::initialPenetration > 0) is warned about too: the solver pushes the bodies
+// apart as an interference fit, which is rarely what a user meant.
+PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings);
 
 // The whole of a parallel Vec on every rank (global order).
 PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full);

@@ -52,7 +52,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
   if (scene.contact) {
     std::vector<std::string> w;
     PetscCall(kacanov.Solve(fom, map));
-    PetscCall(ContactSurfaceWarnings(comm, map, kacanov.sys, kacanov.lambda, &w));
+    PetscCall(ContactSurfaceWarnings(comm, kacanov, map, &w));
     for (const auto &s : w) PetscCall(fom.Warn(s));
   } else PetscCall(fom.SolveElastic());
   { // never write a non-finite answer (nor over a good earlier output): the check comes before any output
@@ -72,6 +72,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["converged"]          = (bool)kacanov.converged;
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
     rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
+    rep.root["initial_overlap"]["max_penetration"] = (double)kacanov.initialPenetration; // at u = 0 (0: none)
+    rep.root["initial_overlap"]["nodes"]           = (long long)kacanov.initialPenetrating;
     rep.root["ncontact"]           = (long long)cs.R;
     rep.root["nactive"]            = (long long)cs.nactive;
     rep.root["contact_force"]      = (double)cs.force;

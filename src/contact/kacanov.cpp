@@ -200,6 +200,36 @@ static PetscErrorCode GatherAt(Vec v, const std::vector<PetscInt> &D, std::vecto
   PetscFunctionReturn(0);
 }
 
+// At u = 0: the weighted gaps g_i / weight_i < 0 beyond rounding are an initial overlap (the deepest, where, how many).
+PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
+{
+  std::vector<PetscReal> g, w, x[3];
+
+  PetscFunctionBeginUser;
+  initialPenetration = 0;
+  initialPenetrating = 0;
+  PetscCall(GatherVec(sys.g, &g));
+  PetscCall(GatherVec(sys.weight, &w));
+  PetscInt dim = 0;
+  for (; dim < 3 && sys.coord[dim]; ++dim) PetscCall(GatherVec(sys.coord[dim], &x[dim]));
+  PetscReal scale = 0; // size of the slave surface: the rounding level of a gap
+  for (PetscInt d = 0; d < dim; ++d)
+    for (PetscReal c : x[d]) scale = std::max(scale, std::abs(c));
+  for (size_t i = 0; i < g.size(); ++i) {
+    if (!(w[i] > 0)) continue;
+    const PetscReal gap = g[i] / w[i];
+    if (gap < -1e-9 * std::max<PetscReal>(scale, 1e-300)) {
+      ++initialPenetrating;
+      if (-gap > initialPenetration) {
+        initialPenetration = -gap;
+        for (PetscInt d = 0; d < dim; ++d) initialPenetrationAt[d] = x[d][i];
+      }
+    }
+  }
+  (void)comm;
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)fom.dm);
@@ -249,6 +279,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
+    if (k == 1) PetscCall(MeasureInitialOverlap(comm));
     const PetscBool warm = lambda ? PETSC_TRUE : PETSC_FALSE;
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
@@ -377,11 +408,19 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, Vec lambda, std::vector<std::string> *warnings)
+PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
   std::vector<PetscReal> lam, x[2], n[2];
+  const ContactSystem   &sys    = kac.sys;
+  Vec                    lambda = kac.lambda;
 
   PetscFunctionBeginUser;
+  if (kac.initialPenetrating > 0) {
+    std::ostringstream o;
+    o << "initial overlap: " << kac.initialPenetrating << " slave node(s) lie inside the master body before any deformation (deepest " << kac.initialPenetration << " at (" << kac.initialPenetrationAt[0] << ", " << kac.initialPenetrationAt[1]
+      << ")); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
+    warnings->push_back(o.str());
+  }
   const auto &ends = map.SlaveEndRows();
   const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
