@@ -376,7 +376,16 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       PetscCall(VecAXPY(lamPrev, -1.0, lambda));
       PetscCall(VecNorm(lamPrev, NORM_2, &ndl));
     } else ndl = nl;
-    const PetscReal du = RelChange(ndu, nup, nu), dl = lamPrev ? RelChange(ndl, nlp, nl) : (nl == 0 ? 0.0 : kInf);
+    // The change of lambda relative to max(|lambda_prev|, 1e-6 |A u| / |K|_F): |A u| / |K|_F is the size of a
+    // multiplier whose force matches the elastic forces. The floor matters only when lambda is at rounding
+    // level (grazing contact: a rigid body touching at one node, lambda ~ 1e-16 changing by 100 % between
+    // iterates, never converging relatively); real contact forces are far above it (ring_on_block: |lambda|
+    // is 0.25 |A u| / |K|_F), and there the rule is the plain relative one.
+    PetscReal nrhs, nK;
+    PetscCall(VecNorm(rhs, NORM_2, &nrhs));
+    PetscCall(MatNorm(sys.K, NORM_FROBENIUS, &nK));
+    const PetscReal lamScale = nK > 0 ? 1e-6 * nrhs / nK : 0.0;
+    const PetscReal du = RelChange(ndu, nup, nu), dl = lamPrev ? RelChange(ndl, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
     history.du.push_back(du);
     history.dl.push_back(dl);
     history.nactive.push_back(nact);
