@@ -12,7 +12,7 @@
 // Parameters (gmsh -setnumber NAME value):
 //   L  (1.0)  edge length
 //   h  (0.17) mesh size, multiplied by -clscale
-// Mesh: gmsh -3 meshes/block3d.geo -o block3d.msh -format msh22
+// Mesh: gmsh -3 meshes/block3d.geo -o block3d.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   L = {1.0, Min 1e-3, Max 100, Name "Parameters/L"},

@@ -27,7 +27,7 @@
 //   h_base  (0.08)      base mesh size at x = 0
 //   base_grading (1.18) base mesh size at x = 1 is base_grading*h_base
 //   All sizes are multiplied by -clscale.
-// Mesh: gmsh -2 meshes/flat_punch.geo -o flat_punch.msh -format msh22
+// Mesh: gmsh -2 meshes/flat_punch.geo -o flat_punch.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   h_punch      = {0.05, Min 1e-4, Max 1, Name "Parameters/h_punch"},

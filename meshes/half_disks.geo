@@ -26,7 +26,7 @@
 //             (master 1.5x finer than the slave: non-matching; a master coarser than the slave makes the P1 pressure oscillate, docs/contact.md)
 //   lc_lower  lower mesh size at the flat edge      (default 0.06, at Rl=1)
 // All sizes are multiplied by -clscale.
-// Mesh: gmsh -2 meshes/half_disks.geo -o half_disks.msh -format msh22
+// Mesh: gmsh -2 meshes/half_disks.geo -o half_disks.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   gap       = {1e-3,   Min 0,    Max 0.1,  Name "Parameters/gap"},

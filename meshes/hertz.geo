@@ -25,7 +25,7 @@
 // Parameters (gmsh -setnumber NAME value):
 //   R (1.0), h_slave (0.01), h_master (0.0067), d_fine (0.15),
 //   hmax_cyl (0.1), d_cyl (1.5), hmax_fnd (0.5), d_fnd (5.0)
-// Mesh: gmsh -2 meshes/hertz.geo -o hertz.msh -format msh22
+// Mesh: gmsh -2 meshes/hertz.geo -o hertz.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   R        = {1.0,   Min 0.1,  Max 5,  Name "Parameters/R"},

@@ -27,7 +27,7 @@
 //             (master 1.5x finer than the slave: non-matching; a master coarser than the slave makes the P1 pressure oscillate, docs/contact.md)
 //   lc_block  block mesh size at the block corners
 // All sizes are multiplied by -clscale.  Defaults: ~1590 nodes per body, ~50 on "slave".
-// Mesh: gmsh -2 meshes/ring_on_block.geo -o ring_on_block.msh -format msh22
+// Mesh: gmsh -2 meshes/ring_on_block.geo -o ring_on_block.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   Ro        = {1.0,   Min 0.95, Max 1.15, Step 0.01, Name "Parameters/Ro"},

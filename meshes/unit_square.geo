@@ -15,7 +15,7 @@
 // Parameters (gmsh -setnumber NAME value):
 //   L  (1.0)  edge length
 //   h  (0.1)  mesh size (relative to L), multiplied by -clscale
-// Mesh: gmsh -2 meshes/unit_square.geo -o unit_square.msh -format msh22
+// Mesh: gmsh -2 meshes/unit_square.geo -o unit_square.msh -format msh41   (format 2.2 mislabels with PETSc 3.18: docs/bad_input.md)
 
 DefineConstant[
   L = {1.0, Min 1e-3, Max 100, Name "Parameters/L"},

@@ -29,3 +29,5 @@ rbc_bad_stage(output_dir_offline "-rom /nonexistent_rbc/rom.h5: cannot write the
 rbc_bad_stage(output_dir_online "-rom_reconstruct /nonexistent_rbc/f.h5: cannot write there" online -rom nosuch.h5 -rom_reconstruct /nonexistent_rbc/f.h5)
 rbc_bad_stage(output_dir_validate "-report /nonexistent_rbc/v.json: cannot write there" validate -options_file runs/ring_on_block.opts -rom nosuch.h5 -report /nonexistent_rbc/v.json)
 rbc_bad_stage(output_dir_dualbasis "-dual_out /nonexistent_rbc/w.h5: cannot write there" dualbasis -snapshots nosuch.h5:/lambda -dual_out /nonexistent_rbc/w.h5)
+# a gmsh 2.2 file whose entity tag equals another physical group's tag (PETSc 3.18 would mislabel it)
+rbc_bad_stage(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of physical group 'master'[)] has the tag of physical group 'pin_core'" fom -options_file runs/hard_cases/pin_in_hole.opts -mesh_file @PIN_MSH22@)

@@ -8,7 +8,8 @@
 #     'nan' (as a word, any case).
 # Prints the command, the exit code and the error lines, so a failing test shows why.
 # Special arguments: the tokens @GARBAGE_MSH@ / @GARBAGE_GEO@ in the command are replaced by the path
-# of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards.
+# of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
+# meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag).
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -24,6 +25,10 @@ for a in "$@"; do
   if [ "$a" = "@GARBAGE_MSH@" ]; then
     printf '$MeshFormat\nthis is not a mesh\n$EndMeshFormat\n$Nodes\n3\n1 0 0\n2 x y z\n' > "$tmpdir/garbage_mesh.msh"
     args+=("$tmpdir/garbage_mesh.msh")
+  elif [ "$a" = "@PIN_MSH22@" ]; then
+    # meshes/pin_in_hole.geo written in gmsh format 2.2: entity 13 (master arc) vs physical group 13
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/pin_in_hole.geo" -format msh22 -v 0 -o "$tmpdir/pin_in_hole.22.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    args+=("$tmpdir/pin_in_hole.22.msh")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

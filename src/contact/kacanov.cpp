@@ -2,6 +2,7 @@
 // matrix-free S of dual_shell.cpp: -fom_dual_matrix), KKT checks and the contact summary (force,
 // pressure, active zone).
 #include "rbcontact/kacanov.hpp"
+#include "contact_point.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
 #include <cmath>
@@ -417,6 +418,68 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscFunctionReturn(0);
 }
 
+// Mean facet size of the slave facets with a vertex in the active zone (bounding box of the active rows, grown
+// by 1 %) and of the master facets whose centroid lies in that box grown by the slave size: a master clearly
+// coarser than the slave there (> 2x) makes the pressure oscillate node to node (docs/contact.md).
+static PetscErrorCode MeshRatioWarning(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, const std::vector<PetscReal> &lam, std::vector<std::string> *warnings)
+{
+  const PetscInt         dim = map.Slave().dim;
+  std::vector<PetscReal> x[3];
+  PetscReal              lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {-PETSC_MAX_REAL, -PETSC_MAX_REAL, -PETSC_MAX_REAL};
+  bool                   any = false;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.coord[d], &x[d]));
+  for (size_t i = 0; i < lam.size(); ++i)
+    if (lam[i] > 0) {
+      any = true;
+      for (PetscInt d = 0; d < dim; ++d) {
+        lo[d] = std::min(lo[d], x[d][i]);
+        hi[d] = std::max(hi[d], x[d][i]);
+      }
+    }
+  if (!any) PetscFunctionReturn(0);
+  PetscReal diam = 0;
+  for (PetscInt d = 0; d < dim; ++d) diam = std::max(diam, hi[d] - lo[d]);
+  auto inside = [&](const PetscReal *p, PetscReal grow) {
+    for (PetscInt d = 0; d < dim; ++d)
+      if (p[d] < lo[d] - grow || p[d] > hi[d] + grow) return false;
+    return true;
+  };
+  PetscReal sum[4] = {0, 0, 0, 0}; // slave size sum, count, master size sum, count
+  for (const auto &F : map.Slave().facets) {
+    bool in = false;
+    for (PetscInt k = 0; k < F.nv && !in; ++k) in = inside(&F.X[k * dim], 0.01 * diam);
+    if (in) {
+      sum[0] += std::pow(FacetMeasure(F.X.data(), dim), 1.0 / (dim - 1));
+      sum[1] += 1;
+    }
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPIU_SUM, comm));
+  if (sum[1] == 0) PetscFunctionReturn(0);
+  const PetscReal hs = sum[0] / sum[1];
+  for (const auto &F : map.Master().facets) {
+    PetscReal c[3] = {0, 0, 0};
+    for (PetscInt k = 0; k < F.nv; ++k)
+      for (PetscInt d = 0; d < dim; ++d) c[d] += F.X[k * dim + d] / F.nv;
+    if (inside(c, hs)) {
+      sum[2] += std::pow(FacetMeasure(F.X.data(), dim), 1.0 / (dim - 1));
+      sum[3] += 1;
+    }
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, sum + 2, 2, MPIU_REAL, MPIU_SUM, comm));
+  if (sum[3] == 0) PetscFunctionReturn(0);
+  const PetscReal hm = sum[2] / sum[3];
+  if (hm > 2 * hs) {
+    std::ostringstream o;
+    o.precision(3);
+    o << "the master surface is " << hm / hs << "x coarser than the slave in the contact zone (facet sizes " << hm << " and " << hs
+      << "): the contact pressure oscillates node to node and its peak is overestimated; mesh the master at least as fine as the slave (docs/contact.md)";
+    warnings->push_back(o.str());
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
   std::vector<PetscReal> lam, x[2], n[2];
@@ -430,10 +493,11 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
       << ")); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
     warnings->push_back(o.str());
   }
+  PetscCall(GatherVec(lambda, &lam));
+  PetscCall(MeshRatioWarning(comm, map, sys, lam, warnings));
   const auto &ends = map.SlaveEndRows();
   const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
-  PetscCall(GatherVec(lambda, &lam));
   for (int d = 0; d < 2; ++d) {
     PetscCall(GatherVec(sys.coord[d], &x[d]));
     PetscCall(GatherVec(sys.normal[d], &n[d]));

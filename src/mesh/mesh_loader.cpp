@@ -2,10 +2,12 @@
 // physical names as labels, label checks, and distribution.
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/partition.hpp"
+#include "rbcontact/report.hpp"
 #include <petscsf.h>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -70,6 +72,10 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   char scale[64];
   std::snprintf(scale, sizeof scale, "%.12g", (double)spec.clscale);
   key << "|clscale=" << scale;
+  // gmsh writes format 4.1: PETSc 3.18's reader of format 2.2 also puts the elements whose elementary
+  // (entity) tag equals a physical tag into that physical group (measured: pin_in_hole.geo's "pin_core",
+  // tag 13, received the master arc Circle(13)); 4.1 keeps entities and physical groups apart
+  key << "|format=msh41";
   std::string setnum;
   for (const auto &kv : spec.geoNumbers) {
     char v[64];
@@ -90,7 +96,7 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
     } else {
       const std::string tmp = *mshPath + ".tmp." + std::to_string((long)getpid()) + ".msh";
       const std::string log = *mshPath + ".log";
-      const std::string cmd = std::string(RBC_GMSH_EXECUTABLE) + " -3 '" + src + "' -clscale " + scale + setnum + " -format msh22 -v 2 -o '" + tmp + "' > '" + log + "' 2>&1";
+      const std::string cmd = std::string(RBC_GMSH_EXECUTABLE) + " -3 '" + src + "' -clscale " + scale + setnum + " -format msh41 -v 2 -o '" + tmp + "' > '" + log + "' 2>&1";
       const int         rc  = std::system(cmd.c_str());
       if (rc != 0 || !FileExists(tmp)) {
         ok = 0;
@@ -180,6 +186,76 @@ PetscErrorCode MeshCheckLabel(DM dm, const std::string &name, const char *option
   PetscFunctionReturn(0);
 }
 
+// gmsh format 2.2 files: PETSc 3.18's reader (with -dm_plex_gmsh_use_regions) puts an element into every
+// physical group whose tag equals one of the element's tags, the elementary (entity) tag included. An
+// element of entity 13 in physical group 12 lands in group 13 as well when one exists: a wrong mesh
+// (measured: pin_in_hole's master arc, Circle(13), became part of "pin_core", tag 13: an imposed
+// displacement on the master, contact enforced on half the arc). Refuse such files, naming the clash.
+static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, const std::string &option)
+{
+  PetscMPIInt rank;
+  std::string why;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    std::ifstream f(msh);
+    std::string   line;
+    bool          v2 = false;
+    std::map<std::pair<int, int>, std::string> groups; // (dim, tag) -> name
+    while (f && std::getline(f, line)) {
+      if (line.rfind("$MeshFormat", 0) == 0) {
+        std::getline(f, line);
+        v2 = !line.empty() && line[0] == '2';
+        if (!v2) break;
+      } else if (line.rfind("$PhysicalNames", 0) == 0) {
+        int n = 0;
+        f >> n;
+        for (int i = 0; i < n; ++i) {
+          int         d, t;
+          std::string name;
+          f >> d >> t;
+          std::getline(f, name);
+          const size_t a = name.find('"'), b = name.rfind('"');
+          groups[{d, t}] = (a != std::string::npos && b > a) ? name.substr(a + 1, b - a - 1) : name;
+        }
+      } else if (line.rfind("$Elements", 0) == 0) {
+        auto dimOf = [](int type) {
+          switch (type) {
+          case 15: return 0;
+          case 1: case 8: case 26: case 27: case 28: return 1;
+          case 2: case 3: case 9: case 10: case 16: case 20: case 21: case 22: case 23: case 24: case 25: return 2;
+          default: return 3;
+          }
+        };
+        long n = 0;
+        f >> n;
+        std::getline(f, line);
+        for (long e = 0; e < n && std::getline(f, line) && why.empty(); ++e) {
+          std::istringstream in(line);
+          int                id, type, ntags, phys = 0, ent = 0;
+          in >> id >> type >> ntags;
+          if (ntags >= 2) in >> phys >> ent;
+          if (ntags < 2 || ent == phys) continue;
+          const auto g = groups.find({dimOf(type), ent});
+          if (g != groups.end()) {
+            const auto own = groups.find({dimOf(type), phys});
+            std::ostringstream m;
+            m << "mesh '" << msh << "' (" << option << ") is in gmsh format 2.2 and its entity " << ent << " (of physical group '" << (own != groups.end() ? own->second : std::to_string(phys))
+              << "') has the tag of physical group '" << g->second << "': PETSc 3.18's reader would put those elements into '" << g->second
+              << "' too (a wrong mesh). Write it with gmsh -format msh41 (or give the physical groups tags no entity uses)";
+            why = m.str();
+          }
+        }
+        break;
+      }
+    }
+  }
+  PetscCall(BcastString(comm, &why));
+  PetscCheck(why.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "%s", why.c_str());
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
 {
   std::string msh;
@@ -191,6 +267,7 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   PetscCall(PetscLogEventBegin(MESH_Load, 0, 0, 0, 0));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-dm_plex_gmsh_use_regions", &set));
   if (!set) PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_gmsh_use_regions", "true"));
+  if (EndsWith(msh, ".msh")) PetscCall(CheckGmsh22Tags(comm, msh, "-mesh_file " + scene.mesh.file));
   {
     PetscErrorCode ierr = 0;
     PetscMPIInt    size, rank;
