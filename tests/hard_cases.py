@@ -201,6 +201,23 @@ def rom_onset(ctx):
     return row
 
 
+def rom_split(ctx):
+    """A pad with two bumps: two contact zones that merge into one inside the parameter box (push 0.003..0.04,
+    merging near 0.025); the ROM against the FOM on 10 random pushes."""
+    rom = os.path.join(ctx.work, "twin.h5")
+    off = stage(ctx, "offline", ["-options_file", "runs/hard_cases/twin_bumps.opts", "-rom", rom])
+    val = stage(ctx, "validate", ["-options_file", "runs/hard_cases/twin_bumps.opts", "-rom", rom], np_=1)
+    if off.rep is None or val.rep is None:
+        return failed([off, val], "twin_bumps")
+    t = val.rep["test"]
+    two, one = sum(1 for m in t["mu"] if m < 0.02), sum(1 for m in t["mu"] if m > 0.03)
+    ok = t["failed"] == 0 and t["max_rel_err_u"] <= 1e-4 and t["max_rel_err_lambda"] <= 1e-2 and t["max_rel_err_force"] <= 1e-3 and two > 0 and one > 0
+    row = result([off, val], ok, "u %.1e, lambda %.1e, force %.1e (tol 1e-4, 1e-2, 1e-3)" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]),
+                 "%d test pushes with two zones (< 0.02), %d with one (> 0.03); N %d, R %d, Mc %d" % (two, one, val.rep["rom"]["N"], val.rep["rom"]["R"], val.rep["rom"]["Mc"]))
+    row["converged"], row["kkt"] = t["failed"] == 0, None
+    return row
+
+
 def dual_duplicates(ctx):
     """The dual greedy and its NNLS on the ring's multiplier snapshots with every column repeated, and a copy
     perturbed by 1e-12 (nearly collinear): the same basis size and selected errors as on the plain set."""
@@ -282,6 +299,7 @@ CASES = {
     "load_1e-8": ("loads 1e-8 and 1e-6 of the shipped one (one node in contact)", "linearity in the push", load_tiny, False),
     "load_largest": ("load 5x the shipped one: active zone 72 % of the slave surface", "Hertz (analytic; its own error grows as (a/R)^2, a/R = 0.25)", hertz_case(["-bc_cylinder_top_u", "0,-0.1"], a_tol=0.02, p0_tol=0.02), False),
     "rom_onset": ("ROM: parameter box across the onset of contact", "FOM on 10 random parameters", rom_onset, True),
+    "rom_split": ("ROM: an active zone that splits in two across the box (twin bumps)", "FOM on 10 random parameters", rom_split, False),
     "dual_duplicates": ("dual greedy + NNLS: duplicate and nearly collinear snapshots", "the same greedy without them", dual_duplicates, False),
     "repeated_training": ("offline: a training set with every parameter twice", "the same offline stage without repeats", repeated_training, False),
 }
