@@ -29,6 +29,7 @@
 // uses the default (oldest) HDF5 file format, which has no "file open for writing" flag, so a file
 // left by a killed job opens normally.
 #include "rbcontact/report.hpp"
+#include "rbcontact/scene.hpp"
 #include "rbcontact/snapshot_file.hpp"
 #include "h5util.hpp"
 #include <hdf5.h>
@@ -221,16 +222,8 @@ std::string Hex(unsigned long long v)
   return b;
 }
 
-// Shortest of %.15g, %.16g, %.17g that reads back as v.
-std::string Num(double v)
-{
-  char b[40];
-  for (int p = 15; p <= 17; ++p) {
-    std::snprintf(b, sizeof b, "%.*g", p, v);
-    if (std::strtod(b, nullptr) == v) break;
-  }
-  return b;
-}
+// The shortest decimal that reads back as v (scene.hpp).
+std::string Num(double v) { return ShortestReal(v); }
 
 std::string Join(const std::vector<std::string> &v)
 {
