@@ -72,7 +72,7 @@ inline void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscR
 {
   for (PetscInt k = 0; k < n; ++k) {
     PetscReal *x = &X[(size_t)k * r];
-    std::memcpy(x, &D[(size_t)k * r], sizeof(PetscReal) * r);
+    std::copy_n(&D[(size_t)k * r], r, x); // (memcpy from a null pointer is undefined even for 0 bytes: UBSan)
     PetscInt m = 0;
     for (; m + 4 <= k; m += 4) {
       const PetscReal  l0 = L[k + m * n], l1 = L[k + (m + 1) * n], l2 = L[k + (m + 2) * n], l3 = L[k + (m + 3) * n];
@@ -192,15 +192,15 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
   for (PetscInt i = 0; i < N; ++i) finite = finite && std::isfinite(f[i]);
   for (PetscInt i = 0; i < R; ++i) finite = finite && std::isfinite(c[i]);
   PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in f or c");
-  const bool hitA = reuseFactorization && cachedA_ && cN_ == N && !std::memcmp(A, Ac_.data(), sizeof(PetscReal) * N * N);
-  const bool hitD = hitA && cachedD_ && cR_ == R && !std::memcmp(D, Dc_.data(), sizeof(PetscReal) * R * N);
+  const bool hitA = reuseFactorization && cachedA_ && cN_ == N && std::equal(A, A + (size_t)N * N, Ac_.data());
+  const bool hitD = hitA && cachedD_ && cR_ == R && std::equal(D, D + (size_t)R * N, Dc_.data());
   if (!hitA) {
     cachedA_ = cachedD_ = false;
     finite              = MaxRowSum(N, N, A, tN_.data(), &normA_) && finite;
     PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in A (or a row sum overflows)");
     // A = L L'
     PetscReal amax = 0;
-    std::memcpy(L_.data(), A, sizeof(PetscReal) * N * N);
+    std::copy_n(A, N * N, L_.data());
     for (PetscInt i = 0; i < N; ++i) amax = std::max(amax, A[i + i * N]);
     PetscBLASInt linfo = 0;
     if (N) LAPACKpotrf_("L", &n, L_.data(), &ldn, &linfo);
@@ -216,7 +216,7 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
       PetscFunctionReturn(0);
     }
     if (reuseFactorization) {
-      std::memcpy(Ac_.data(), A, sizeof(PetscReal) * N * N);
+      std::copy_n(A, N * N, Ac_.data());
       cachedA_ = true;
       cN_      = N;
     }
@@ -241,13 +241,13 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
     for (PetscInt k = 0; k < N; ++k)
       for (PetscInt i = 0; i < R; ++i) G_[i + k * R] *= s_[i];
     if (reuseFactorization) {
-      std::memcpy(Dc_.data(), D, sizeof(PetscReal) * R * N);
+      std::copy_n(D, R * N, Dc_.data());
       cachedD_ = true;
       cR_      = R;
     }
   }
   // y = L^{-1} f, b = GT y - diag(s) c
-  std::memcpy(y_.data(), f, sizeof(PetscReal) * N);
+  std::copy_n(f, N, y_.data());
   ForwardSolve(N, L_.data(), y_.data());
   for (PetscInt i = 0; i < R; ++i) b_[i] = -s_[i] * c[i];
   for (PetscInt k = 0; k < N; ++k) {
@@ -459,7 +459,7 @@ finish:
 void ReducedQP::Recover(PetscInt N, PetscInt R, const PetscReal *l, PetscReal *v)
 {
   if (!N) return;
-  std::memcpy(v, y_.data(), sizeof(PetscReal) * N);
+  std::copy_n(y_.data(), N, v);
   for (PetscInt i = 0; i < R; ++i) // only the positive multipliers contribute
     if (l[i] != 0) {
       const PetscReal li = l[i], *g = &G_[i];
