@@ -293,6 +293,12 @@ def warnings(args):
     check(len(w) == 2, "P1, nu = 0.4999: a locking warning per body (%d)" % len(w))
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999", "-fem_degree", "2"] + args.extra, "nu_p2")
     check(not any("lock" in s for s in r["warnings"]), "P2, nu = 0.4999: no locking warning")
+    # contact running past the end of the master surface (x = 0.6): a lateral push of 0.55 warns, 0.3 does not
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-bc_ring_top_u", "0.55,-0.1"] + args.extra, "past_master")
+    w = [s for s in r["warnings"] if "runs past an end of the master surface" in s]
+    check(len(w) == 1, "lateral push 0.55: one warning for contact past the master's end (%s)" % r["warnings"])
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-bc_ring_top_u", "0.3,-0.1"] + args.extra, "slide")
+    check(r["warnings"] == [], "lateral push 0.3 (contact inside the master surface): no warning (%s)" % r["warnings"])
     # an initial overlap of 0.01 (ring moved down through the block top): warned, measured, still solved
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-mesh_geo_set", "g0=-0.01", "-map_ring_dilation_center", "0,-0.01"] + args.extra, "overlap")
     w = [s for s in r["warnings"] if "initial overlap" in s and "interference fit" in s]

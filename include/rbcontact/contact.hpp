@@ -118,6 +118,9 @@ public:
   // slave facet; 3D: none yet) and, per such row, the unit outward normal (reference mesh) of the body's
   // boundary facet that continues the surface there (zero if none), the same on every rank (from Setup).
   const std::vector<PetscInt> &SlaveEndRows() const { return endRows_; }
+  // 2D: multiplier rows (global, gathered on every rank) with an integration point that the last Assemble
+  // projected past an end of the master surface (clamped to its end vertex, beyond it along the surface).
+  PetscErrorCode PastMasterEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const;
   const std::vector<std::array<PetscReal, 2>> &SlaveEndNextNormals() const { return endNext_; }
   const ContactSurface &Slave() const { return slave_; }
   const ContactSurface &Master() const { return master_; }
@@ -141,6 +144,7 @@ private:
   std::vector<PetscReal> quadPoints_, quadWeights_; // reference facet rule (barycentric, nv per point)
   std::vector<SurfaceFacet> masterAll_;
   std::vector<PetscInt>     endRows_;
+  std::vector<PetscInt>     pastMasterEnd_; // rows (local list, may repeat) of the last Assemble: PastMasterEndRows
   std::vector<std::array<PetscReal, 2>> endNext_;
 };
 

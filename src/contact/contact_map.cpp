@@ -347,6 +347,13 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     }
   }
 
+  // 2D: the vertices that end the master surface (in one master facet only)
+  std::unordered_map<PetscInt, PetscInt> vcount;
+  if (dim == 2)
+    for (const auto &M : masterAll_)
+      for (PetscInt k = 0; k < nv; ++k) ++vcount[M.vglobal[k]];
+  pastMasterEnd_.clear();
+
   std::vector<PetscInt>    cols;
   std::vector<PetscScalar> vals;
   const PetscInt           nq = (PetscInt)quadWeights_.size();
@@ -391,6 +398,18 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
         [&](const SurfaceFacet &M, PetscInt k) { return vnormal[M.vglobal[k]].data(); }, &e);
       const SurfaceFacet &M = masterAll_[e.m];
       const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2, gap = e.gap;
+      if (dim == 2)
+        for (PetscInt k = 0; k < 2; ++k)
+          if (e.bm[k] == 1.0 && vcount[M.vglobal[k]] == 1) {
+            // clamped to an end vertex: past the end when the slave point lies beyond it along the facet
+            const PetscReal *xm = cp.Vertices(e.m), *xe = xm + 2 * k, *xo = xm + 2 * (1 - k);
+            PetscReal        z[3], t[2] = {xe[0] - xo[0], xe[1] - xo[1]};
+            SlavePoint(F, dim, b, z);
+            const PetscReal len = std::sqrt(t[0] * t[0] + t[1] * t[1]);
+            if (len > 0 && ((z[0] - xe[0]) * t[0] + (z[1] - xe[1]) * t[1]) / len > 1e-6 * len)
+              for (PetscInt j = 0; j < nv; ++j)
+                if (b[j] != 0.0) pastMasterEnd_.push_back(rows[j]);
+          }
       for (PetscInt k = 0; k < nv; ++k) {
         const PetscReal psi = MultiplierShape(multiplier, nv, b, k);
         const PetscInt  r   = rows[k];
@@ -433,6 +452,22 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       PetscCall(VecAssemblyEnd(v));
     }
   for (PetscInt d = 0; d < dim; ++d) PetscCall(VecPointwiseDivide(sys->normal[d], sys->normal[d], sys->weight));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ContactMap::PastMasterEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const
+{
+  PetscMPIInt size, n = (PetscMPIInt)pastMasterEnd_.size();
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<PetscMPIInt> counts(size), displs(size, 0);
+  PetscCallMPI(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt i = 1; i < size; ++i) displs[i] = displs[i - 1] + counts[i - 1];
+  rows->resize((size_t)displs[size - 1] + counts[size - 1]);
+  PetscCallMPI(MPI_Allgatherv(pastMasterEnd_.data(), n, MPIU_INT, rows->data(), counts.data(), displs.data(), MPIU_INT, comm));
+  std::sort(rows->begin(), rows->end());
+  rows->erase(std::unique(rows->begin(), rows->end()), rows->end());
   PetscFunctionReturn(0);
 }
 

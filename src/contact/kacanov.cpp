@@ -495,6 +495,26 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
   }
   PetscCall(GatherVec(lambda, &lam));
   PetscCall(MeshRatioWarning(comm, map, sys, lam, warnings));
+  { // active rows projected past an end of the master surface: contact there is measured to the end vertex
+    std::vector<PetscInt>  past;
+    std::vector<PetscReal> px[2];
+    PetscCall(map.PastMasterEndRows(comm, &past));
+    PetscReal lmax = 0;
+    for (PetscReal l : lam) lmax = std::max(lmax, l);
+    PetscInt  nact = 0, worst = -1;
+    for (PetscInt r : past)
+      if (lmax > 0 && lam[r] > 1e-10 * lmax) {
+        ++nact;
+        if (worst < 0 || lam[r] > lam[worst]) worst = r;
+      }
+    if (nact > 0) {
+      for (int d = 0; d < 2; ++d) PetscCall(GatherVec(sys.coord[d], &px[d]));
+      std::ostringstream o;
+      o << "the contact zone runs past an end of the master surface: " << nact << " active slave node(s) lie beyond it (e.g. the node at (" << px[0][worst] << ", " << px[1][worst] << ") of the undeformed configuration, pressure " << lam[worst]
+        << "); their contact is measured to the master's end vertex, not to the body beyond it: declare a larger master surface";
+      warnings->push_back(o.str());
+    }
+  }
   const auto &ends = map.SlaveEndRows();
   const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
