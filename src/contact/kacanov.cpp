@@ -421,15 +421,13 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
 // Mean facet size of the slave facets with a vertex in the active zone (bounding box of the active rows, grown
 // by 1 %) and of the master facets whose centroid lies in that box grown by the slave size: a master clearly
 // coarser than the slave there (> 2x) makes the pressure oscillate node to node (docs/contact.md).
-static PetscErrorCode MeshRatioWarning(MPI_Comm comm, const ContactMap &map, const ContactSystem &sys, const std::vector<PetscReal> &lam, std::vector<std::string> *warnings)
+static PetscErrorCode MeshRatioWarning(MPI_Comm comm, const ContactMap &map, const std::vector<PetscReal> x[], const std::vector<PetscReal> &lam, std::vector<std::string> *warnings)
 {
   const PetscInt         dim = map.Slave().dim;
-  std::vector<PetscReal> x[3];
   PetscReal              lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {-PETSC_MAX_REAL, -PETSC_MAX_REAL, -PETSC_MAX_REAL};
   bool                   any = false;
 
   PetscFunctionBeginUser;
-  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.coord[d], &x[d]));
   for (size_t i = 0; i < lam.size(); ++i)
     if (lam[i] > 0) {
       any = true;
@@ -482,9 +480,9 @@ static PetscErrorCode MeshRatioWarning(MPI_Comm comm, const ContactMap &map, con
 
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
-  std::vector<PetscReal> lam, x[2], n[2];
-  const ContactSystem   &sys    = kac.sys;
-  Vec                    lambda = kac.lambda;
+  std::vector<PetscReal> lam, x[3], n[2];
+  const ContactSystem   &sys = kac.sys;
+  const PetscInt         dim = map.Slave().dim;
 
   PetscFunctionBeginUser;
   if (kac.initialPenetrating > 0) {
@@ -493,24 +491,26 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
       << ")); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
     warnings->push_back(o.str());
   }
-  PetscCall(GatherVec(lambda, &lam));
-  PetscCall(MeshRatioWarning(comm, map, sys, lam, warnings));
+  // gathered once for the three checks below: multipliers, their largest value, slave vertex coordinates
+  PetscCall(GatherVec(kac.lambda, &lam));
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.coord[d], &x[d]));
+  PetscReal lmax = 0;
+  for (PetscReal l : lam) lmax = std::max(lmax, l);
+  auto active = [&](PetscInt r) { return lmax > 0 && lam[r] > 1e-10 * lmax; };
+
+  PetscCall(MeshRatioWarning(comm, map, x, lam, warnings));
   { // active rows projected past an end of the master surface: contact there is measured to the end vertex
-    std::vector<PetscInt>  past;
-    std::vector<PetscReal> px[2];
+    std::vector<PetscInt> past;
     PetscCall(map.PastMasterEndRows(comm, &past));
-    PetscReal lmax = 0;
-    for (PetscReal l : lam) lmax = std::max(lmax, l);
-    PetscInt  nact = 0, worst = -1;
+    PetscInt nact = 0, worst = -1;
     for (PetscInt r : past)
-      if (lmax > 0 && lam[r] > 1e-10 * lmax) {
+      if (active(r)) {
         ++nact;
         if (worst < 0 || lam[r] > lam[worst]) worst = r;
       }
     if (nact > 0) {
-      for (int d = 0; d < 2; ++d) PetscCall(GatherVec(sys.coord[d], &px[d]));
       std::ostringstream o;
-      o << "the contact zone runs past an end of the master surface: " << nact << " active slave node(s) lie beyond it (e.g. the node at (" << px[0][worst] << ", " << px[1][worst] << ") of the undeformed configuration, pressure " << lam[worst]
+      o << "the contact zone runs past an end of the master surface: " << nact << " active slave node(s) lie beyond it (e.g. the node at (" << x[0][worst] << ", " << x[1][worst] << ") of the undeformed configuration, pressure " << lam[worst]
         << "); their contact is measured to the master's end vertex, not to the body beyond it: declare a larger master surface";
       warnings->push_back(o.str());
     }
@@ -518,19 +518,14 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
   const auto &ends = map.SlaveEndRows();
   const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
-  for (int d = 0; d < 2; ++d) {
-    PetscCall(GatherVec(sys.coord[d], &x[d]));
-    PetscCall(GatherVec(sys.normal[d], &n[d]));
-  }
-  PetscReal lmax = 0;
-  for (PetscReal l : lam) lmax = std::max(lmax, l);
+  for (int d = 0; d < 2; ++d) PetscCall(GatherVec(sys.normal[d], &n[d]));
   for (size_t e = 0; e < ends.size(); ++e) {
     const PetscInt r = ends[e];
     // the body's boundary continuing past the end faces the master (its outward normal against the
     // master's, which points to the slave): contact there is possible but not enforced. A surface that
     // ends at a corner of its body (a flat punch's edge: the next side is parallel to the master normal) is not.
     const bool facing = next[e][0] * n[0][r] + next[e][1] * n[1][r] < -0.5;
-    if (facing && lmax > 0 && lam[r] > 1e-10 * lmax) {
+    if (facing && active(r)) {
       std::ostringstream o;
       o << "the contact zone reaches the end of the slave surface at (" << x[0][r] << ", " << x[1][r] << ") (pressure " << lam[r] << " there, max " << lmax
         << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
