@@ -44,3 +44,10 @@ add_test(NAME bad_input_garbage_msh_np2
   COMMAND ${RBC_EXPECT_ERROR} "Cannot read mesh '[^']*garbage_mesh[.]msh'" ${RBC_MPIEXEC} -n 2 ${RBC_FOM_RING} -mesh_file @GARBAGE_MSH@
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(bad_input_garbage_msh_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 60 PROCESSORS 2 LABELS elasticity)
+
+# The element-by-element assembly (default) against PetscFE's residual and Jacobian: A, f, H1 matrix and
+# energy to 1e-12 on P1/P2, 2D/3D, mapped bodies at several mu, loads (body force, traction) and liftings.
+rbc_test_exe(test_element_assembly)
+rbc_add_mpi_test(NAME element_assembly_half_disks RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/half_disks.opts -fem_degree 2 -test_mu 0.7,0.06,1.3,0.12 LABELS elasticity)
+rbc_add_mpi_test(NAME element_assembly_ring_loads RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/ring_on_block.opts -body_force 0.3,-1 -bc_traction ring_top -bc_ring_top_t 0.5,-2 -bc_dirichlet block_bottom,slave -bc_slave_u 0.01,0.02 -test_mu 0.95,1.15 LABELS elasticity)
+rbc_add_mpi_test(NAME element_assembly_block3d RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -scene block3d -mesh_file meshes/block3d.geo -bodies block -body_E 100 -body_nu 0.3 -bc_dirichlet bottom,sides -bc_bottom_u 0,0,0 -bc_sides_u 0.01,0,0.02 -bc_sides_comps 0,2 -bc_traction top -bc_top_t 0.1,0,-1 -body_force 0,0,-2 -contact 0 -fem_degree 2 LABELS elasticity)

@@ -10,6 +10,7 @@
 #include <petscsnes.h>
 #include <petscds.h>
 #include <deque>
+#include "rbcontact/element_assembly.hpp"
 #include "rbcontact/geometry_map.hpp"
 #include "rbcontact/scene.hpp"
 
@@ -76,6 +77,10 @@ public:
 
 private:
   PetscErrorCode SetupMaterials();
+  // The element-by-element path (default; -fem_assembly petscfe selects PetscFE's residual/Jacobian)
+  PetscErrorCode                 EnsureElements() const;
+  ElementAssembler::Coefficients ElementCoefficients() const;
+  PetscErrorCode                 AssembleLoads(Vec f); // f = body forces + tractions (no lifting)
   PetscErrorCode ApplyConstants(PetscReal bodyForceScale, const std::vector<PetscReal> &tractionScale);
   const GeometryMap        *map_ = nullptr;
   SNES                      snes_ = nullptr; // carries the DM's FEM callbacks; never solved
@@ -84,6 +89,9 @@ private:
   std::deque<DirichletSpec> bcs_;            // stable storage for boundary-condition contexts
   std::vector<PetscInt>     cellBody_;
   std::vector<PetscInt>     tractionBody_;
+  std::vector<std::vector<PetscReal>> bodyAux_; // the state set by SetBodyAux, per body
+  bool                      elementAssembly_ = true;
+  mutable ElementAssembler  elem_;
 };
 
 } // namespace rbc

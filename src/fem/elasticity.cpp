@@ -3,6 +3,7 @@
 // body force / tractions from the scene (scaled through the constants); essential values by lifting.
 #include "rbcontact/elasticity.hpp"
 #include "rbcontact/mesh.hpp"
+#include <algorithm>
 #include <cmath>
 
 namespace rbc {
@@ -202,6 +203,7 @@ PetscErrorCode Elasticity::SetBodyAux(const std::vector<std::vector<PetscReal>> 
   PetscScalar *arr;
 
   PetscFunctionBeginUser;
+  bodyAux_ = perBody;
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(VecGetArray(aux_, &arr));
   for (PetscInt c = cStart; c < cEnd; ++c) {
@@ -285,6 +287,14 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   PetscCall(PetscObjectReference((PetscObject)dm));
   PetscCall(DMGetDimension(dm, &dim));
   degree = scene.degree;
+  {
+    const char *types[] = {"element", "petscfe"};
+    PetscInt    t       = elementAssembly_ ? 0 : 1;
+    PetscOptionsBegin(comm, "fem_", "Finite-element assembly", "Elasticity");
+    PetscCall(PetscOptionsEList("-assembly", "Assembly of A, the lifting and the energy: element (cell tables and exact reference integrals, a cached pattern) or petscfe (PetscFE residual and Jacobian, the reference)", NULL, types, 2, types[t], &t, NULL));
+    PetscOptionsEnd();
+    elementAssembly_ = t == 0;
+  }
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
   {
     DMPolytopeType ct;
@@ -394,20 +404,44 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode Elasticity::EnsureElements() const
+{
+  PetscFunctionBeginUser;
+  if (!elem_.Ready()) PetscCall(elem_.Setup(dm));
+  PetscFunctionReturn(0);
+}
+
+ElementAssembler::Coefficients Elasticity::ElementCoefficients() const
+{
+  ElementAssembler::Coefficients k;
+  k.cellBody = &cellBody_;
+  for (const auto &a : bodyAux_) {
+    k.tensor.push_back(a.data() + AuxTensorOffset());
+    k.mass.push_back(a[AuxMassIndex()]);
+  }
+  return k;
+}
+
 PetscErrorCode Elasticity::AssembleMatrix(Mat *A)
 {
-  Vec zero;
+  Vec       zero;
+  const bool create = !*A;
 
   PetscFunctionBeginUser;
-  if (!*A) {
-    PetscCall(DMCreateMatrix(dm, A));
+  if (elementAssembly_) {
+    PetscCall(EnsureElements());
+    PetscCall(elem_.AssembleMatrix(ElementCoefficients(), A));
+  } else {
+    if (create) PetscCall(DMCreateMatrix(dm, A));
+    PetscCall(DMGetGlobalVector(dm, &zero));
+    PetscCall(VecSet(zero, 0.0));
+    PetscCall(SNESComputeJacobian(snes_, zero, *A, *A));
+    PetscCall(DMRestoreGlobalVector(dm, &zero));
+  }
+  if (create) {
     PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
     PetscCall(MatSetOption(*A, MAT_SPD, PETSC_TRUE));
   }
-  PetscCall(DMGetGlobalVector(dm, &zero));
-  PetscCall(VecSet(zero, 0.0));
-  PetscCall(SNESComputeJacobian(snes_, zero, *A, *A));
-  PetscCall(DMRestoreGlobalVector(dm, &zero));
   PetscFunctionReturn(0);
 }
 
@@ -426,12 +460,47 @@ PetscErrorCode Elasticity::AssembleH1(Mat *M)
   PetscFunctionReturn(0);
 }
 
+// Loads only: the PetscFE residual at u = 0 in the current state with a zero stiffness tensor (its
+// Dirichlet lifting vanishes with it); nothing to integrate when the scene has no body force and no traction.
+PetscErrorCode Elasticity::AssembleLoads(Vec f)
+{
+  Vec zero;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(f, 0.0));
+  if (!scene.bodyForceF0 && scene.bodyForce.empty() && scene.tractions.empty()) PetscFunctionReturn(0);
+  const std::vector<std::vector<PetscReal>> state = bodyAux_;
+  std::vector<std::vector<PetscReal>>       loadsOnly = state;
+  for (auto &a : loadsOnly) std::fill(a.begin() + AuxTensorOffset(), a.end(), 0.0);
+  PetscCall(SetBodyAux(loadsOnly));
+  PetscCall(DMGetGlobalVector(dm, &zero));
+  PetscCall(VecSet(zero, 0.0));
+  PetscCall(SNESComputeFunction(snes_, zero, f)); // F(0) = -(loads)
+  PetscCall(VecScale(f, -1.0));
+  PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscCall(SetBodyAux(state));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode Elasticity::AssembleRhs(Vec *f)
 {
   Vec zero;
 
   PetscFunctionBeginUser;
   if (!*f) PetscCall(DMCreateGlobalVector(dm, f));
+  if (elementAssembly_) {
+    Vec uloc;
+    PetscCall(EnsureElements());
+    PetscCall(AssembleLoads(*f));
+    PetscCall(DMGetGlobalVector(dm, &zero));
+    PetscCall(DMGetLocalVector(dm, &uloc));
+    PetscCall(VecSet(zero, 0.0));
+    PetscCall(GlobalToLocalWithBC(zero, uloc)); // the Dirichlet values, zero elsewhere
+    PetscCall(elem_.AddLifting(ElementCoefficients(), uloc, *f));
+    PetscCall(DMRestoreLocalVector(dm, &uloc));
+    PetscCall(DMRestoreGlobalVector(dm, &zero));
+    PetscFunctionReturn(0);
+  }
   PetscCall(DMGetGlobalVector(dm, &zero));
   PetscCall(VecSet(zero, 0.0));
   PetscCall(SNESComputeFunction(snes_, zero, *f)); // F(0) = -(loads) + A_{fc} u_D
@@ -463,6 +532,15 @@ PetscErrorCode Elasticity::Energy(Vec u, PetscReal *energy) const
   PetscScalar integral[1] = {0};
 
   PetscFunctionBeginUser;
+  if (elementAssembly_) {
+    Vec uloc;
+    PetscCall(EnsureElements());
+    PetscCall(DMGetLocalVector(dm, &uloc));
+    PetscCall(GlobalToLocalWithBC(u, uloc));
+    PetscCall(elem_.Energy(ElementCoefficients(), uloc, energy));
+    PetscCall(DMRestoreLocalVector(dm, &uloc));
+    PetscFunctionReturn(0);
+  }
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSSetObjective(ds, 0, obj_energy));
   PetscCall(DMPlexComputeIntegralFEM(dm, u, integral, NULL));

@@ -1,0 +1,54 @@
+// rbcontact/element_assembly.hpp: the element-by-element assembly of the elasticity operator on
+// affine simplices (P1/P2 triangles and tetrahedra). Owns the per-mesh tables built once: the closure
+// indices of every local cell (global, constrained dofs negative; local), the cell Jacobians, the exact
+// reference-element integrals of the basis gradients and values (the integrands are polynomials with a
+// cell-constant tensor: no quadrature per assembly), and a preallocated matrix pattern reused by every
+// assembly on the mesh. Computes A, the Dirichlet lifting -A_{free,constrained} u_D and the energy
+// 1/2 a(U, U) with the same basis ordering as PetscFE (its own tabulation); the PetscFE residual and
+// Jacobian of elasticity.cpp stay the reference (-fem_assembly petscfe, docs/fom_speed.md).
+#pragma once
+#include <petscdmplex.h>
+#include <vector>
+
+namespace rbc {
+
+class ElementAssembler {
+public:
+  ElementAssembler() = default;
+  ElementAssembler(const ElementAssembler &) = delete;
+  ElementAssembler &operator=(const ElementAssembler &) = delete;
+  ~ElementAssembler();
+  // Tables of dm (its field 0 is the vector Lagrange PetscFE; the local and global sections exist).
+  PetscErrorCode Setup(DM dm);
+  bool           Ready() const { return pattern_ != nullptr; }
+  // Per-cell coefficients: the effective tensor T[c][a][e][b] (dim^4) and the mass coefficient of each
+  // cell, through its body: tensor(b), mass(b) for body index cellBody[c - cStart].
+  struct Coefficients {
+    const std::vector<PetscInt>                *cellBody = nullptr;
+    std::vector<const PetscReal *>              tensor;  // per body, dim^4 entries
+    std::vector<PetscReal>                      mass;    // per body
+  };
+  // A (created from the cached pattern when *A is null; otherwise zeroed and refilled).
+  PetscErrorCode AssembleMatrix(const Coefficients &k, Mat *A) const;
+  // f += -A_{free,constrained} U_c, U_c the constrained values held in the local vector uloc (its
+  // free entries are ignored).
+  PetscErrorCode AddLifting(const Coefficients &k, Vec uloc, Vec f) const;
+  // 1/2 a(U, U) of the full local field U (constrained dofs included), summed over the ranks.
+  PetscErrorCode Energy(const Coefficients &k, Vec uloc, PetscReal *energy) const;
+
+private:
+  PetscErrorCode CreatePattern();
+  void           ElementMatrix(const Coefficients &k, PetscInt cell, PetscReal *Ke) const;
+
+  DM                     dm_ = nullptr;
+  Mat                    pattern_ = nullptr; // preallocated, zero values
+  PetscInt               dim_ = 0, nb_ = 0, cStart_ = 0, cEnd_ = 0;
+  std::vector<PetscInt>  gidx_, lidx_;       // per cell nb_ closure indices (global: constrained < 0)
+  std::vector<PetscInt>  liftCells_;         // local cells with a constrained dof in their closure
+  std::vector<PetscReal> invJ_, detJ_;       // per cell dim^2 (dxi/dx, PETSc layout) and |det J|
+  std::vector<PetscInt>  comp_;              // component of each vector basis function
+  std::vector<PetscReal> gradInt_;           // [i][j][alpha][beta] int dphi_i/dxi_alpha dphi_j/dxi_beta
+  std::vector<PetscReal> massInt_;           // [i][j] int phi_i phi_j (same component only)
+};
+
+} // namespace rbc
