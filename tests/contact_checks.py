@@ -137,7 +137,10 @@ def no_contact(args):
     du = np.max(np.abs(u - ue)) / np.max(np.abs(ue))
     check(du <= 1e-12, "max |u - u_elastic| / max |u_elastic| = %.2e <= 1e-12" % du)
     de = abs(r["energy"] - re["energy"]) / re["energy"]
-    check(de <= 1e-12, "energy %.12e vs elastic %.12e (rel %.1e <= 1e-12)" % (r["energy"], re["energy"], de))
+    # on 1 rank the contact run factors A once with the Schur complement on the contact dofs (another
+    # elimination order than the elastic run's): both solves have residuals ~3e-15, and at this conditioning
+    # their energies differ by up to 6e-12 (measured, 1 and 2 BLAS threads); identical arithmetic gave 0
+    check(de <= 1e-11, "energy %.12e vs elastic %.12e (rel %.1e <= 1e-11)" % (r["energy"], re["energy"], de))
 
 
 def ring(args):
@@ -175,7 +178,8 @@ def dual_shell(args):
     dense = {}
     for s, opts in cases:
         tag = s + "".join(opts)
-        rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + args.extra, tag + "_dense")
+        # the dense reference without Anderson mixing (the shell path has none): the same Kacanov iterates
+        rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + ["-kacanov_anderson", "0"] + args.extra, tag + "_dense")
         dense[tag] = (rd, h5d)
         # auto with a tiny -fom_dual_dense_max must pick the shell (and shell must skip the compliance)
         shell = ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"] if s == "flat_punch" else ["-fom_dual_matrix", "shell"]

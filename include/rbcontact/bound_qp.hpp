@@ -37,14 +37,17 @@ public:
   DualQPSolver &operator=(const DualQPSolver &) = delete;
   ~DualQPSolver();
   // prefix: options prefix of the Tao (e.g. "fom_" -> -fom_tao_type, -fom_tao_gatol); -<prefix>qp_polish.
+  // Default -<prefix>tao_type activeset: the active-set method alone, warm-started; bqpip (or any
+  // bound-constrained TAO type) runs TAO from zero, then the active-set polish.
   PetscErrorCode Setup(const std::string &prefix);
-  // S: R x R column-major SPD; minimizes 1/2 l'Sl - b'l over l >= 0. lambda: in/out.
-  PetscErrorCode Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info);
+  // S: R x R column-major SPD; minimizes 1/2 l'Sl - b'l over l >= 0. warm (optional, size R): a start,
+  // e.g. the previous Kacanov iterate's multipliers (its support is the initial active set).
+  PetscErrorCode Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info, const std::vector<PetscReal> *warm = nullptr);
 
 private:
   std::string prefix_;
   PetscBool   polish_ = PETSC_TRUE;
-  PetscBool   useTao_ = PETSC_TRUE;
+  PetscBool   useTao_ = PETSC_FALSE;
 };
 
 } // namespace rbc

@@ -92,6 +92,8 @@ private:
   std::vector<std::vector<PetscReal>> bodyAux_; // the state set by SetBodyAux, per body
   bool                      elementAssembly_ = true;
   mutable ElementAssembler  elem_;
+  mutable Vec               bcLocal_ = nullptr; // the Dirichlet values of the current state, zero elsewhere
+  mutable bool              bcValid_ = false;   // cleared by every change of the load scales
 };
 
 } // namespace rbc

@@ -33,6 +33,15 @@ public:
   PetscErrorCode SetMu(const std::vector<PetscReal> &mu);
   // Assembles A(mu) and f(mu) (affine sums if SetupAffine was called, else directly) and factors A.
   PetscErrorCode AssembleAndFactor();
+  // The contact dofs D of the dense dual solve (KacanovSolver::ShareFactor sets them). On 1 rank with the
+  // default direct solver (preonly + Cholesky + MUMPS) and -contact_compliance auto|schur, A is then
+  // factored once with MUMPS and its Schur complement on D: the compliance reads that Schur complement
+  // and every solve uses the same factor (one factorization per parameter; docs/fom_speed.md).
+  void SetSchurDofs(const std::vector<PetscInt> &D) { schurDofs_ = D; }
+  const std::vector<PetscInt> &SchurDofs() const { return schurDofs_; }
+  // The Schur complement S_A = A_DD - A_DI A_II^{-1} A_ID of the last factorization (a sequential
+  // dense copy), or null when A was factored by the KSP alone.
+  Mat SchurComplement() const { return schurS_; }
   // u = A^{-1} rhs with the factored operator.
   PetscErrorCode ApplyInverse(Vec rhs, Vec x);
   // Plain elastic solve u = A^{-1} f.
@@ -66,7 +75,10 @@ public:
   FomTimes   times;
 
 private:
-  bool residualChecked_ = false; // the first solve after a factorization checks ||A x - rhs||
+  PetscErrorCode FactorWithSchur(bool *done);
+  bool                  residualChecked_ = false; // the first solve after a factorization checks ||A x - rhs||
+  std::vector<PetscInt> schurDofs_;
+  Mat                   schurFactor_ = nullptr, schurS_ = nullptr; // MUMPS factor with the Schur on D, S copy
 };
 
 // One attribute of an XDMF grid: display name, HDF5 dataset path, components, node or cell centred.

@@ -9,6 +9,7 @@
 // (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), or S as a MATSHELL with the matrix-free
 // primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*).
 #pragma once
+#include "rbcontact/anderson.hpp"
 #include "rbcontact/bound_qp.hpp"
 #include "rbcontact/compliance.hpp"
 #include "rbcontact/contact.hpp"
@@ -39,6 +40,9 @@ public:
   // Solves the contact problem of fom (assembled and factored). On return fom.u is the displacement,
   // lambda (R, distributed like the rows of K) the multipliers, sys the constraint at the last iterate.
   PetscErrorCode Solve(ElasticFOM &fom, ContactMap &map);
+  // Before fom.AssembleAndFactor: when the dual matrix will be dense, hands the contact dofs to the FOM
+  // so that one factorization serves the solves and the compliance (ElasticFOM::SetSchurDofs). Collective.
+  PetscErrorCode ShareFactor(ElasticFOM &fom, const ContactMap &map) const;
 
   Vec            lambda = nullptr;
   ContactSystem  sys;
@@ -49,6 +53,7 @@ public:
   PetscInt       maxIt = 30;
   PetscReal      rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
   PetscBool      monitor = PETSC_FALSE;
+  PetscInt       anderson = 3; // -kacanov_anderson m: Anderson mixing of the contact-dof displacement (0: plain)
   DualQPInfo     lastQP;
   DualShellInfo  lastShell;
   SurfaceCompliance compliance;

@@ -3,6 +3,8 @@
 #include <petscsys.h>
 #include <slepcsys.h>
 #include <cctype>
+#include <cstdlib>
+#include <dlfcn.h>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -107,6 +109,23 @@ static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *f
   return n;
 }
 
+// With several ranks on the machine's cores, a threaded BLAS (libopenblas0-pthread, installed by
+// share/setup.sh) would start its own threads in every rank and oversubscribe the cores: one BLAS thread
+// per rank unless OPENBLAS_NUM_THREADS says otherwise (docs/fom_speed.md). A reference BLAS has no such
+// symbol: nothing to do.
+static PetscErrorCode OneBlasThreadPerRank()
+{
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+  if (size > 1 && !std::getenv("OPENBLAS_NUM_THREADS")) {
+    using SetThreads = void (*)(int);
+    if (auto fn = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) fn(1);
+  }
+  PetscFunctionReturn(0);
+}
+
 int main(int argc, char **argv)
 {
   if (argc < 2 || argv[1][0] == '-') {
@@ -119,6 +138,7 @@ int main(int argc, char **argv)
   --argc;
 
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
+  PetscCall(OneBlasThreadPerRank());
   {
     PetscBool full = PETSC_FALSE;
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-rbc_full_traceback", &full, NULL));

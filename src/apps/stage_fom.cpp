@@ -47,6 +47,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     PetscCall(kacanov.SetFromOptions(comm));
     PetscCall(map.Setup(fom.elas, scene.slave, scene.master));
     map.SetGeometry(&fom.map, fom.mu);
+    PetscCall(kacanov.ShareFactor(fom, map));
   }
   PetscCall(fom.AssembleAndFactor());
   if (scene.contact) {

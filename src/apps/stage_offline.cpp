@@ -152,6 +152,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
     if (scene.contact) {
       PetscCall(kac.SetFromOptions(group));
       PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+      PetscCall(kac.ShareFactor(fom, cmap));
       R = cmap.NumMultipliers();
       PetscCall(cmap.SurfaceDofs(group, &D));
       // contact dofs in canonical numbering, sorted; Dperm[j] = position in D of the j-th canonical one

@@ -168,6 +168,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   PetscCall(bases.Read(comm, model, romPath, order.NumDofs()));
   PetscCall(kac.SetFromOptions(comm));
   PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+  PetscCall(kac.ShareFactor(fom, cmap));
   const PetscInt dim = fom.elas.dim;
 
   // the ROM without EIM: exact reduced contact terms on the full patch (the ROM's contact quadrature)

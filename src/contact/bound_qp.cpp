@@ -116,7 +116,7 @@ DualQPSolver::~DualQPSolver() = default;
 
 PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
 {
-  char type[64] = "bqpip";
+  char type[64] = "activeset";
 
   PetscFunctionBeginUser;
   prefix_ = prefix;
@@ -127,7 +127,7 @@ PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode DualQPSolver::Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info)
+PetscErrorCode DualQPSolver::Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info, const std::vector<PetscReal> *warm)
 {
   std::vector<PetscReal> d(R), Ss(S.size()), bs(R), y(R, 0.0);
   PetscReal              bnorm = 0;
@@ -152,6 +152,8 @@ PetscErrorCode DualQPSolver::Solve(PetscInt R, const std::vector<PetscReal> &S, 
     PetscFunctionReturn(0);
   }
   for (PetscInt i = 0; i < R; ++i) bs[i] /= bnorm;
+  if (!useTao_ && warm && (PetscInt)warm->size() == R) // y = D^{-1} lambda / ||D b||
+    for (PetscInt i = 0; i < R; ++i) y[i] = (*warm)[i] > 0 ? (*warm)[i] / (d[i] * bnorm) : 0.0;
 
   if (useTao_) {
     Tao   tao;

@@ -187,7 +187,25 @@ void ClosestPoint::Find(const PetscReal p[], PetscInt *facet, PetscReal b[], Pet
   for (PetscInt d = 0; d < dim_; ++d) span = std::max(span, h_[d] * nb_[d] + std::abs(p[d] - lo_[d]) + std::abs(p[d] - (lo_[d] + h_[d] * nb_[d])));
   for (;;) {
     PetscReal lo[3], hi[3];
-    for (PetscInt d = 0; d < dim_; ++d) { lo[d] = p[d] - r; hi[d] = p[d] + r; }
+    PetscReal nbox = 1; // bins the box covers: once they outnumber the facets, test every facet (exact)
+    for (PetscInt d = 0; d < dim_; ++d) {
+      lo[d] = p[d] - r;
+      hi[d] = p[d] + r;
+      const PetscReal a = std::max(0.0, std::floor((lo[d] - lo_[d]) / h_[d])), z = std::min<PetscReal>(nb_[d] - 1, std::floor((hi[d] - lo_[d]) / h_[d]));
+      nbox *= std::max<PetscReal>(1, z - a + 1);
+    }
+    if (nbox > nf) {
+      for (PetscInt f = 0; f < nf; ++f) {
+        PetscReal       bb[3];
+        const PetscReal dd = DistToFacet(f, p, bb);
+        if (dd < *dist || (dd == *dist && f < *facet)) {
+          *dist  = dd;
+          *facet = f;
+          for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
+        }
+      }
+      return;
+    }
     Candidates(lo, hi, &cand);
     for (PetscInt f : cand) {
       PetscReal bb[3];

@@ -8,14 +8,39 @@ namespace rbc {
 
 static PetscLogEvent CMP_Compute = 0;
 
-// A (sequential, global numbering) -> G = (A^{-1})_{DD} through the MUMPS Schur complement on D.
+// G = S_A^{-1} from the Schur complement S_A = A_DD - A_DI A_II^{-1} A_ID (SPD: Cholesky inverse).
+static PetscErrorCode InverseOfSchur(Mat S, std::vector<PetscReal> *G)
+{
+  const PetscScalar *s;
+  PetscInt           lda, n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetSize(S, &n, NULL));
+  const PetscBLASInt nb = (PetscBLASInt)n;
+  PetscCall(MatDenseGetLDA(S, &lda));
+  PetscCall(MatDenseGetArrayRead(S, &s));
+  G->assign((size_t)n * n, 0.0);
+  for (PetscInt j = 0; j < n; ++j)
+    for (PetscInt i = 0; i < n; ++i) (*G)[i + (size_t)j * n] = PetscRealPart(s[i + j * lda]);
+  PetscCall(MatDenseRestoreArrayRead(S, &s));
+  PetscBLASInt linfo = 0;
+  LAPACKpotrf_("L", &nb, G->data(), &nb, &linfo);
+  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_MAT_CH_ZRPVT, "Contact compliance: Schur complement on the contact dofs is not SPD (LAPACK potrf info %d)", (int)linfo);
+  LAPACKpotri_("L", &nb, G->data(), &nb, &linfo);
+  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_LIB, "Contact compliance: LAPACK potri info %d", (int)linfo);
+  for (PetscInt j = 0; j < n; ++j)
+    for (PetscInt i = 0; i < j; ++i) (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n];
+  PetscFunctionReturn(0);
+}
+
+// A (sequential, global numbering) -> G = (A^{-1})_{DD} through a MUMPS factorization with the Schur
+// complement on D.
 static PetscErrorCode ComplianceBySchur(Mat Aseq, const std::vector<PetscInt> &D, std::vector<PetscReal> *G)
 {
   Mat                  F, S;
   IS                   is;
   MatFactorInfo        info;
   MatFactorSchurStatus status;
-  const PetscBLASInt   n = (PetscBLASInt)D.size();
 
   PetscFunctionBeginUser;
   PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)D.size(), D.data(), PETSC_COPY_VALUES, &is));
@@ -25,22 +50,7 @@ static PetscErrorCode ComplianceBySchur(Mat Aseq, const std::vector<PetscInt> &D
   PetscCall(MatCholeskyFactorSymbolic(F, Aseq, NULL, &info));
   PetscCall(MatCholeskyFactorNumeric(F, Aseq, &info));
   PetscCall(MatFactorCreateSchurComplement(F, &S, &status));
-  // S_A = A_DD - A_DI A_II^{-1} A_ID; (A^{-1})_DD = S_A^{-1} (SPD: Cholesky inverse)
-  const PetscScalar *s;
-  PetscInt           lda;
-  PetscCall(MatDenseGetLDA(S, &lda));
-  PetscCall(MatDenseGetArrayRead(S, &s));
-  G->assign((size_t)n * n, 0.0);
-  for (PetscBLASInt j = 0; j < n; ++j)
-    for (PetscBLASInt i = 0; i < n; ++i) (*G)[i + (size_t)j * n] = PetscRealPart(s[i + j * lda]);
-  PetscCall(MatDenseRestoreArrayRead(S, &s));
-  PetscBLASInt linfo = 0;
-  LAPACKpotrf_("L", &n, G->data(), &n, &linfo);
-  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_MAT_CH_ZRPVT, "Contact compliance: Schur complement on the contact dofs is not SPD (LAPACK potrf info %d)", (int)linfo);
-  LAPACKpotri_("L", &n, G->data(), &n, &linfo);
-  PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_LIB, "Contact compliance: LAPACK potri info %d", (int)linfo);
-  for (PetscBLASInt j = 0; j < n; ++j)
-    for (PetscBLASInt i = 0; i < j; ++i) (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n];
+  PetscCall(InverseOfSchur(S, G));
   PetscCall(MatDestroy(&S));
   PetscCall(MatDestroy(&F));
   PetscCall(ISDestroy(&is));
@@ -111,7 +121,10 @@ PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<Pet
   if (!strcmp(m, "auto")) method = size == 1 ? "schur" : "redundant";
   else method = m;
   PetscCheck(method != "schur" || size == 1, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank (PETSc 3.18 has no parallel MUMPS Schur complement); use redundant or solves");
-  if (method == "schur") PetscCall(ComplianceBySchur(fom.A, D, &G));
+  if (method == "schur" && fom.SchurComplement() && fom.SchurDofs() == D) {
+    method = "schur (the factor of the solves)"; // one factorization per parameter
+    PetscCall(InverseOfSchur(fom.SchurComplement(), &G));
+  } else if (method == "schur") PetscCall(ComplianceBySchur(fom.A, D, &G));
   else if (method == "redundant") {
     Mat Aseq;
     PetscCall(MatCreateRedundantMatrix(fom.A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, &Aseq));

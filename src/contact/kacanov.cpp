@@ -29,7 +29,9 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCall(PetscOptionsReal("-rtol_dual", "Relative change of lambda to stop", NULL, rtolDual, &rtolDual, NULL));
   PetscCall(PetscOptionsReal("-relaxation", "Under-relaxation factor in (0, 1]", NULL, relaxation, &relaxation, NULL));
   PetscCall(PetscOptionsBool("-monitor", "Print the changes and the active-set size per iteration", NULL, monitor, &monitor, NULL));
+  PetscCall(PetscOptionsInt("-anderson", "Anderson mixing depth on the contact-dof displacement (dense dual matrix; 0: plain Kacanov)", NULL, anderson, &anderson, NULL));
   PetscOptionsEnd();
+  PetscCheck(anderson >= 0 && anderson <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_anderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", anderson);
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
   {
@@ -231,10 +233,22 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode KacanovSolver::ShareFactor(ElasticFOM &fom, const ContactMap &map) const
+{
+  std::vector<PetscInt> D;
+
+  PetscFunctionBeginUser;
+  const PetscInt R0    = map.NumMultipliers();
+  const bool     shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && R0 > dualDenseMax);
+  if (!shell) PetscCall(map.SurfaceDofs(PetscObjectComm((PetscObject)fom.dm), &D));
+  fom.SetSchurDofs(D);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)fom.dm);
-  Vec            u0, uprev, uloc, lamPrev = nullptr, tmp, rhs;
+  Vec            u0, uprev, uloc, usurf, lamPrev = nullptr, tmp, rhs;
   PetscLogDouble t0, t1;
 
   PetscFunctionBeginUser;
@@ -251,6 +265,10 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(VecDuplicate(u0, &rhs));
   PetscCall(VecSet(uprev, 0.0));
   PetscCall(DMCreateLocalVector(fom.dm, &uloc));
+  PetscCall(VecDuplicate(u0, &usurf)); // u on the contact dofs (dense dual matrix), zero elsewhere
+  PetscCall(VecSet(usurf, 0.0));
+  std::vector<PetscReal> uDprev, lamWarm, mixed; // the input u_D of the iterate, the previous multipliers (QP warm start)
+  AndersonMixing         aa;
   PetscCall(VecSet(uloc, 0.0)); // u^0 = 0: the reference configuration
   // Dual Hessian: dense S through the compliance of the contact dofs (once per parameter: every
   // iterate's S = K_D G K_D^T costs dense operations only), or a MATSHELL with no compliance at all.
@@ -268,6 +286,10 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(PetscTime(&t1));
   fom.times.contact += t1 - t0;
   const PetscBLASInt nD = (PetscBLASInt)D.size();
+  if (!shell && anderson > 0) {
+    aa.Setup(nD, anderson);
+    mixed.assign(nD, 0.0);
+  }
   if (monitor) {
     if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ")\n", R0, dualMatrixOption.c_str(), dualDenseMax));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
@@ -343,7 +365,8 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     }
     PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
     PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
-    PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP));
+    PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP, lamWarm.empty() ? nullptr : &lamWarm));
+    lamWarm = lam;
     PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
     {
       PetscInt     lo, hi;
@@ -357,20 +380,55 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     }
     PetscCall(PetscTime(&t1));
     fom.times.contact += t1 - t0;
-    // u = A^{-1} (f - K^T lambda): one back-solve with the factored A
+    // u = A^{-1} (f - K^T lambda) = u0 - A^{-1} K^T lambda. Dense dual matrix: only the contact dofs
+    // are needed for the next geometry, u_D = u0_D - G K_D^T lambda (G = (A^{-1})_DD), and the
+    // whole field is solved for once, after the loop. Shell: one back-solve per iterate.
     PetscCall(MatMultTranspose(sys.K, lambda, rhs));
     PetscCall(VecAYPX(rhs, -1.0, fom.f));
-    PetscCall(fom.ApplyInverse(rhs, fom.u));
+    PetscReal nu, nup, ndu, nl, nlp = 0, ndl;
+    if (shell) {
+      PetscCall(fom.ApplyInverse(rhs, fom.u));
+      if (relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - relaxation, relaxation, uprev));
+      PetscCall(VecNorm(fom.u, NORM_2, &nu));
+      PetscCall(VecNorm(uprev, NORM_2, &nup));
+      PetscCall(VecWAXPY(tmp, -1.0, uprev, fom.u));
+      PetscCall(VecNorm(tmp, NORM_2, &ndu));
+    } else {
+      const PetscBLASInt R = (PetscBLASInt)sys.R, one = 1;
+      const PetscScalar  m1 = -1.0, p1 = 1.0;
+      std::vector<PetscReal> w(nD, 0.0);
+      for (PetscBLASInt j = 0; j < nD; ++j) {
+        PetscReal v = 0;
+        for (PetscBLASInt i = 0; i < R; ++i) v += KD[i + (size_t)j * R] * lam[i];
+        w[j] = v;
+      }
+      std::vector<PetscReal> uD(u0D);
+      if (nD) BLASgemv_("N", &nD, &nD, &m1, compliance.G.data(), &nD, w.data(), &one, &p1, uD.data(), &one);
+      if (uDprev.empty()) uDprev.assign(nD, 0.0);
+      if (relaxation < 1)
+        for (PetscBLASInt j = 0; j < nD; ++j) uD[j] = relaxation * uD[j] + (1 - relaxation) * uDprev[j];
+      PetscReal a = 0, b = 0, c = 0;
+      for (PetscBLASInt j = 0; j < nD; ++j) {
+        a += uD[j] * uD[j];
+        b += uDprev[j] * uDprev[j];
+        c += (uD[j] - uDprev[j]) * (uD[j] - uDprev[j]);
+      }
+      nu = std::sqrt(a), nup = std::sqrt(b), ndu = std::sqrt(c);
+      // the next geometry: u_D itself, or Anderson's mix of this input (uDprev) and its image (uD)
+      if (anderson > 0 && aa.Mix(uDprev.data(), uD.data(), mixed.data()) > 0) uDprev = mixed;
+      else uDprev = uD;
+      PetscInt lo, hi;
+      PetscScalar *us;
+      PetscCall(VecGetOwnershipRange(usurf, &lo, &hi));
+      PetscCall(VecGetArray(usurf, &us));
+      for (PetscBLASInt j = 0; j < nD; ++j)
+        if (D[j] >= lo && D[j] < hi) us[D[j] - lo] = uDprev[j];
+      PetscCall(VecRestoreArray(usurf, &us));
+    }
     PetscCall(PetscTime(&t0));
     fom.times.solve += t0 - t1;
-    if (relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - relaxation, relaxation, uprev));
 
-    // Relative changes
-    PetscReal nu, nup, ndu, nl, nlp = 0, ndl;
-    PetscCall(VecNorm(fom.u, NORM_2, &nu));
-    PetscCall(VecNorm(uprev, NORM_2, &nup));
-    PetscCall(VecWAXPY(tmp, -1.0, uprev, fom.u));
-    PetscCall(VecNorm(tmp, NORM_2, &ndu));
+    // Relative changes (of u on the contact dofs with the dense dual matrix, of the whole u with the shell)
     PetscCall(VecNorm(lambda, NORM_2, &nl));
     if (lamPrev) {
       PetscCall(VecNorm(lamPrev, NORM_2, &nlp));
@@ -395,18 +453,25 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     else if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
-    PetscCall(VecCopy(fom.u, uprev));
+    if (shell) PetscCall(VecCopy(fom.u, uprev));
     if (maxIt == 1 || (du <= rtolPrimal && dl <= rtolDual)) {
       converged = PETSC_TRUE;
       break;
     }
-    PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+    PetscCall(fom.elas.GlobalToLocalWithBC(shell ? fom.u : usurf, uloc));
+  }
+  if (!shell) { // the whole field at the last multipliers: u = A^{-1} (f - K^T lambda)
+    PetscCall(PetscTime(&t0));
+    PetscCall(fom.ApplyInverse(rhs, fom.u));
+    PetscCall(PetscTime(&t1));
+    fom.times.solve += t1 - t0;
   }
   PetscCall(VecDestroy(&u0));
   PetscCall(VecDestroy(&rhs));
   PetscCall(VecDestroy(&uprev));
   PetscCall(VecDestroy(&tmp));
   PetscCall(VecDestroy(&uloc));
+  PetscCall(VecDestroy(&usurf));
   PetscCall(VecDestroy(&lamPrev));
   if (!converged) {
     std::ostringstream h;

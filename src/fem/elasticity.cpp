@@ -107,6 +107,7 @@ static PetscErrorCode ConstantBC(PetscInt dim, PetscReal t, const PetscReal x[],
 
 Elasticity::~Elasticity()
 {
+  (void)VecDestroy(&bcLocal_);
   (void)SNESDestroy(&snes_);
   (void)VecDestroy(&aux_);
   (void)DMDestroy(&dmAux_);
@@ -235,6 +236,7 @@ PetscErrorCode Elasticity::SetLoadScales(const std::vector<PetscReal> &dirichlet
   PetscFunctionBeginUser;
   size_t k = 0;
   for (auto &bc : bcs_) bc.scale = dirichlet[k++];
+  bcValid_ = false;
   PetscCall(ApplyConstants(bodyForce, traction));
   PetscFunctionReturn(0);
 }
@@ -520,9 +522,14 @@ PetscErrorCode Elasticity::Assemble(Mat *A, Vec *f)
 PetscErrorCode Elasticity::GlobalToLocalWithBC(Vec u, Vec uloc) const
 {
   PetscFunctionBeginUser;
-  PetscCall(VecSet(uloc, 0.0));
+  if (!bcValid_) { // the boundary values of this state, projected once (DMPlexInsertBoundaryValues is slow)
+    if (!bcLocal_) PetscCall(DMCreateLocalVector(dm, &bcLocal_));
+    PetscCall(VecSet(bcLocal_, 0.0));
+    PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, bcLocal_, 0.0, NULL, NULL, NULL));
+    bcValid_ = true;
+  }
+  PetscCall(VecCopy(bcLocal_, uloc)); // the global-to-local scatter leaves the constrained entries alone
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, uloc));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, uloc, 0.0, NULL, NULL, NULL));
   PetscFunctionReturn(0);
 }
 
