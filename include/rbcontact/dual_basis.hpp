@@ -39,7 +39,7 @@ struct NNLSStats {
 
 // What one NNLS solve did (optional output of NNLSSolver::Solve).
 struct NNLSInfo {
-  PetscInt           attempts = 0;         // 1: first try accepted; 2: gatol/10 retry; 3: active set alone
+  PetscInt           attempts = 0;         // attempts made (tao: TAO, TAO gatol/10, active set; activeset: warm, cold, TAO, TAO gatol/10)
   PetscInt           taoIterations = 0;    // of the accepted attempt (0 if TAO was not used)
   TaoConvergedReason taoReason = TAO_CONTINUE_ITERATING;
   PetscInt           polishIterations = 0; // active-set changes of the Lawson-Hanson polish
@@ -48,7 +48,8 @@ struct NNLSInfo {
   PetscBool          ok = PETSC_TRUE;      // kkt <= -nnls_kkt_tol
 };
 
-// min_{x >= 0} || Q x - b ||_2 with TAO (default BQPIP, options prefix nnls_, -nnls_tao_type) following
+// min_{x >= 0} || Q x - b ||_2 by the Lawson-Hanson active-set method (default -nnls_method activeset,
+// warm-started from a previous solution when given), or (-nnls_method tao) with TAO (BQPIP, options prefix nnls_, -nnls_tao_type) following
 // ../shared/notes/nnls-with-bqpip.md (equilibration, upper bound 2, grtol 0, gatol, inner Cholesky),
 // then a Lawson-Hanson active-set polish from TAO's support. Every solve is checked (x >= 0,
 // gradient >= -tol, complementarity <= tol); a failed check is retried (tighter gatol, then the
@@ -66,14 +67,16 @@ public:
   ~NNLSSolver(); // destroys the cached Tao (call Reset() before PetscFinalize if the solver outlives it)
   PetscErrorCode SetFromOptions(); // reads the nnls_ options
   // stats (may be null) accumulates; info (may be null) describes this solve.
-  PetscErrorCode Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats, NNLSInfo *info = nullptr);
+  // start (may be null; size Q.cols): a previous solution whose support starts the active-set method
+  // (the cone-projected greedy passes each snapshot's projection of the previous step).
+  PetscErrorCode Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats, NNLSInfo *info = nullptr, const std::vector<PetscReal> *start = nullptr);
   PetscErrorCode Reset(); // destroys the cached Tao and problem data
 
 private:
   PetscErrorCode SetupTao(PetscInt n);
   PetscErrorCode SolveTao(const std::vector<PetscReal> &H, const std::vector<PetscReal> &c, PetscBool bounded, PetscReal gatolFactor, std::vector<PetscReal> *y, PetscInt *its, TaoConvergedReason *reason);
 
-  PetscBool useTao_ = PETSC_TRUE, polish_ = PETSC_TRUE;
+  PetscBool useTao_ = PETSC_FALSE, polish_ = PETSC_TRUE;
   PetscReal kktTol_ = 1e-9, supportTol_ = 1e-6;
   Tao       tao_ = nullptr;
   Mat       H_   = nullptr;
@@ -122,7 +125,9 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res);
 
 // Projection errors of every column of L onto the cone of W (NNLS), in l-infinity or l2.
 // solver: a configured NNLSSolver to use (null: a local one, configured from the options: collective).
-PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats, NNLSSolver *solver = nullptr);
+// warm (may be null): per snapshot, the coefficients of its previous projection (in/out; padded with zeros
+// for columns added since), the start of each NNLS.
+PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats, NNLSSolver *solver = nullptr, std::vector<std::vector<PetscReal>> *warm = nullptr);
 
 // mcpg's subproblem: Upsilon = W y, y = argmin ||theta - W y|| s.t. y >= 0, W y <= theta (theta >= 0).
 // Solved as a least-squares problem with inequality constraints by Lawson-Hanson's LSI -> LDP -> NNLS

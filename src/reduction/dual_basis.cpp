@@ -96,7 +96,7 @@ PetscErrorCode GramConditionNumber(const DenseMatrix &W, PetscReal *cond)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats, NNLSSolver *solver)
+PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, bool linf, std::vector<PetscReal> *err, NNLSStats *stats, NNLSSolver *solver, std::vector<std::vector<PetscReal>> *warm)
 {
   const PetscInt         R = L.rows, m = L.cols;
   NNLSSolver             local;
@@ -113,7 +113,12 @@ PetscErrorCode ConeProjectionErrors(const DenseMatrix &W, const DenseMatrix &L, 
   for (PetscInt j = 0; j < m; ++j) {
     std::copy(&L.a[(size_t)j * R], &L.a[(size_t)j * R] + R, b.begin());
     if (W.cols == 0) { (*err)[j] = VecNormOf(b.data(), R, linf); continue; }
-    PetscCall(s->Solve(W, b, &x, stats));
+    if (warm) {
+      if ((PetscInt)warm->size() != m) warm->assign(m, {});
+      (*warm)[j].resize(W.cols, 0.0); // columns added since the last projection start at 0
+      PetscCall(s->Solve(W, b, &x, stats, nullptr, &(*warm)[j]));
+      (*warm)[j] = x;
+    } else PetscCall(s->Solve(W, b, &x, stats));
     r = b;
     for (PetscInt k = 0; k < W.cols; ++k)
       if (x[k] != 0)
@@ -403,6 +408,7 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
     err                      = snapNorm;
     const PetscReal nothing  = 1e-13 * res->initialMaxErr; // "the pick adds nothing"
     std::vector<char> picked(m, 0);
+    std::vector<std::vector<PetscReal>> warmX; // per snapshot, its cone projection at the previous step
     res->mcpgMinRemainder = 0;
     if (monitor) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  dual %s (%s): step 0, largest snapshot norm %.6e, tolerance %.3e\n", types[type], norms[norm], (double)res->initialMaxErr, (double)res->tolAbs));
     while (true) {
@@ -430,7 +436,7 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
       picked[j] = 1;
       res->selected.push_back(j);
       if (type == 1) PetscCall(SpanProjectionErrors(res->W, L, linf, &err));
-      else PetscCall(ConeProjectionErrors(res->W, L, linf, &err, &res->nnls, &nnls));
+      else PetscCall(ConeProjectionErrors(res->W, L, linf, &err, &res->nnls, &nnls, &warmX)); // warm: the previous step's projections
       PetscReal c;
       PetscCall(GramConditionNumber(res->W, &c));
       res->history.push_back(*std::max_element(err.begin(), err.end()));

@@ -304,7 +304,7 @@ PetscErrorCode NNLSSolver::SolveTao(const std::vector<PetscReal> &H, const std::
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode NNLSSolver::Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats, NNLSInfo *info)
+PetscErrorCode NNLSSolver::Solve(const DenseMatrix &Q, const std::vector<PetscReal> &b, std::vector<PetscReal> *x, NNLSStats *stats, NNLSInfo *info, const std::vector<PetscReal> *start)
 {
   const PetscInt R = Q.rows, n = Q.cols;
   NNLSInfo       local;
@@ -360,14 +360,22 @@ PetscErrorCode NNLSSolver::Solve(const DenseMatrix &Q, const std::vector<PetscRe
     trivial = !(cmax > 0); // gradient -Q^T b >= 0 at 0: x = 0 is optimal (b = 0, b in the polar cone)
   }
   if (!trivial) {
-    // attempts: 0 TAO (gatol), 1 TAO (gatol / 10), 2 the active-set method alone
+    // attempts, in order until the KKT check passes: -nnls_method tao: TAO (gatol), TAO (gatol / 10), the
+    // active-set method alone; activeset: from the start's support (if given), from zero, then TAO twice
+    enum Kind { TaoFull, TaoTight, ActiveWarm, ActiveCold };
+    std::vector<Kind> plan;
+    if (useTao_) plan = {TaoFull, TaoTight, ActiveCold};
+    else {
+      if (start && (PetscInt)start->size() == n) plan.push_back(ActiveWarm);
+      plan.insert(plan.end(), {ActiveCold, TaoFull, TaoTight});
+    }
     PetscReal bestKKT = PETSC_MAX_REAL;
     NNLSInfo  bestInfo;
-    for (PetscInt attempt = useTao_ ? 0 : 2; attempt < 3; ++attempt) {
+    for (size_t attempt = 0; attempt < plan.size(); ++attempt) {
       NNLSInfo a;
-      a.attempts = attempt + 1;
-      if (attempt < 2) {
-        PetscCall(SolveTao(Hs_, cs, nonnegative_ ? PETSC_TRUE : PETSC_FALSE, attempt == 0 ? 1.0 : 0.1, &y, &a.taoIterations, &a.taoReason));
+      a.attempts = (PetscInt)attempt + 1;
+      if (plan[attempt] == TaoFull || plan[attempt] == TaoTight) {
+        PetscCall(SolveTao(Hs_, cs, nonnegative_ ? PETSC_TRUE : PETSC_FALSE, plan[attempt] == TaoFull ? 1.0 : 0.1, &y, &a.taoIterations, &a.taoReason));
         if (polish_) {
           PetscReal ymax = 0;
           for (PetscReal v : y) ymax = std::max(ymax, v);
@@ -376,6 +384,8 @@ PetscErrorCode NNLSSolver::Solve(const DenseMatrix &Q, const std::vector<PetscRe
         }
       } else {
         y.assign(nc, 0.0);
+        if (plan[attempt] == ActiveWarm) // y = x ||q_j|| / ||b||: its support starts the method
+          for (PetscInt k = 0; k < nc; ++k) y[k] = std::max((PetscReal)0, (*start)[cols_[k]] * colNorm_[cols_[k]] / bnorm);
         PetscCall(NNLSLawsonHanson(Qs_, bs, &y, 5 * nc + 50, &a.polishIterations));
       }
       a.kkt = NNLSKKT(Qs_, bs, y);
@@ -385,8 +395,8 @@ PetscErrorCode NNLSSolver::Solve(const DenseMatrix &Q, const std::vector<PetscRe
       }
       if (a.kkt < bestKKT) { bestKKT = a.kkt; best = y; bestInfo = a; }
       if (a.kkt <= kktTol_) break;
-      if (attempt < 2 && stats) ++stats->retries;
-      PetscCall(PetscInfo(NULL, "NNLS attempt %" PetscInt_FMT " (R %" PetscInt_FMT ", n %" PetscInt_FMT "): scaled KKT %g > -nnls_kkt_tol %g, TAO reason %s\n", attempt + 1, R, n, (double)a.kkt, (double)kktTol_, TaoConvergedReasons[a.taoReason]));
+      if (attempt + 1 < plan.size() && stats) ++stats->retries;
+      PetscCall(PetscInfo(NULL, "NNLS attempt %" PetscInt_FMT " (R %" PetscInt_FMT ", n %" PetscInt_FMT "): scaled KKT %g > -nnls_kkt_tol %g, TAO reason %s\n", (PetscInt)attempt + 1, R, n, (double)a.kkt, (double)kktTol_, TaoConvergedReasons[a.taoReason]));
     }
     inf    = bestInfo;
     inf.ok = bestKKT <= kktTol_ ? PETSC_TRUE : PETSC_FALSE;
