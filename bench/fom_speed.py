@@ -15,6 +15,8 @@ untimed warm-up run):
   5. `rbcontact dualbasis -dual_type cpg` on a 400 x 120 Hertz-like snapshot matrix (relative tolerance
      1e-3, l-infinity): time per NNLS (the RBCNNLS event of -log_view) with the default warm-started
      active-set method and with -nnls_method tao (BQPIP + polish), and whether picks and history agree.
+  6. The offline snapshot stage of ring_on_block (21 radii) at refine 0, 1, 2 on 1 and 2 ranks
+     (-offline_stop snapshots; time_s.snapshots of the report): efficiency T1 / (2 T2).
 
 Usage: /usr/bin/python3 bench/fom_speed.py [--exe build/bin/rbcontact] [--repeat 3] [--tables 1 2 3 4]
        [--json out.json]   (tables 1-4 take ~6 min, table 5 ~30 s on the 2-core VM)
@@ -164,11 +166,39 @@ def table5(args, rows):
         rows.append({"table": 5, "method": meth, "nnls": count, "seconds": secs, "same": same})
 
 
+def table6(args, rows):
+    print("\n## 6. Offline snapshot stage, ring_on_block, 21 radii (min of %d runs, s)\n" % args.repeat)
+    print("| refine | ndofs | 1 rank | 2 ranks | efficiency |")
+    print("|---|---|---|---|---|")
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    for ref in (0, 1, 2):
+        t = {}
+        for np_ in (1, 2):
+            best_t = None
+            for _ in range(args.repeat):
+                out = tempfile.mkdtemp(prefix="rbc_fomspeed_")
+                rep, snap = os.path.join(out, "r.json"), os.path.join(out, "s.h5")
+                cmd = ["mpirun", "-n", str(np_), args.exe, "offline", "-options_file", os.path.join(ROOT, "runs", "ring_on_block.opts"),
+                       "-mesh_refine", str(ref), "-offline_stop", "snapshots", "-snapshots", snap, "-report", rep]
+                p = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                if p.returncode != 0:
+                    print(p.stdout[-3000:])
+                    sys.exit("fom_speed.py: run failed: %s" % " ".join(cmd))
+                with open(rep) as f:
+                    v = json.load(f)["time_s"]["snapshots"]
+                best_t = v if best_t is None else min(best_t, v)
+            t[np_] = best_t
+        nd = run(args, 1, "ring_on_block", ["-mesh_refine", str(ref), "-contact", "0"])["ndofs"]
+        eff = t[1] / (2 * t[2])
+        print("| %d | %d | %.2f | %.2f | %.2f |" % (ref, nd, t[1], t[2], eff))
+        rows.append({"table": 6, "refine": ref, "t1": t[1], "t2": t[2], "efficiency": eff})
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--exe", default=os.path.join(ROOT, "build", "bin", "rbcontact"))
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--tables", type=int, nargs="+", default=[1, 2, 3, 4, 5])
+    ap.add_argument("--tables", type=int, nargs="+", default=[1, 2, 3, 4, 5, 6])
     ap.add_argument("--json")
     ap.add_argument("-v", "--verbose", action="store_true")
     args = ap.parse_args()
@@ -176,7 +206,7 @@ def main():
         sys.exit("fom_speed.py: %s not found (build first)" % args.exe)
     rows = []
     for t in args.tables:
-        {1: table1, 2: table2, 3: table3, 4: table4, 5: table5}[t](args, rows)
+        {1: table1, 2: table2, 3: table3, 4: table4, 5: table5, 6: table6}[t](args, rows)
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)
