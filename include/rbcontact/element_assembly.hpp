@@ -12,6 +12,10 @@
 
 namespace rbc {
 
+// out[c al e be] = scale sum_{a,b} T[c a e b] M[al a] M[be b] (dim^4 tensors, M dim x dim row-major): a
+// fourth-order tensor's derivative indices pulled back by M (the physical tensor by G^-1, the cell's by J^-1).
+void PullBackTensor(PetscInt dim, const PetscReal *T, const PetscReal *M, PetscReal scale, PetscReal *out);
+
 class ElementAssembler {
 public:
   ElementAssembler() = default;

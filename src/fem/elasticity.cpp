@@ -182,16 +182,12 @@ void Elasticity::PhysicalAux(PetscReal E, PetscReal nu, const Affine &a, std::ve
   }
   // T[c][a][e][b] = |det G| sum_{d,f} C[c][d][e][f] Gi[a][d] Gi[b][f], C = L d_cd d_ef + G (d_ce d_df + d_cf d_de)
   const PetscReal J = std::abs(det);
-  auto C = [&](PetscInt c, PetscInt d, PetscInt e, PetscInt f) { return L * (c == d) * (e == f) + G * ((c == e) * (d == f) + (c == f) * (d == e)); };
+  PetscReal       C[81];
   for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt aa = 0; aa < dim; ++aa)
+    for (PetscInt d = 0; d < dim; ++d)
       for (PetscInt e = 0; e < dim; ++e)
-        for (PetscInt b = 0; b < dim; ++b) {
-          PetscReal v = 0;
-          for (PetscInt d = 0; d < dim; ++d)
-            for (PetscInt f = 0; f < dim; ++f) v += C(c, d, e, f) * Gi[aa * dim + d] * Gi[b * dim + f];
-          (*aux)[AuxTensorOffset() + ((c * dim + aa) * dim + e) * dim + b] = J * v;
-        }
+        for (PetscInt f = 0; f < dim; ++f) C[((c * dim + d) * dim + e) * dim + f] = L * (c == d) * (e == f) + G * ((c == e) * (d == f) + (c == f) * (d == e));
+  PullBackTensor(dim, C, Gi, J, aux->data() + AuxTensorOffset());
   (*aux)[0] = L;
   (*aux)[1] = G;
   for (PetscInt k = 0; k < dim * dim; ++k) (*aux)[2 + k] = Gi[k];

@@ -9,6 +9,20 @@ namespace rbc {
 
 static PetscLogEvent EA_Setup = 0, EA_Matrix = 0, EA_Lifting = 0, EA_Energy = 0;
 
+void PullBackTensor(PetscInt dim, const PetscReal *T, const PetscReal *M, PetscReal scale, PetscReal *out)
+{
+  const PetscInt d = dim;
+  for (PetscInt c = 0; c < d; ++c)
+    for (PetscInt al = 0; al < d; ++al)
+      for (PetscInt e = 0; e < d; ++e)
+        for (PetscInt be = 0; be < d; ++be) {
+          PetscReal s = 0;
+          for (PetscInt a = 0; a < d; ++a)
+            for (PetscInt b = 0; b < d; ++b) s += T[((c * d + a) * d + e) * d + b] * M[al * d + a] * M[be * d + b];
+          out[((c * d + al) * d + e) * d + be] = scale * s;
+        }
+}
+
 ElementAssembler::~ElementAssembler()
 {
   (void)MatDestroy(&pattern_);
@@ -123,7 +137,7 @@ PetscErrorCode ElementAssembler::Setup(DM dm)
 // The nonzero pattern from the closure tables, kept with zero values and duplicated by every assembly.
 // Each rank lists, for every row its cells touch, the columns of those cells (deduplicated through a
 // marker on the local-vector index); the lists of rows owned by another rank (points on the partition
-// boundary) go to their owner, which merges them: an exact preallocation, filled once row by row.
+// boundary) go to their owner, which merges them: the exact pattern, set in one call from its CSR.
 PetscErrorCode ElementAssembler::CreatePattern()
 {
   PetscInt    nloc, N, rstart, nlv;
@@ -200,26 +214,24 @@ PetscErrorCode ElementAssembler::CreatePattern()
       t += 2 + n;
     }
   }
-  std::vector<PetscInt> dnz(nloc, 0), onz(nloc, 0);
+  std::vector<PetscInt> rowStart(nloc + 1, 0), colIdx; // CSR of the owned rows, global column indices
   for (PetscInt r = 0; r < nloc; ++r) {
     auto &c = ownedCols[r];
     std::sort(c.begin(), c.end());
     c.erase(std::unique(c.begin(), c.end()), c.end());
-    for (PetscInt col : c) (col >= rstart && col < rstart + nloc ? dnz[r] : onz[r])++;
+    rowStart[r + 1] = rowStart[r] + (PetscInt)c.size();
   }
+  colIdx.reserve(rowStart[nloc]);
+  for (auto &c : ownedCols) {
+    colIdx.insert(colIdx.end(), c.begin(), c.end());
+    std::vector<PetscInt>().swap(c);
+  }
+  // the structure (and zero values) in one call; the call that does not match the type is ignored
   PetscCall(MatCreate(comm, &pattern_));
   PetscCall(MatSetType(pattern_, MATAIJ));
   PetscCall(MatSetSizes(pattern_, nloc, nloc, N, N));
-  PetscCall(MatXAIJSetPreallocation(pattern_, 1, dnz.data(), onz.data(), NULL, NULL));
-  PetscCall(MatSetOption(pattern_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  std::vector<PetscScalar> zeros;
-  for (PetscInt r = 0; r < nloc; ++r) {
-    const PetscInt n = (PetscInt)ownedCols[r].size(), row = rstart + r;
-    if ((PetscInt)zeros.size() < n) zeros.assign(n, 0.0);
-    PetscCall(MatSetValues(pattern_, 1, &row, n, ownedCols[r].data(), zeros.data(), INSERT_VALUES));
-  }
-  PetscCall(MatAssemblyBegin(pattern_, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(pattern_, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatSeqAIJSetPreallocationCSR(pattern_, rowStart.data(), colIdx.data(), NULL));
+  PetscCall(MatMPIAIJSetPreallocationCSR(pattern_, rowStart.data(), colIdx.data(), NULL));
   PetscCall(MatSetOption(pattern_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
   PetscCall(MatSetDM(pattern_, dm_));
   PetscFunctionReturn(0);
@@ -232,15 +244,7 @@ void ElementAssembler::ElementMatrix(const Coefficients &k, PetscInt c, PetscRea
   const PetscInt   d = dim_, nb = nb_, body = (*k.cellBody)[c - cStart_];
   const PetscReal *T = k.tensor[body], *iJ = &invJ_[(size_t)(c - cStart_) * d * d], J = detJ_[c - cStart_];
   PetscReal        Tp[81];
-  for (PetscInt ci = 0; ci < d; ++ci)
-    for (PetscInt al = 0; al < d; ++al)
-      for (PetscInt e = 0; e < d; ++e)
-        for (PetscInt be = 0; be < d; ++be) {
-          PetscReal s = 0;
-          for (PetscInt a = 0; a < d; ++a)
-            for (PetscInt b = 0; b < d; ++b) s += T[((ci * d + a) * d + e) * d + b] * iJ[al * d + a] * iJ[be * d + b];
-          Tp[((ci * d + al) * d + e) * d + be] = J * s;
-        }
+  PullBackTensor(d, T, iJ, J, Tp);
   const PetscReal m = k.mass[body] * J;
   for (PetscInt i = 0; i < nb; ++i)
     for (PetscInt j = 0; j < nb; ++j) {
