@@ -124,7 +124,7 @@ public:
   PetscInt  maxIt = 30;
   // Kacanov tolerances matched to the ROM's accuracy (docs/online.md): the ROM's own error is >= 1e-5 in u,
   // 1e-3 in lambda, so 1e-6 changes no reported digit and saves an iterate (the FOM's 1e-8 did not)
-  PetscReal rtolPrimal = 1e-6, rtolDual = 1e-6, relaxation = 1.0, kktTol = 1e-8;
+  PetscReal rtolPrimal = 1e-6, rtolDual = 1e-4, relaxation = 1.0, kktTol = 1e-8;
   PetscInt  anderson = 3; // -rom_kacanov_anderson m: Anderson mixing of depth m (0: plain fixed point)
   PetscBool monitor = PETSC_FALSE, warmStart = PETSC_TRUE;
   bool      recordIterates = false;

@@ -59,6 +59,12 @@ public:
   // Reuse the Cholesky factor of A when A is bitwise equal to the previous call's, and S (and D L^{-T})
   // when D is too (memcmp on every call); f and c always enter the setup.
   bool reuseFactorization = true;
+  // false: Solve leaves the scaled KKT residuals of info at 0 on the active-set path (a loop that only
+  // needs them for its last solve calls Residuals then; TAO always computes them: its status needs them).
+  bool residuals = true;
+  // The scaled KKT residuals of (v, lambda) for the data of the last Solve (same A, D: the norms of its
+  // set-up), into info->primal, dual, complementarity, stationarity.
+  void Residuals(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *D, const PetscReal *c, const PetscReal *v, const PetscReal *lambda, ReducedQPInfo *info) { KKT(N, R, A, f, D, c, v, lambda, info); }
 
 private:
   PetscErrorCode Setup(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *D, const PetscReal *c, ReducedQPInfo *info);

@@ -646,7 +646,8 @@ PetscErrorCode ReducedQP::Solve(PetscInt N, PetscInt R, const PetscReal *A, cons
       info->message = "reduced dual Hessian S is singular on the active set (rank-deficient reduced constraints; the multipliers overflowed): the dual basis is too rich for the primal one; add -pod_supremizers or reduce R";
     }
   }
-  KKT(N, R, A, f, D, c, v, lambda, info);
+  info->primal = info->dual = info->complementarity = info->stationarity = 0;
+  if (residuals || type == ReducedQPType::Tao) KKT(N, R, A, f, D, c, v, lambda, info);
   if (type == ReducedQPType::Tao) {
     PetscReal lmax = 0;
     PetscInt  nact = 0;
