@@ -66,9 +66,11 @@ public:
 
 private:
   void                  Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const;
-  PetscReal             DistToFacet(PetscInt f, const PetscReal p[], PetscReal b[]) const;
+  // squared distance from p to facet f (the searches compare squares: no square root per facet)
+  PetscReal             DistToFacet2(PetscInt f, const PetscReal p[], PetscReal b[]) const;
   PetscInt              dim_ = 2, nv_ = 2;
   std::vector<PetscReal> xdef_;
+  std::vector<PetscReal> invLen2_; // 2D: 1 / |x1 - x0|^2 per facet (0 for a degenerate one), set with the vertices
   PetscReal             lo_[3] = {0, 0, 0}, h_[3] = {1, 1, 1};
   PetscInt              nb_[3] = {1, 1, 1};
   std::vector<PetscInt> binStart_, binFacets_;

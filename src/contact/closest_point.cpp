@@ -22,22 +22,29 @@ void ClosestPoint::SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt
       for (PetscInt d = 0; d < dim; ++d) xdef_[9 * f + k * dim + d] = F.X[k * dim + d] + (deformed && node >= 0 ? F.U[node * dim + d] : 0.0);
     }
   }
+  invLen2_.assign(dim == 2 ? nf : 0, 0.0);
+  if (dim == 2)
+    for (PetscInt f = 0; f < nf; ++f) {
+      const PetscReal *x = &xdef_[9 * f], tt = (x[2] - x[0]) * (x[2] - x[0]) + (x[3] - x[1]) * (x[3] - x[1]);
+      invLen2_[f] = tt > 0 ? 1.0 / tt : 0.0;
+    }
 }
 
 void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt nc, PetscInt *facet, PetscReal b[], PetscReal *dist) const
 {
-  *facet = -1;
-  *dist  = PETSC_MAX_REAL;
+  PetscReal best = PETSC_MAX_REAL; // squared
+  *facet         = -1;
   for (PetscInt i = 0; i < nc; ++i) {
     const PetscInt  f = cand[i];
     PetscReal       bb[3];
-    const PetscReal dd = DistToFacet(f, p, bb);
-    if (dd < *dist || (dd == *dist && f < *facet)) {
-      *dist  = dd;
+    const PetscReal dd = DistToFacet2(f, p, bb);
+    if (dd < best || (dd == best && f < *facet)) {
+      best   = dd;
       *facet = f;
       for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
     }
   }
+  *dist = *facet >= 0 ? std::sqrt(best) : PETSC_MAX_REAL;
 }
 
 PetscErrorCode ClosestPoint::Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
@@ -117,19 +124,19 @@ void ClosestPoint::Candidates(const PetscReal lo[], const PetscReal hi[], std::v
       }
 }
 
-// Closest point of a segment or triangle; b = barycentric coordinates of the closest point.
-PetscReal ClosestPoint::DistToFacet(PetscInt f, const PetscReal p[], PetscReal b[]) const
+// Closest point of a segment or triangle; b = barycentric coordinates of the closest point; returns the
+// squared distance.
+PetscReal ClosestPoint::DistToFacet2(PetscInt f, const PetscReal p[], PetscReal b[]) const
 {
   const PetscReal *x = &xdef_[9 * f];
   if (dim_ == 2) {
     const PetscReal t[2] = {x[2] - x[0], x[3] - x[1]};
-    const PetscReal tt   = t[0] * t[0] + t[1] * t[1];
-    PetscReal       s    = tt > 0 ? ((p[0] - x[0]) * t[0] + (p[1] - x[1]) * t[1]) / tt : 0;
+    PetscReal       s    = ((p[0] - x[0]) * t[0] + (p[1] - x[1]) * t[1]) * invLen2_[f];
     s                    = std::min(1.0, std::max(0.0, s));
     b[0] = 1 - s;
     b[1] = s;
     const PetscReal q[2] = {x[0] + s * t[0] - p[0], x[1] + s * t[1] - p[1]};
-    return std::sqrt(q[0] * q[0] + q[1] * q[1]);
+    return q[0] * q[0] + q[1] * q[1];
   }
   // Triangle (Ericson, Real-Time Collision Detection, 5.1.5)
   const PetscReal *a = x, *bb = x + 3, *c = x + 6;
@@ -171,13 +178,14 @@ PetscReal ClosestPoint::DistToFacet(PetscInt f, const PetscReal p[], PetscReal b
     const PetscReal qi = b[0] * a[i] + b[1] * bb[i] + b[2] * c[i] - p[i];
     q2 += qi * qi;
   }
-  return std::sqrt(q2);
+  return q2;
 }
 
 void ClosestPoint::Find(const PetscReal p[], PetscInt *facet, PetscReal b[], PetscReal *dist) const
 {
-  *facet = -1;
-  *dist  = PETSC_MAX_REAL;
+  PetscReal best = PETSC_MAX_REAL; // squared
+  *facet         = -1;
+  *dist          = PETSC_MAX_REAL;
   const PetscInt nf = NumFacets();
   if (!nf) return;
   PetscReal r = 0;
@@ -197,25 +205,27 @@ void ClosestPoint::Find(const PetscReal p[], PetscInt *facet, PetscReal b[], Pet
     if (nbox > nf) {
       for (PetscInt f = 0; f < nf; ++f) {
         PetscReal       bb[3];
-        const PetscReal dd = DistToFacet(f, p, bb);
-        if (dd < *dist || (dd == *dist && f < *facet)) {
-          *dist  = dd;
+        const PetscReal dd = DistToFacet2(f, p, bb);
+        if (dd < best || (dd == best && f < *facet)) {
+          best   = dd;
           *facet = f;
           for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
         }
       }
+      *dist = std::sqrt(best);
       return;
     }
     Candidates(lo, hi, &cand);
     for (PetscInt f : cand) {
       PetscReal bb[3];
-      const PetscReal dd = DistToFacet(f, p, bb);
-      if (dd < *dist || (dd == *dist && f < *facet)) {
-        *dist  = dd;
+      const PetscReal dd = DistToFacet2(f, p, bb);
+      if (dd < best || (dd == best && f < *facet)) {
+        best   = dd;
         *facet = f;
         for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
       }
     }
+    if (*facet >= 0) *dist = std::sqrt(best);
     if (*dist <= r || r > span) break;
     r *= 2;
   }
