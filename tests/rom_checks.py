@@ -83,10 +83,13 @@ def pipeline(args):
     # the sizes are those of the reduced model (N, R, M), not of the mesh: the largest array is C (Mk x N x R)
     # or B (M x M); R itself grows somewhat with the mesh at a fixed dual tolerance (more nodes enter the
     # contact zone one by one over the parameter range)
-    def expected(o):  # the EIM terms in the file (Mk_stored; Mk, Mg: the sizes used by default), the cubature's R x Mc
+    def expected(o, ds):  # the EIM terms in the file (Mk_stored; Mk, Mg: the sizes used by default), the cubature's R x Mc,
+        # and the contact patch's basis rows theta (patch dofs x N: the dofs of the facets the EIM/cubature points touch)
         r = o["rom"]
-        return max(r["Mk_stored"] * r["N"] * r["R"], r["Mk_stored"] ** 2, r["Mg_stored"] ** 2, r["Mg_stored"] * r["R"], r["Mc"] * r["R"])
-    check(big == expected(off) and big1 == expected(off1), "largest ROM array = max(Mk N R, Mk^2, Mg^2, Mc R): %d and %d (refined)" % (big, big1))
+        th = [s for n, s in ds.items() if n.endswith("/theta")]
+        check(th and all(len(s) == 2 and s[1] == r["N"] for s in th), "contact patch bases theta: patch dofs x N (N = %d): %s" % (r["N"], th))
+        return max([r["Mk_stored"] * r["N"] * r["R"], r["Mk_stored"] ** 2, r["Mg_stored"] ** 2, r["Mg_stored"] * r["R"], r["Mc"] * r["R"]] + [s[0] * s[1] for s in th])
+    check(big == expected(off, ds) and big1 == expected(off1, ds1), "largest ROM array = max(Mk N R, Mk^2, Mg^2, Mc R, patch dofs N): %d and %d (refined)" % (big, big1))
     check(off1["ndofs"] > 3 * ndofs and big1 / big < 0.5 * off1["ndofs"] / ndofs and longest1 / longest < 0.5 * off1["ndofs"] / ndofs,
           "mesh refined (ndofs x%.2f): largest ROM array x%.2f (R %d -> %d), longest dimension %d -> %d" % (off1["ndofs"] / ndofs, big1 / big, off["rom"]["R"], off1["rom"]["R"], longest, longest1))
     check(off["eim"]["kappa"]["kind"] == "eim" and off["eim"]["kappa"]["depends_on_u"], "kappa depends on u (measured %.2e): EIM" % off["eim"]["kappa"]["u_sensitivity"])
