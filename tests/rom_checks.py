@@ -193,7 +193,13 @@ def bad_input(args):
     expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5", "does not exist"], "missing ROM file")
     expect_error(args, ["-rom", rom, "-mu", "1.3"], ["radius", "1.3", "outside its box"], "mu outside the box")
     expect_error(args, ["-rom", rom, "-rom_N", "99"], ["-rom_N", "99"], "truncation out of range")
-    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "1", "-rom_warm_start", "0"], ["did not converge", "-rom_kacanov_max_it"], "reduced Kacanov not converged")
+    # (-rom_kacanov_max_it 1 is the linearized reduced model, converged by definition, as -kacanov_max_it 1 for the FOM)
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "2", "-rom_warm_start", "0", "-rom_kacanov_rtol_primal", "1e-15",
+                        "-rom_kacanov_rtol_dual", "1e-15"], ["did not converge", "-rom_kacanov_max_it"], "reduced Kacanov not converged")
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "1", "-rom_warm_start", "0", "-report", d + "/lin.json"])
+    lin = report(d + "/lin.json")
+    check(lin["converged"] and lin["kacanov_iterations"] == 1, "-rom_kacanov_max_it 1: the linearized reduced model (1 iterate, converged)")
+    expect_error(args, ["-rom", rom, "-rom_kacanov_relaxation", "1.5"], ["-rom_kacanov_relaxation", "1.5"], "-rom_kacanov_relaxation out of range")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
     expect_error(args, ["-rom", rom, "-rom_kacanov_anderson", "11"], ["-rom_kacanov_anderson", "11"], "-rom_kacanov_anderson out of range")
     # Anderson mixing (default depth 3) and the plain fixed point reach the same reduced solution
@@ -225,7 +231,8 @@ def bad_input(args):
 
 def infeasible(args):
     d = tempfile.mkdtemp(prefix="rbc_rom_inf_")
-    p = run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "7", "-pod_supremizers", "0", "-rom", d + "/rom.h5"], expect_ok=False)
+    # -pod_tol 1e-8: 2 POD modes for up to 7 dual vectors (the scene's 1e-11 keeps all 7 snapshots: R <= N)
+    p = run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "7", "-pod_tol", "1e-8", "-pod_supremizers", "0", "-rom", d + "/rom.h5"], expect_ok=False)
     check(p.returncode != 0 and "inf-sup" in p.stdout and "-pod_supremizers" in p.stdout, "R > N without supremizers: refused with the hint -pod_supremizers")
     if p.returncode == 0:
         print(p.stdout[-1500:])

@@ -7,6 +7,10 @@ rbc_add_mpi_test(NAME reduced_contact RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FIL
 #                          a LAPACK solve, iteration counts vs the plain iteration, the restart safeguard
 rbc_test_exe(test_anderson)
 rbc_add_mpi_test(NAME test_anderson RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_anderson> LABELS rom)
+#   test_kacanov_loop      the Kacanov loop shared by the FOM and the ROM (KacanovLoop): fixed point vs LAPACK,
+#                          Anderson, relaxation, the linearized max_it 1, the not-converged message, the options
+rbc_test_exe(test_kacanov_loop)
+rbc_add_mpi_test(NAME test_kacanov_loop RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_kacanov_loop> LABELS rom)
 #   test_empirical_cubature  the ECSW fit (-rom_hyper ecsw): Gram matrix vs explicit rows, Caratheodory bound on
 #                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
 rbc_test_exe(test_empirical_cubature)

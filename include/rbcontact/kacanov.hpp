@@ -15,6 +15,7 @@
 #include "rbcontact/contact.hpp"
 #include "rbcontact/dual_shell.hpp"
 #include "rbcontact/fom.hpp"
+#include "rbcontact/kacanov_loop.hpp"
 
 namespace rbc {
 
@@ -50,10 +51,10 @@ public:
   KKTResiduals   kkt;
   PetscInt       iterations = 0;
   PetscBool      converged  = PETSC_FALSE;
-  PetscInt       maxIt = 30;
-  PetscReal      rtolPrimal = 1e-8, rtolDual = 1e-8, relaxation = 1.0, kktTol = 1e-8;
-  PetscBool      monitor = PETSC_FALSE;
-  PetscInt       anderson = 3; // -kacanov_anderson m: Anderson mixing of the contact-dof displacement (0: plain)
+  // -kacanov_max_it (30), _rtol_primal, _rtol_dual (1e-8 each), _relaxation, _anderson (3: Anderson mixing of
+  // the contact-dof displacement, dense dual matrix), _monitor: the loop shared with the ROM (kacanov_loop.hpp)
+  KacanovLoop    loop;
+  PetscReal      kktTol = 1e-8;
   DualQPInfo     lastQP;
   DualShellInfo  lastShell;
   SurfaceCompliance compliance;

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 #include "rbcontact/affine_decomposition.hpp"
-#include "rbcontact/anderson.hpp"
+#include "rbcontact/kacanov_loop.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/reduced_qp.hpp"
@@ -121,12 +121,12 @@ public:
   std::vector<PetscReal> warmMu, warmV, warmL;       // training parameters and their reduced solutions
   std::vector<PetscReal> dualGram;                   // W'W (Rfull x Rfull): the Kacanov change of lambda = W lambda^ is measured in it
   // options
-  PetscInt  maxIt = 30;
-  // Kacanov tolerances matched to the ROM's accuracy (docs/online.md): the ROM's own error is >= 1e-5 in u,
-  // 1e-3 in lambda, so 1e-6 changes no reported digit and saves an iterate (the FOM's 1e-8 did not)
-  PetscReal rtolPrimal = 1e-6, rtolDual = 1e-4, relaxation = 1.0, kktTol = 1e-8;
-  PetscInt  anderson = 3; // -rom_kacanov_anderson m: Anderson mixing of depth m (0: plain fixed point)
-  PetscBool monitor = PETSC_FALSE, warmStart = PETSC_TRUE;
+  // -rom_kacanov_max_it (30), _rtol_primal, _rtol_dual, _relaxation, _anderson (3), _monitor: the loop shared with
+  // the FOM (kacanov_loop.hpp). Tolerances matched to the ROM's accuracy targets (docs/online.md): 1e-6 on the
+  // primal change (u target 1e-4), 1e-4 on the dual one (lambda target 1e-2)
+  KacanovLoop loop{1e-6, 1e-4, "ROM Kacanov"};
+  PetscReal   kktTol    = 1e-8;
+  PetscBool   warmStart = PETSC_TRUE;
   bool      recordIterates = false;
   ReducedQP qp;
 
@@ -148,7 +148,6 @@ private:
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
-  AndersonMixing         aa_;
 };
 
 // Writes the online part of a model (everything Open reads) to w.

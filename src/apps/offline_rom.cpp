@@ -154,7 +154,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscCall(rm.SetFromOptions()); // rom_kacanov_*, rom_qp_* (the truncation options are not for this step)
   PetscCall(rm.Truncate(-1, -1, -1, -1));
   rm.warmStart      = PETSC_FALSE;
-  rm.monitor        = PETSC_FALSE;
+  rm.loop.monitor   = PETSC_FALSE;
   rm.recordIterates = true;
 
   // --- snapshots of kappa (Q x N per evaluation) and gamma (Q): training solutions and the iterates

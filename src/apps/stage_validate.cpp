@@ -346,7 +346,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     JsonValue table;
     table["rows"]            = rows;
     table["fom_median_s"]    = fomMedian;
-    table["fom_tolerance"]   = (double)std::max(kac.rtolPrimal, kac.rtolDual);
+    table["fom_tolerance"]   = (double)std::max(kac.loop.rtolPrimal, kac.loop.rtolDual);
     table["scene"]           = scene.name;
     table["hyper"]           = model.HyperName();
     table["Mc"]              = (long long)model.Mc();

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
 #include <sstream>
 
 namespace rbc {
@@ -23,15 +24,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
     PetscCall(PetscLogEventRegister("RBCContactSchur", MAT_CLASSID, &KAC_Schur));
     PetscCall(PetscLogEventRegister("RBCContactQP", MAT_CLASSID, &KAC_QP));
   }
-  PetscOptionsBegin(comm, "kacanov_", "Kacanov iterations", "KacanovSolver");
-  PetscCall(PetscOptionsInt("-max_it", "Maximum Kacanov iterations (1: linearized model)", NULL, maxIt, &maxIt, NULL));
-  PetscCall(PetscOptionsReal("-rtol_primal", "Relative change of u to stop", NULL, rtolPrimal, &rtolPrimal, NULL));
-  PetscCall(PetscOptionsReal("-rtol_dual", "Relative change of lambda to stop", NULL, rtolDual, &rtolDual, NULL));
-  PetscCall(PetscOptionsReal("-relaxation", "Under-relaxation factor in (0, 1]", NULL, relaxation, &relaxation, NULL));
-  PetscCall(PetscOptionsBool("-monitor", "Print the changes and the active-set size per iteration", NULL, monitor, &monitor, NULL));
-  PetscCall(PetscOptionsInt("-anderson", "Anderson mixing depth on the contact-dof displacement (dense dual matrix; 0: plain Kacanov)", NULL, anderson, &anderson, NULL));
-  PetscOptionsEnd();
-  PetscCheck(anderson >= 0 && anderson <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_anderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", anderson);
+  PetscCall(loop.SetFromOptions(comm, "")); // -kacanov_* (Anderson mixing on the contact-dof displacement: dense dual matrix only)
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
   {
@@ -42,9 +35,6 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   }
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, shell above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscOptionsEnd();
-  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
-  PetscCheck(rtolPrimal > 0 && rtolDual > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_rtol_primal and -kacanov_rtol_dual must be > 0");
-  PetscCheck(relaxation > 0 && relaxation <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
   PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp_.Setup("fom_"));
   PetscCall(shell_.SetFromOptions(comm, "fom_"));
@@ -74,11 +64,6 @@ PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full)
 
 static const PetscReal kInf = std::numeric_limits<PetscReal>::infinity(); // reported as null in JSON
 
-static PetscReal RelChange(PetscReal diff, PetscReal prev, PetscReal cur)
-{
-  if (prev > 0) return diff / prev;
-  return cur == 0 ? 0.0 : kInf;
-}
 
 PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
 {
@@ -268,7 +253,6 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(VecDuplicate(u0, &usurf)); // u on the contact dofs (dense dual matrix), zero elsewhere
   PetscCall(VecSet(usurf, 0.0));
   std::vector<PetscReal> uDprev, lamWarm, mixed; // the input u_D of the iterate, the previous multipliers (QP warm start)
-  AndersonMixing         aa;
   PetscCall(VecSet(uloc, 0.0)); // u^0 = 0: the reference configuration
   // Dual Hessian: dense S through the compliance of the contact dofs (once per parameter: every
   // iterate's S = K_D G K_D^T costs dense operations only), or a MATSHELL with no compliance at all.
@@ -286,16 +270,14 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(PetscTime(&t1));
   fom.times.contact += t1 - t0;
   const PetscBLASInt nD = (PetscBLASInt)D.size();
-  if (!shell && anderson > 0) {
-    aa.Setup(nD, anderson);
-    mixed.assign(nD, 0.0);
-  }
-  if (monitor) {
+  loop.Begin(shell ? 0 : (PetscInt)nD); // the shell path keeps its state distributed: it records its own changes
+  mixed.assign(nD, 0.0);
+  if (loop.monitor) {
     if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ")\n", R0, dualMatrixOption.c_str(), dualDenseMax));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
   }
 
-  for (PetscInt k = 1; k <= maxIt; ++k) {
+  for (PetscInt k = 1; k <= loop.maxIt; ++k) {
     std::vector<PetscReal> KD, T, Sfull, gfull, bfull, lam;
     PetscInt               nact = 0;
     PetscCall(PetscTime(&t0));
@@ -385,14 +367,16 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     // whole field is solved for once, after the loop. Shell: one back-solve per iterate.
     PetscCall(MatMultTranspose(sys.K, lambda, rhs));
     PetscCall(VecAYPX(rhs, -1.0, fom.f));
-    PetscReal nu, nup, ndu, nl, nlp = 0, ndl;
+    PetscReal du, nl, nlp = 0, ndl;
     if (shell) {
+      PetscReal nu, nup, ndu;
       PetscCall(fom.ApplyInverse(rhs, fom.u));
-      if (relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - relaxation, relaxation, uprev));
+      if (loop.relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - loop.relaxation, loop.relaxation, uprev));
       PetscCall(VecNorm(fom.u, NORM_2, &nu));
       PetscCall(VecNorm(uprev, NORM_2, &nup));
       PetscCall(VecWAXPY(tmp, -1.0, uprev, fom.u));
       PetscCall(VecNorm(tmp, NORM_2, &ndu));
+      du = KacanovLoop::RelChange(ndu, nup, nu);
     } else {
       const PetscBLASInt R = (PetscBLASInt)sys.R, one = 1;
       const PetscScalar  m1 = -1.0, p1 = 1.0;
@@ -405,18 +389,10 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       std::vector<PetscReal> uD(u0D);
       if (nD) BLASgemv_("N", &nD, &nD, &m1, compliance.G.data(), &nD, w.data(), &one, &p1, uD.data(), &one);
       if (uDprev.empty()) uDprev.assign(nD, 0.0);
-      if (relaxation < 1)
-        for (PetscBLASInt j = 0; j < nD; ++j) uD[j] = relaxation * uD[j] + (1 - relaxation) * uDprev[j];
-      PetscReal a = 0, b = 0, c = 0;
-      for (PetscBLASInt j = 0; j < nD; ++j) {
-        a += uD[j] * uD[j];
-        b += uDprev[j] * uDprev[j];
-        c += (uD[j] - uDprev[j]) * (uD[j] - uDprev[j]);
-      }
-      nu = std::sqrt(a), nup = std::sqrt(b), ndu = std::sqrt(c);
+      du = loop.Relax(uDprev.data(), uD.data()); // the relaxed image and the change of the input
       // the next geometry: u_D itself, or Anderson's mix of this input (uDprev) and its image (uD)
-      if (anderson > 0 && aa.Mix(uDprev.data(), uD.data(), mixed.data()) > 0) uDprev = mixed;
-      else uDprev = uD;
+      loop.Next(uDprev.data(), uD.data(), mixed.data());
+      uDprev = mixed;
       PetscInt lo, hi;
       PetscScalar *us;
       PetscCall(VecGetOwnershipRange(usurf, &lo, &hi));
@@ -444,17 +420,18 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(VecNorm(rhs, NORM_2, &nrhs));
     PetscCall(MatNorm(sys.K, NORM_FROBENIUS, &nK));
     const PetscReal lamScale = nK > 0 ? 1e-6 * nrhs / nK : 0.0;
-    const PetscReal du = RelChange(ndu, nup, nu), dl = lamPrev ? RelChange(ndl, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
-    history.du.push_back(du);
-    history.dl.push_back(dl);
-    history.nactive.push_back(nact);
+    const PetscReal dl = lamPrev ? KacanovLoop::RelChange(ndl, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
     iterations = k;
-    if (monitor && shell) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (dual shell: TAO its %" PetscInt_FMT " (%" PetscInt_FMT " products), active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastShell.taoIterations, lastShell.taoProducts, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt));
-    else if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " Kacanov |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT " (QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e)\n", k, (double)du, (double)dl, nact, sys.R, lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt));
+    char detail[320] = "";
+    if (loop.monitor && shell)
+      std::snprintf(detail, sizeof detail, "dual shell: TAO its %" PetscInt_FMT " (%" PetscInt_FMT " products), active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e", lastShell.taoIterations, lastShell.taoProducts, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt);
+    else if (loop.monitor) std::snprintf(detail, sizeof detail, "QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e", lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt);
+    bool done = false;
+    PetscCall(loop.Record(comm, k, du, dl, nact, sys.R, detail, &done));
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
     if (shell) PetscCall(VecCopy(fom.u, uprev));
-    if (maxIt == 1 || (du <= rtolPrimal && dl <= rtolDual)) {
+    if (done) {
       converged = PETSC_TRUE;
       break;
     }
@@ -473,11 +450,11 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(VecDestroy(&uloc));
   PetscCall(VecDestroy(&usurf));
   PetscCall(VecDestroy(&lamPrev));
-  if (!converged) {
-    std::ostringstream h;
-    for (size_t i = 0; i < history.du.size(); ++i) h << "\n  it " << i + 1 << ": du " << history.du[i] << ", dlambda " << history.dl[i] << ", active " << history.nactive[i];
-    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "Kacanov iterations did not converge in %" PetscInt_FMT " iterations (-kacanov_max_it; tolerances -kacanov_rtol_primal %g, -kacanov_rtol_dual %g; try -kacanov_relaxation 0.5). History:%s", maxIt, (double)rtolPrimal, (double)rtolDual, h.str().c_str());
-  }
+  history.du      = loop.history.du;
+  history.dl      = loop.history.dl;
+  history.nactive = loop.history.nactive;
+  PetscCheck(converged, comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true).c_str());
+
   PetscCall(ComputeKKT(fom));
   PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol);
   PetscFunctionReturn(0);

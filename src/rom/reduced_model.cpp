@@ -336,18 +336,9 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscInt n = -1, r = -1, mk = -1, mg = -1;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_kacanov_max_it", &maxIt, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_primal", &rtolPrimal, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_rtol_dual", &rtolDual, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kacanov_relaxation", &relaxation, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_kacanov_anderson", &anderson, NULL));
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_kacanov_monitor", &monitor, NULL));
+  PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kkt_tol", &kktTol, NULL));
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_warm_start", &warmStart, NULL));
-  PetscCheck(maxIt >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_max_it %" PetscInt_FMT " must be >= 1", maxIt);
-  PetscCheck(rtolPrimal > 0 && rtolDual > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_rtol_primal/-rom_kacanov_rtol_dual must be > 0");
-  PetscCheck(anderson >= 0 && anderson <= 10, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_anderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", anderson);
-  PetscCheck(relaxation > 0 && relaxation <= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kacanov_relaxation %g must lie in (0, 1]", (double)relaxation);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
@@ -623,12 +614,10 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     for (PetscInt i = 0; i < Na; ++i) sol->v[i] = (1 - t) * warmV[lo * Nfull + cols_[i]] + t * warmV[hi * Nfull + cols_[i]];
     for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = (1 - t) * warmL[lo * Rfull + i] + t * warmL[hi * Rfull + i];
   }
-  thread_local std::vector<PetscReal> vprev, lprev, vnew, lnew, vmix;
-  if (anderson > 0) {
-    aa_.Setup(Na, anderson);
-    vmix.resize(Na);
-  }
-  for (PetscInt it = 1; it <= maxIt; ++it) {
+  thread_local std::vector<PetscReal> vprev, lprev, vnew, lnew, vnext;
+  loop.Begin(Na);
+  vnext.resize(Na);
+  for (PetscInt it = 1; it <= loop.maxIt; ++it) {
     vprev = sol->v;
     lprev = sol->lambda;
     if (recordIterates) sol->iterates.insert(sol->iterates.end(), vprev.begin(), vprev.end());
@@ -647,18 +636,13 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
       sol->lambda.assign(r, 0.0);
       PetscFunctionReturn(0);
     }
-    PetscReal nv = 0, dv = 0, nl = 0, dln = 0;
-    for (PetscInt i = 0; i < Na; ++i) {
-      sol->v[i] = vprev[i] + relaxation * (vnew[i] - vprev[i]);
-      nv += PetscSqr(sol->v[i]);
-      dv += PetscSqr(sol->v[i] - vprev[i]);
-    }
-    // Anderson mixing: the next contact terms at the mixed input; sol->v stays the QP's solution
-    // (consistent with sol->lambda) until the test below has passed
-    const bool mixed = anderson > 0 && aa_.Mix(vprev.data(), sol->v.data(), vmix.data()) > 0;
-    PetscInt nact = 0;
+    // the relaxed image and the change of the input (KacanovLoop); the multipliers relaxed alike
+    sol->v            = vnew;
+    const PetscReal du = loop.Relax(vprev.data(), sol->v.data());
+    PetscInt        nact = 0;
+    PetscReal       nl = 0, dln = 0;
     for (PetscInt i = 0; i < r; ++i) {
-      sol->lambda[i] = lprev[i] + relaxation * (sol->lambda[i] - lprev[i]);
+      sol->lambda[i] = lprev[i] + loop.relaxation * (sol->lambda[i] - lprev[i]);
       nact += sol->lambda[i] > 0;
     }
     // changes of the multiplier field W lambda^ (the FOM's rule), in the Gram matrix W'W
@@ -670,23 +654,26 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
       }
     nl  = std::max<PetscReal>(nl, 0);
     dln = std::max<PetscReal>(dln, 0);
-    const PetscReal du = nv > 0 ? std::sqrt(dv / nv) : std::sqrt(dv), dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
-    sol->du.push_back(du);
-    sol->dl.push_back(dl);
-    sol->nactive.push_back(nact);
-    if (monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  ROM Kacanov %2" PetscInt_FMT "  du %.3e  dlambda %.3e  active %" PetscInt_FMT "/%" PetscInt_FMT "  QP its %" PetscInt_FMT "\n", it, (double)du, (double)dl, nact, r, sol->qp.iterations));
-    if (du <= rtolPrimal && dl <= rtolDual) {
+    const PetscReal dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
+    char            detail[48] = "";
+    if (loop.monitor) std::snprintf(detail, sizeof detail, "QP its %" PetscInt_FMT, sol->qp.iterations);
+    bool done = false;
+    PetscCall(loop.Record(PETSC_COMM_SELF, it, du, dl, nact, r, loop.monitor ? detail : nullptr, &done));
+    if (done) {
       // the KKT residuals of the last QP only (the loop's QPs skip them: -log_view 1-2 % of a solve)
       qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
       sol->converged = true;
       break;
     }
-    if (mixed) sol->v = vmix; // the next input (the contact terms are evaluated there)
+    // the next input (the contact terms are evaluated there): Anderson's mix, or the relaxed image;
+    // sol->v stays the QP's solution (consistent with sol->lambda) until the test above has passed
+    if (loop.Next(vprev.data(), sol->v.data(), vnext.data())) sol->v = vnext;
   }
+  sol->du      = loop.history.du;
+  sol->dl      = loop.history.dl;
+  sol->nactive = loop.history.nactive;
   if (!sol->converged) {
-    std::ostringstream o;
-    o << "reduced Kacanov loop did not converge in " << maxIt << " iterations (-rom_kacanov_max_it); last changes du " << sol->du.back() << ", dlambda " << sol->dl.back() << " (-rom_kacanov_rtol_primal " << rtolPrimal << ", -rom_kacanov_rtol_dual " << rtolDual << ")";
-    sol->message = o.str();
+    sol->message = "reduced model: " + loop.NotConverged(false);
     PetscFunctionReturn(0);
   }
   const PetscReal kkt = std::max(std::max(sol->qp.primal, sol->qp.dual), std::max(sol->qp.complementarity, sol->qp.stationarity));

@@ -1,0 +1,90 @@
+// src/contact/kacanov_loop.cpp: KacanovLoop, the fixed-point loop shared by the full-order and the reduced
+// Kacanov iterations (options, relaxation, primal change, stopping rule, Anderson mixing, monitor, history).
+#include "rbcontact/kacanov_loop.hpp"
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace rbc {
+
+PetscReal KacanovLoop::RelChange(PetscReal diff, PetscReal prev, PetscReal cur)
+{
+  if (prev > 0) return diff / prev;
+  return cur == 0 ? 0.0 : std::numeric_limits<PetscReal>::infinity();
+}
+
+PetscErrorCode KacanovLoop::SetFromOptions(MPI_Comm comm, const std::string &prefix)
+{
+  const std::string p = "-" + prefix + "kacanov_";
+
+  PetscFunctionBeginUser;
+  prefix_ = prefix;
+  PetscOptionsBegin(comm, (prefix + "kacanov_").c_str(), "Kacanov iterations", "KacanovLoop");
+  PetscCall(PetscOptionsInt("-max_it", "Maximum Kacanov iterations (1: the linearized model)", NULL, maxIt, &maxIt, NULL));
+  PetscCall(PetscOptionsReal("-rtol_primal", "Relative change of the primal input to stop", NULL, rtolPrimal, &rtolPrimal, NULL));
+  PetscCall(PetscOptionsReal("-rtol_dual", "Relative change of the multipliers to stop", NULL, rtolDual, &rtolDual, NULL));
+  PetscCall(PetscOptionsReal("-relaxation", "Under-relaxation factor in (0, 1]", NULL, relaxation, &relaxation, NULL));
+  PetscCall(PetscOptionsInt("-anderson", "Anderson mixing depth on the primal input (0: plain Kacanov)", NULL, anderson, &anderson, NULL));
+  PetscCall(PetscOptionsBool("-monitor", "Print the changes and the active-set size per iteration", NULL, monitor, &monitor, NULL));
+  PetscOptionsEnd();
+  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%smax_it %" PetscInt_FMT " must be >= 1", p.c_str(), maxIt);
+  PetscCheck(rtolPrimal > 0 && rtolDual > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%srtol_primal (%g) and %srtol_dual (%g) must be > 0", p.c_str(), (double)rtolPrimal, p.c_str(), (double)rtolDual);
+  PetscCheck(relaxation > 0 && relaxation <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%srelaxation %g must lie in (0, 1]", p.c_str(), (double)relaxation);
+  PetscCheck(anderson >= 0 && anderson <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "%sanderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", p.c_str(), anderson);
+  PetscFunctionReturn(0);
+}
+
+void KacanovLoop::Begin(PetscInt n)
+{
+  history.du.clear();
+  history.dl.clear();
+  history.nactive.clear();
+  n_ = n;
+  if (anderson > 0 && n > 0) aa_.Setup(n, anderson);
+}
+
+PetscReal KacanovLoop::Relax(const PetscReal *x, PetscReal *g) const
+{
+  PetscReal nx = 0, ng = 0, nd = 0;
+  for (PetscInt i = 0; i < n_; ++i) {
+    g[i] = x[i] + relaxation * (g[i] - x[i]);
+    nx += x[i] * x[i];
+    ng += g[i] * g[i];
+    nd += (g[i] - x[i]) * (g[i] - x[i]);
+  }
+  return RelChange(std::sqrt(nd), std::sqrt(nx), std::sqrt(ng));
+}
+
+PetscErrorCode KacanovLoop::Record(MPI_Comm comm, PetscInt k, PetscReal du, PetscReal dl, PetscInt nactive, PetscInt R, const char *detail, bool *converged)
+{
+  PetscFunctionBeginUser;
+  history.du.push_back(du);
+  history.dl.push_back(dl);
+  history.nactive.push_back(nactive);
+  if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " %s |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT "%s%s%s\n", k, label.c_str(), (double)du, (double)dl, nactive, R, detail ? " (" : "", detail ? detail : "", detail ? ")" : ""));
+  *converged = maxIt == 1 || (du <= rtolPrimal && dl <= rtolDual);
+  PetscFunctionReturn(0);
+}
+
+bool KacanovLoop::Next(const PetscReal *x, const PetscReal *g, PetscReal *next)
+{
+  if (anderson > 0 && n_ > 0 && aa_.Mix(x, g, next) > 0) return true;
+  std::copy(g, g + n_, next);
+  return false;
+}
+
+std::string KacanovLoop::NotConverged(bool withHistory) const
+{
+  const std::string  p = "-" + prefix_ + "kacanov_";
+  std::ostringstream o;
+  o << label << " iterations did not converge in " << maxIt << " iterations (" << p << "max_it; tolerances " << p << "rtol_primal " << rtolPrimal << ", " << p << "rtol_dual " << rtolDual << "; try " << p << "relaxation 0.5)";
+  if (!history.du.empty()) o << "; last changes du " << history.du.back() << ", dlambda " << history.dl.back();
+  if (withHistory) {
+    o << ". History:";
+    for (size_t i = 0; i < history.du.size(); ++i) o << "\n  it " << i + 1 << ": du " << history.du[i] << ", dlambda " << history.dl[i] << ", active " << history.nactive[i];
+  }
+  return o.str();
+}
+
+} // namespace rbc

@@ -1,0 +1,175 @@
+// tests/test_kacanov_loop.cpp: KacanovLoop (src/contact/kacanov_loop.cpp), the loop shared by the FOM and
+// the ROM, on a linear contraction x = M x + b (n = 12, spectral radius 0.8) driven exactly as the backends
+// drive it (Begin, Relax, Record, Next), serial:
+//   1. the fixed point against an independent LAPACK solve of (I - M) x = b, with Anderson depth 0 and 3
+//      (fewer iterations with mixing), and with relaxation 0.5;
+//   2. the primal change Relax returns = |g - x| / |x| computed here; the history holds every iterate;
+//   3. max_it 1 is the linearized model (converged after one iterate); a loop that runs out of iterations
+//      reports it with the option names and the history;
+//   4. the options: -t_kacanov_max_it, _anderson, _relaxation read with the prefix; out-of-range values refused.
+#include "rbcontact/kacanov_loop.hpp"
+#include <petscblaslapack.h>
+#include <cmath>
+#include <random>
+
+using namespace rbc;
+
+static int failures = 0;
+static void Check(bool ok, const char *what, double v, double bound)
+{
+  PetscCallVoid(PetscPrintf(PETSC_COMM_WORLD, "  %-6s %-78s %.3e (bound %.1e)\n", ok ? "ok" : "FAIL", what, v, bound));
+  if (!ok) ++failures;
+}
+
+struct Problem {
+  PetscInt            n = 12;
+  std::vector<double> M, b, xstar;
+};
+
+static Problem MakeProblem()
+{
+  Problem      p;
+  const int    n = (int)p.n;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  p.M.assign(n * n, 0.0);
+  p.b.resize(n);
+  for (auto &v : p.M) v = u(rng);
+  double rowmax = 0;
+  for (int i = 0; i < n; ++i) {
+    double s = 0;
+    for (int j = 0; j < n; ++j) s += std::abs(p.M[i + j * n]);
+    rowmax = std::max(rowmax, s);
+  }
+  for (auto &v : p.M) v *= 0.8 / rowmax; // ||M||_inf = 0.8: a contraction
+  for (auto &v : p.b) v = u(rng);
+  // (I - M) x = b by LAPACK
+  std::vector<double> A(n * n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) A[i + j * n] = (i == j) - p.M[i + j * n];
+  p.xstar = p.b;
+  std::vector<PetscBLASInt> piv(n);
+  PetscBLASInt              nn = n, one = 1, info = 0;
+  LAPACKgesv_(&nn, &one, A.data(), &nn, piv.data(), p.xstar.data(), &nn, &info);
+  return p;
+}
+
+// drives the loop like the backends; returns the iterations, x the last (relaxed) image
+static PetscErrorCode Drive(KacanovLoop &loop, const Problem &p, std::vector<double> *x, PetscInt *its, bool *conv, double *relaxErr)
+{
+  const PetscInt      n = p.n;
+  std::vector<double> in(n, 0.0), g(n), next(n);
+  PetscFunctionBeginUser;
+  *conv     = false;
+  *relaxErr = 0;
+  loop.Begin(n);
+  for (PetscInt k = 1; k <= loop.maxIt; ++k) {
+    for (PetscInt i = 0; i < n; ++i) {
+      g[i] = p.b[i];
+      for (PetscInt j = 0; j < n; ++j) g[i] += p.M[i + j * n] * in[j];
+    }
+    // the change by hand: relaxed image minus input, relative to the input
+    double nd = 0, nx = 0;
+    for (PetscInt i = 0; i < n; ++i) {
+      const double gr = in[i] + loop.relaxation * (g[i] - in[i]);
+      nd += (gr - in[i]) * (gr - in[i]);
+      nx += in[i] * in[i];
+    }
+    const double expect = nx > 0 ? std::sqrt(nd / nx) : std::numeric_limits<double>::infinity();
+    const double du     = loop.Relax(in.data(), g.data());
+    if (std::isfinite(expect)) *relaxErr = std::max(*relaxErr, std::abs(du - expect) / expect);
+    else if (std::isfinite(du)) *relaxErr = 1;
+    bool done = false;
+    PetscCall(loop.Record(PETSC_COMM_SELF, k, du, du, 0, 0, nullptr, &done)); // dl: the same change (a stand-in)
+    *its = k;
+    if (done) {
+      *conv = true;
+      *x    = g;
+      break;
+    }
+    loop.Next(in.data(), g.data(), next.data());
+    in = next;
+    *x = g;
+  }
+  PetscFunctionReturn(0);
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  const Problem p = MakeProblem();
+  double        xs = 0;
+  for (double v : p.xstar) xs = std::max(xs, std::abs(v));
+  PetscInt its[2] = {0, 0};
+  for (PetscInt depth : {0, 3}) {
+    KacanovLoop loop(1e-12, 1e-12, "test");
+    loop.anderson = depth;
+    loop.maxIt    = 500;
+    std::vector<double> x;
+    PetscInt            it = 0;
+    bool                conv = false;
+    double              rerr = 0;
+    PetscCall(Drive(loop, p, &x, &it, &conv, &rerr));
+    double e = 0;
+    for (PetscInt i = 0; i < p.n; ++i) e = std::max(e, std::abs(x[i] - p.xstar[i]));
+    char what[160];
+    std::snprintf(what, sizeof what, "Anderson depth %d: converged in %d iterations, fixed point = LAPACK solve (rel)", (int)depth, (int)it);
+    Check(conv && e <= 1e-10 * xs, what, e / xs, 1e-10);
+    Check(rerr <= 1e-12, "Relax: |g - x| / |x| as computed by hand (rel)", rerr, 1e-12);
+    Check((PetscInt)loop.history.du.size() == it && (PetscInt)loop.history.nactive.size() == it, "history: one entry per iterate", (double)loop.history.du.size(), (double)it);
+    its[depth ? 1 : 0] = it;
+  }
+  Check(its[1] < its[0], "Anderson mixing (depth 3) needs fewer iterations than the plain loop", (double)its[1], (double)its[0]);
+  {
+    KacanovLoop loop(1e-12, 1e-12, "test");
+    loop.anderson   = 0;
+    loop.relaxation = 0.5;
+    loop.maxIt      = 1000;
+    std::vector<double> x;
+    PetscInt            it = 0;
+    bool                conv = false;
+    double              rerr = 0, e = 0;
+    PetscCall(Drive(loop, p, &x, &it, &conv, &rerr));
+    for (PetscInt i = 0; i < p.n; ++i) e = std::max(e, std::abs(x[i] - p.xstar[i]));
+    Check(conv && e <= 1e-10 * xs && rerr <= 1e-12, "relaxation 0.5: same fixed point, change of the relaxed image", e / xs, 1e-10);
+  }
+  {
+    KacanovLoop loop(1e-12, 1e-12, "test");
+    loop.maxIt = 1;
+    std::vector<double> x;
+    PetscInt            it = 0;
+    bool                conv = false;
+    double              rerr = 0;
+    PetscCall(Drive(loop, p, &x, &it, &conv, &rerr));
+    Check(conv && it == 1, "max_it 1: the linearized model, converged after one iterate", (double)it, 1);
+    loop.maxIt = 3;
+    PetscCall(Drive(loop, p, &x, &it, &conv, &rerr));
+    const std::string msg = loop.NotConverged(true);
+    Check(!conv && it == 3 && msg.find("did not converge in 3") != std::string::npos && msg.find("-kacanov_max_it") != std::string::npos && msg.find("it 3: du") != std::string::npos,
+          "max_it 3, tolerance 1e-12: not converged, message names the option and the history", (double)it, 3);
+  }
+  {
+    KacanovLoop loop;
+    PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_max_it", "7"));
+    PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_anderson", "5"));
+    PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_relaxation", "0.25"));
+    PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "t_"));
+    Check(loop.maxIt == 7 && loop.anderson == 5 && loop.relaxation == 0.25, "-t_kacanov_max_it 7, _anderson 5, _relaxation 0.25 read with the prefix", (double)loop.maxIt, 7);
+    PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_relaxation", "1.5"));
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    PetscErrorCode ierr = loop.SetFromOptions(PETSC_COMM_SELF, "t_");
+    PetscCall(PetscPopErrorHandler());
+    Check(ierr == PETSC_ERR_ARG_OUTOFRANGE, "-t_kacanov_relaxation 1.5 refused (PETSC_ERR_ARG_OUTOFRANGE)", (double)ierr, PETSC_ERR_ARG_OUTOFRANGE);
+    PetscCall(PetscOptionsClearValue(NULL, "-t_kacanov_relaxation"));
+    PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_anderson", "11"));
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = loop.SetFromOptions(PETSC_COMM_SELF, "t_");
+    PetscCall(PetscPopErrorHandler());
+    Check(ierr == PETSC_ERR_ARG_OUTOFRANGE, "-t_kacanov_anderson 11 refused", (double)ierr, PETSC_ERR_ARG_OUTOFRANGE);
+    PetscCall(PetscOptionsClearValue(NULL, "-t_kacanov_anderson"));
+    PetscCall(PetscOptionsClearValue(NULL, "-t_kacanov_max_it"));
+  }
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "test_kacanov_loop: %d failure(s)\n", failures));
+  PetscCall(PetscFinalize());
+  return failures ? 1 : 0;
+}
