@@ -111,6 +111,24 @@ static PetscErrorCode Run(MPI_Comm comm)
       PetscCall(fe.Energy(u, &efe));
       PetscCall(el.Energy(u, &eel));
       PetscCall(Check(comm, "energy 1/2 a(U, U) of a random field", std::abs(efe - eel), std::abs(efe), 1e-12));
+      {
+        // the local vector with the Dirichlet values: constant values inserted directly (element path)
+        // against DMPlexInsertBoundaryValues's projection (PetscFE path); same numbering (cloned DM)
+        Vec       lfe, lel;
+        PetscReal dmax = 0, nref = 0;
+        PetscCall(DMGetLocalVector(fe.dm, &lfe));
+        PetscCall(DMGetLocalVector(el.dm, &lel));
+        PetscCall(fe.GlobalToLocalWithBC(u, lfe));
+        PetscCall(el.GlobalToLocalWithBC(u, lel));
+        PetscCall(VecNorm(lfe, NORM_INFINITY, &nref));
+        PetscCall(VecAXPY(lel, -1.0, lfe));
+        PetscCall(VecNorm(lel, NORM_INFINITY, &dmax));
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPI_MAX, comm));
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nref, 1, MPIU_REAL, MPI_MAX, comm));
+        PetscCall(Check(comm, "local vector with the Dirichlet values: direct insertion = DMPlexInsertBoundaryValues", dmax, nref, 1e-14));
+        PetscCall(DMRestoreLocalVector(fe.dm, &lfe));
+        PetscCall(DMRestoreLocalVector(el.dm, &lel));
+      }
       PetscCall(VecDestroy(&u));
       PetscCall(MatDestroy(&Afe));
       PetscCall(MatDestroy(&Ael));

@@ -94,6 +94,10 @@ private:
   mutable ElementAssembler  elem_;
   mutable Vec               bcLocal_ = nullptr; // the Dirichlet values of the current state, zero elsewhere
   mutable bool              bcValid_ = false;   // cleared by every change of the load scales
+  std::vector<PetscInt>     bcValue_;           // label value of each essential boundary (bcs_ order)
+  // Constant Dirichlet values straight into the local vector (Lagrange nodes of the closures of the
+  // labeled points, in DMAddBoundary's order): what DMPlexInsertBoundaryValues projects, without its cost
+  PetscErrorCode InsertConstantBoundaryValues(Vec uloc) const;
 };
 
 } // namespace rbc

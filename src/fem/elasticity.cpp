@@ -345,6 +345,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
 
   // Essential boundaries
   bcs_.assign(scene.dirichlet.begin(), scene.dirichlet.end());
+  bcValue_.clear();
   for (auto &bc : bcs_) {
     DMLabel label;
     PetscCall(MeshCheckLabel(dm, bc.label, "-bc_dirichlet", scene.mesh.file));
@@ -361,6 +362,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
     PetscCall(ISRestoreIndices(valueIS, &vals));
     PetscCall(ISDestroy(&valueIS));
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_INT, MPI_MAX, comm));
+    bcValue_.push_back(v);
     PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, bc.label.c_str(), label, 1, &v, 0, (PetscInt)bc.comps.size(), bc.comps.empty() ? NULL : bc.comps.data(), (void (*)(void))(bc.fn ? bc.fn : ConstantBC), NULL, bc.fn ? bc.fnCtx : (void *)&bc, NULL));
   }
   PetscCall(SetupMaterials());
@@ -519,13 +521,61 @@ PetscErrorCode Elasticity::GlobalToLocalWithBC(Vec u, Vec uloc) const
 {
   PetscFunctionBeginUser;
   if (!bcValid_) { // the boundary values of this state, projected once (DMPlexInsertBoundaryValues is slow)
+    bool constant = elementAssembly_;
+    for (const auto &bc : bcs_) constant = constant && !bc.fn;
     if (!bcLocal_) PetscCall(DMCreateLocalVector(dm, &bcLocal_));
     PetscCall(VecSet(bcLocal_, 0.0));
-    PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, bcLocal_, 0.0, NULL, NULL, NULL));
+    if (constant) PetscCall(InsertConstantBoundaryValues(bcLocal_));
+    else PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, bcLocal_, 0.0, NULL, NULL, NULL));
     bcValid_ = true;
   }
   PetscCall(VecCopy(bcLocal_, uloc)); // the global-to-local scatter leaves the constrained entries alone
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, uloc));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode Elasticity::InsertConstantBoundaryValues(Vec uloc) const
+{
+  PetscSection sec;
+  PetscScalar *a;
+  PetscInt     dim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetLocalSection(dm, &sec));
+  PetscCall(VecGetArray(uloc, &a));
+  size_t k = 0;
+  for (const auto &bc : bcs_) {
+    DMLabel         label;
+    IS              pts = NULL;
+    const PetscInt *pi  = NULL;
+    PetscInt        np  = 0;
+    const PetscInt  v   = bcValue_[k++];
+    PetscCall(DMGetLabel(dm, bc.label.c_str(), &label));
+    if (label && v >= 0) PetscCall(DMLabelGetStratumIS(label, v, &pts));
+    if (!pts) continue;
+    PetscCall(ISGetLocalSize(pts, &np));
+    PetscCall(ISGetIndices(pts, &pi));
+    for (PetscInt q = 0; q < np; ++q) {
+      PetscInt *cl = NULL, ncl = 0;
+      PetscCall(DMPlexGetTransitiveClosure(dm, pi[q], PETSC_TRUE, &ncl, &cl));
+      for (PetscInt c = 0; c < ncl; ++c) {
+        PetscInt dof, off;
+        PetscCall(PetscSectionGetDof(sec, cl[2 * c], &dof));
+        if (!dof) continue;
+        PetscCall(PetscSectionGetOffset(sec, cl[2 * c], &off));
+        for (PetscInt n = 0; n < dof / dim; ++n) // Lagrange nodes of the point, component fastest
+          if (bc.comps.empty())
+            for (PetscInt d = 0; d < dim; ++d) a[off + n * dim + d] = bc.scale * bc.values[d];
+          else
+            for (PetscInt d : bc.comps) a[off + n * dim + d] = bc.scale * bc.values[d];
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, pi[q], PETSC_TRUE, &ncl, &cl));
+    }
+    PetscCall(ISRestoreIndices(pts, &pi));
+    PetscCall(ISDestroy(&pts));
+  }
+  PetscCall(VecRestoreArray(uloc, &a));
   PetscFunctionReturn(0);
 }
 
