@@ -64,7 +64,6 @@ PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full)
 
 static const PetscReal kInf = std::numeric_limits<PetscReal>::infinity(); // reported as null in JSON
 
-
 PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
 {
   Vec       r, Ku, res;
