@@ -149,6 +149,17 @@ int main(int argc, char **argv)
           "max_it 3, tolerance 1e-12: not converged, message names the option and the history", (double)it, 3);
   }
   {
+    // the dual change against multipliers the loop did not compute (a warm start's): recorded, not tested
+    KacanovLoop loop(1e-5, 1e-4, "test");
+    bool        tested = true, untested = false, primalMissed = true;
+    loop.Begin(1);
+    PetscCall(loop.Record(PETSC_COMM_SELF, 1, 1e-6, 0.5, 0, 0, nullptr, &tested));
+    PetscCall(loop.Record(PETSC_COMM_SELF, 1, 1e-6, 0.5, 0, 0, nullptr, &untested, false));
+    PetscCall(loop.Record(PETSC_COMM_SELF, 1, 2e-5, 0.0, 0, 0, nullptr, &primalMissed, false));
+    Check(!tested && untested && !primalMissed && loop.history.dl.size() == 3 && loop.history.dl[1] == 0.5,
+          "Record: dl 0.5 > rtol_dual stops the loop only when it is a change of the iteration; du > rtol_primal never; dl recorded", (double)untested, 1);
+  }
+  {
     KacanovLoop loop;
     PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_max_it", "7"));
     PetscCall(PetscOptionsSetValue(NULL, "-t_kacanov_anderson", "5"));

@@ -33,7 +33,11 @@ public:
   PetscReal Relax(const PetscReal *x, PetscReal *g) const;
   // Records iterate k (du, dl, nactive of R), prints the monitor line (detail: backend's text or null) and
   // sets *converged: du <= rtolPrimal and dl <= rtolDual, or maxIt == 1 (the linearized model).
-  PetscErrorCode Record(MPI_Comm comm, PetscInt k, PetscReal du, PetscReal dl, PetscInt nactive, PetscInt R, const char *detail, bool *converged);
+  // dualIsChange = false: dl compares with multipliers the loop did not compute (a warm start's, which
+  // does not enter the image): it is recorded and printed but not tested. The fixed point is in the
+  // primal input alone (the multipliers are the QP's at the input), so du <= rtolPrimal certifies it;
+  // only a backend that relaxes the multipliers (relaxation < 1) must keep the dual test.
+  PetscErrorCode Record(MPI_Comm comm, PetscInt k, PetscReal du, PetscReal dl, PetscInt nactive, PetscInt R, const char *detail, bool *converged, bool dualIsChange = true);
   // The next input from the input x and its (relaxed) image g: Anderson's mix, or g itself. Returns true
   // when next differs from g (a mix was used).
   bool Next(const PetscReal *x, const PetscReal *g, PetscReal *next);

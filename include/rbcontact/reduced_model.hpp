@@ -122,9 +122,11 @@ public:
   std::vector<PetscReal> dualGram;                   // W'W (Rfull x Rfull): the Kacanov change of lambda = W lambda^ is measured in it
   // options
   // -rom_kacanov_max_it (30), _rtol_primal, _rtol_dual, _relaxation, _anderson (3), _monitor: the loop shared with
-  // the FOM (kacanov_loop.hpp). Tolerances matched to the ROM's accuracy targets (docs/online.md): 1e-6 on the
-  // primal change (u target 1e-4), 1e-4 on the dual one (lambda target 1e-2)
-  KacanovLoop loop{1e-6, 1e-4, "ROM Kacanov"};
+  // the FOM (kacanov_loop.hpp). Tolerances matched to the ROM's accuracy targets (docs/online.md): 1e-5 on the
+  // primal change (u target 1e-4; the loop's own error is about c/(1-c) times the last change, c <= 0.25
+  // measured), 1e-4 on the dual one (lambda target 1e-2); the first iterate's dual change against a warm
+  // start's multipliers is recorded, not tested
+  KacanovLoop loop{1e-5, 1e-4, "ROM Kacanov"};
   PetscReal   kktTol    = 1e-8;
   PetscBool   warmStart = PETSC_TRUE;
   bool      recordIterates = false;

@@ -15,6 +15,7 @@
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/training_set.hpp"
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <sstream>
 
@@ -302,6 +303,11 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   rep.root["fom_time_s"]["all"]       = fomTimes;
   rep.root["speedup_median"]          = onlineMedian > 0 ? fomMedian / onlineMedian : 0.0;
   rep.root["rom_kacanov_iterations"]["max"] = (long long)(romIts.empty() ? 0 : *std::max_element(romIts.begin(), romIts.end()));
+  {
+    std::vector<double> its(romIts.begin(), romIts.end());
+    rep.root["rom_kacanov_iterations"]["mean"]          = its.empty() ? 0.0 : std::accumulate(its.begin(), its.end(), 0.0) / its.size();
+    rep.root["rom_kacanov_iterations"]["per_parameter"] = its;
+  }
   JsonValue &ro = rep.root["rom"];
   ro["N"]  = (long long)model.N();
   ro["R"]  = (long long)model.R();

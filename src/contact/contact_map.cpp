@@ -345,6 +345,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
         for (PetscInt d = 0; d < 3; ++d) a[d] += n[d];
       }
     }
+    for (auto &kv : vnormal) NormalizeVertexNormal(kv.second.data()); // unit, once per vertex (EvaluateContactPoint)
   }
 
   // 2D: the vertices that end the master surface (in one master facet only)

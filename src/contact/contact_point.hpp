@@ -33,6 +33,14 @@ inline void FacetNormal(const PetscReal *x, PetscInt dim, PetscReal outward, Pet
   }
 }
 
+// The unit vertex normal from the accumulated facet normals a (in place): the callers normalize once per
+// vertex, not once per integration point and vertex.
+inline void NormalizeVertexNormal(PetscReal a[3])
+{
+  const PetscReal an = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  for (PetscInt d = 0; d < 3; ++d) a[d] /= an;
+}
+
 // One slave integration point: slave shape values Ns, closest master facet m (index into the master
 // list) at barycentric bm with shape values Nm, unit master normal n2, and the gap (z - rho) . n2 with
 // z, rho the undeformed (physical at mu) positions of the slave point and of its master image.
@@ -41,7 +49,7 @@ struct ContactPointEval {
   PetscReal bm[3] = {0, 0, 0}, Ns[6], Nm[6], n2[3] = {0, 0, 0}, gap = 0, dist = 0;
 };
 
-// vnormal(M, k): accumulated (unnormalized) normal of vertex k of master facet M (smooth normals).
+// vnormal(M, k): unit normal of vertex k of master facet M (smooth normals; NormalizeVertexNormal).
 // find(zdef, &m, bm, &dist): closest point of the deformed master.
 template <class Find, class VertexNormal>
 inline void EvaluateContactPoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[], const std::vector<SurfaceFacet> &masters, const PetscReal *mxdef, bool smooth, Find &&find, VertexNormal &&vnormal, ContactPointEval *e)
@@ -64,9 +72,8 @@ inline void EvaluateContactPoint(const SurfaceFacet &F, PetscInt dim, const Pets
     for (PetscInt d = 0; d < dim; ++d) rho[d] += e->bm[k] * M.X[k * dim + d];
   if (smooth) {
     for (PetscInt k = 0; k < nv; ++k) {
-      const PetscReal *a  = vnormal(M, k);
-      const PetscReal  an = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-      for (PetscInt d = 0; d < dim; ++d) n2[d] += e->bm[k] * a[d] / an;
+      const PetscReal *a = vnormal(M, k);
+      for (PetscInt d = 0; d < dim; ++d) n2[d] += e->bm[k] * a[d];
     }
   } else FacetNormal(mxdef + 9 * e->m, dim, M.outward, n2);
   PetscReal nn = 0;

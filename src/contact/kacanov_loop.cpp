@@ -56,14 +56,14 @@ PetscReal KacanovLoop::Relax(const PetscReal *x, PetscReal *g) const
   return RelChange(std::sqrt(nd), std::sqrt(nx), std::sqrt(ng));
 }
 
-PetscErrorCode KacanovLoop::Record(MPI_Comm comm, PetscInt k, PetscReal du, PetscReal dl, PetscInt nactive, PetscInt R, const char *detail, bool *converged)
+PetscErrorCode KacanovLoop::Record(MPI_Comm comm, PetscInt k, PetscReal du, PetscReal dl, PetscInt nactive, PetscInt R, const char *detail, bool *converged, bool dualIsChange)
 {
   PetscFunctionBeginUser;
   history.du.push_back(du);
   history.dl.push_back(dl);
   history.nactive.push_back(nactive);
-  if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " %s |du|/|u| %9.3e |dlambda|/|lambda| %9.3e active %" PetscInt_FMT "/%" PetscInt_FMT "%s%s%s\n", k, label.c_str(), (double)du, (double)dl, nactive, R, detail ? " (" : "", detail ? detail : "", detail ? ")" : ""));
-  *converged = maxIt == 1 || (du <= rtolPrimal && dl <= rtolDual);
+  if (monitor) PetscCall(PetscPrintf(comm, "  %3" PetscInt_FMT " %s |du|/|u| %9.3e |dlambda|/|lambda| %9.3e%s active %" PetscInt_FMT "/%" PetscInt_FMT "%s%s%s\n", k, label.c_str(), (double)du, (double)dl, dualIsChange ? "" : " (from the warm start)", nactive, R, detail ? " (" : "", detail ? detail : "", detail ? ")" : ""));
+  *converged = maxIt == 1 || (du <= rtolPrimal && (!dualIsChange || dl <= rtolDual));
   PetscFunctionReturn(0);
 }
 

@@ -303,6 +303,9 @@ void ContactPatch::PrepareMaster()
       for (PetscInt k = 0; k < master[m].nv; ++k)
         for (PetscInt d = 0; d < 3; ++d) vnormal_[3 * master[m].vglobal[k] + d] += n[d];
     }
+  if (smoothNormal) // unit, once per vertex (EvaluateContactPoint); vertices of no facet stay 0 and are never read
+    for (PetscInt v = 0; v < nvertex; ++v)
+      if (vnormal_[3 * v] != 0 || vnormal_[3 * v + 1] != 0 || vnormal_[3 * v + 2] != 0) NormalizeVertexNormal(&vnormal_[3 * v]);
 }
 
 PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit) const

@@ -1,6 +1,7 @@
 // src/rom/reduced_model.cpp: the online stage's model: reading/writing its data (ROM file, format 2,
 // docs/rom_file.md), truncation, the EIM (or exact) reduced contact terms and the reduced Kacanov loop.
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/warm_start.hpp"
 #include "dense_kernels.hpp"
 #include <algorithm>
 #include <cmath>
@@ -590,29 +591,20 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     PetscFunctionReturn(0);
   }
   Operators(mu, &A_, &f_);
-  // warm start: the stored reduced solutions of the training parameters; with one parameter the
-  // linear interpolation between the two that bracket mu, otherwise the nearest (box-scaled distance)
+  // warm start: a combination of the stored reduced solutions of the training parameters (the bracketing
+  // interpolation with one parameter, an affine least-squares fit with several: warm_start.hpp); the
+  // multipliers clipped to the cone
   const size_t np = par.params.size(), nw = np ? warmMu.size() / np : 0;
-  if (warmStart && nw > 0) {
-    size_t    best = 0, lo = nw, hi = nw;
-    PetscReal bd   = PETSC_MAX_REAL;
-    for (size_t k = 0; k < nw; ++k) {
-      PetscReal d = 0;
-      for (size_t i = 0; i < np; ++i) {
-        const PetscReal w = std::max<PetscReal>(par.params[i].max - par.params[i].min, 1e-300);
-        d += PetscSqr((warmMu[k * np + i] - mu[i]) / w);
-      }
-      if (d < bd) { bd = d; best = k; }
-      if (np == 1) {
-        if (warmMu[k] <= mu[0] && (lo == nw || warmMu[k] > warmMu[lo])) lo = k;
-        if (warmMu[k] >= mu[0] && (hi == nw || warmMu[k] < warmMu[hi])) hi = k;
-      }
+  const bool   warmed = warmStart && nw > 0;
+  if (warmed) {
+    thread_local std::vector<PetscReal> width;
+    width.resize(np);
+    for (size_t i = 0; i < np; ++i) width[i] = par.params[i].max - par.params[i].min;
+    for (const auto &[k, w] : WarmStartWeights(warmMu, width, mu)) {
+      for (PetscInt i = 0; i < Na; ++i) sol->v[i] += w * warmV[k * Nfull + cols_[i]];
+      for (PetscInt i = 0; i < r; ++i) sol->lambda[i] += w * warmL[k * Rfull + i];
     }
-    PetscReal t = 0;
-    if (np == 1 && lo < nw && hi < nw && warmMu[hi] > warmMu[lo]) t = (mu[0] - warmMu[lo]) / (warmMu[hi] - warmMu[lo]);
-    else lo = hi = best;
-    for (PetscInt i = 0; i < Na; ++i) sol->v[i] = (1 - t) * warmV[lo * Nfull + cols_[i]] + t * warmV[hi * Nfull + cols_[i]];
-    for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = (1 - t) * warmL[lo * Rfull + i] + t * warmL[hi * Rfull + i];
+    for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = std::max<PetscReal>(sol->lambda[i], 0);
   }
   thread_local std::vector<PetscReal> vprev, lprev, vnew, lnew, vnext;
   loop.Begin(Na);
@@ -657,8 +649,11 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     const PetscReal dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
     char            detail[48] = "";
     if (loop.monitor) std::snprintf(detail, sizeof detail, "QP its %" PetscInt_FMT, sol->qp.iterations);
-    bool done = false;
-    PetscCall(loop.Record(PETSC_COMM_SELF, it, du, dl, nact, r, loop.monitor ? detail : nullptr, &done));
+    // the first iterate's multipliers against a warm start's: not a change of the iteration (the image
+    // depends on the input v alone), so only du is tested there (relaxation 1: lambda is the QP's)
+    const bool dualIsChange = !(it == 1 && warmed && loop.relaxation == 1.0);
+    bool       done         = false;
+    PetscCall(loop.Record(PETSC_COMM_SELF, it, du, dl, nact, r, loop.monitor ? detail : nullptr, &done, dualIsChange));
     if (done) {
       // the KKT residuals of the last QP only (the loop's QPs skip them: -log_view 1-2 % of a solve)
       qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
