@@ -103,6 +103,7 @@ def pipeline(args):
     check(off["rom"]["hyper"] == "ecsw" and c["M"] == off["rom"]["Mc"] and 0 < c["M"] < off["eim"]["quadrature_points"], "ECSW is the default and uses %d < %d points" % (c["M"], off["eim"]["quadrature_points"]))
     check(min(c["weights"]) > 0, "cubature weights > 0 (min %.3e)" % min(c["weights"]))
     check(c["residual"] <= c["tol"] and len(eK) == c["states"], "cubature residual %.2e <= tol %.0e on %d training states" % (c["residual"], c["tol"], c["states"]))
+    check(c["fit"] == "terms", "the scene's -ecsw_fit terms is the fit used (the residual below is in the terms measure)")
     check(abs(rms - c["residual"]) <= 1e-3 * c["residual"], "training states: RMS of the K^, g^ errors %.4e = reported residual %.4e" % (rms, c["residual"]))
     # the same offline stage on 1 rank: the same ROM
     d2 = d + "/np1"
@@ -322,6 +323,9 @@ def half_disks(args):
     rom, off = offline(args, d, opts="runs/half_disks.opts", extra=extra)
     ro = off["rom"]
     print("  half_disks ROM: N %d R %d Mk %d Mg %d (16 training points)" % (ro["N"], ro["R"], ro["Mk"], ro["Mg"]))
+    c = off["ecsw"]
+    check(c["fit"] == "action" and ro["hyper"] == "ecsw" and c["residual"] <= c["tol"] and min(c["weights"]) > 0,
+          "default cubature: -ecsw_fit action, residual %.2e <= tol %.0e, %d points, weights > 0" % (c["residual"], c["tol"], c["M"]))
     run(args, 2, "validate", ["-options_file", "runs/half_disks.opts", "-rom", rom, "-test_type", "random", "-test_size", "5", "-test_seed", "3", "-validate_repeat", "5", "-report", d + "/val.json"])
     v = report(d + "/val.json")
     t = v["test"]

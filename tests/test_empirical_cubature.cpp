@@ -1,7 +1,8 @@
 // tests/test_empirical_cubature.cpp: the empirical cubature (src/reduction/empirical_cubature.cpp)
 // against independent references:
 //  1. CubatureGram against the Gram matrix of the explicitly stacked fitting rows (each state's K^ and
-//     g^ entries as functions of the weights, scaled to unit norm), on random data.
+//     g^ entries as functions of the weights, scaled to unit norm), on random data; CubatureActionGram
+//     likewise against its rows (K^' lam_j and K^ v_j - g^ per training solution j, scaled per state).
 //  2. Caratheodory/Tchakaloff: moments of degree 0..4 of a 60-point rule on [0, 1] are reproduced by a
 //     nonnegative rule on at most 5 of its points; the sparse NNLS finds one (weights > 0, support <= 5,
 //     residual <= 1e-9) and the moments it gives match the full rule's.
@@ -76,6 +77,66 @@ int main(int argc, char **argv)
         sc = std::max(sc, std::abs(h));
       }
     Check(d <= 1e-13 * sc, "CubatureGram = G'G of the explicit fitting rows (max |diff| / max |G'G|)", d / sc, 1e-13);
+  }
+
+  { // 1b. the action fit's Gram matrix against its explicit rows: per state s and training solution j,
+    // (K_s(xi)' lam_j) / sqrt(sum_j |K_s' lam_j|^2) and (K_s(xi) v_j - g_s(xi)) / sqrt(sum_j |K_s v_j|^2 + |g_s|^2)
+    const PetscInt         R = 3, Q = 17, N = 2, ms = 4, nt = 3;
+    std::vector<PetscReal> P((size_t)R * Q), Sk((size_t)ms * Q * N), Sg((size_t)ms * Q), Lam((size_t)nt * R), Vs((size_t)nt * N), H;
+    for (auto &x : P) x = std::abs(U(gen));
+    for (auto &x : Sk) x = U(gen);
+    for (auto &x : Sg) x = U(gen);
+    for (auto &x : Lam) x = std::abs(U(gen));
+    for (auto &x : Vs) x = U(gen);
+    CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &H);
+    std::vector<PetscReal> G, K, g, one(Q, 1.0), e(Q);
+    for (PetscInt s = 0; s < ms; ++s) {
+      Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
+      PetscReal n1 = 0, n2 = 0;
+      for (PetscInt j = 0; j < nt; ++j) {
+        for (PetscInt n = 0; n < N; ++n) {
+          PetscReal t = 0;
+          for (PetscInt r = 0; r < R; ++r) t += K[(size_t)r * N + n] * Lam[(size_t)j * R + r];
+          n1 += t * t;
+        }
+        for (PetscInt r = 0; r < R; ++r) {
+          PetscReal t = 0;
+          for (PetscInt n = 0; n < N; ++n) t += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+          n2 += t * t + g[r] * g[r];
+        }
+      }
+      // each row is linear in xi: its coefficient of xi_p from the terms with xi = e_p
+      for (PetscInt j = 0; j < nt; ++j) {
+        std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)R * Q);
+        for (PetscInt p = 0; p < Q; ++p) {
+          std::fill(e.begin(), e.end(), 0.0);
+          e[p] = 1;
+          Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
+          for (PetscInt n = 0; n < N; ++n) {
+            PetscReal t = 0;
+            for (PetscInt r = 0; r < R; ++r) t += K[(size_t)r * N + n] * Lam[(size_t)j * R + r];
+            rows1[(size_t)n * Q + p] = t / std::sqrt(n1);
+          }
+          for (PetscInt r = 0; r < R; ++r) {
+            PetscReal t = -g[r];
+            for (PetscInt n = 0; n < N; ++n) t += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+            rows2[(size_t)r * Q + p] = t / std::sqrt(n2);
+          }
+        }
+        G.insert(G.end(), rows1.begin(), rows1.end());
+        G.insert(G.end(), rows2.begin(), rows2.end());
+      }
+    }
+    const size_t rows = G.size() / Q;
+    PetscReal    d = 0, sc = 0;
+    for (PetscInt p = 0; p < Q; ++p)
+      for (PetscInt q = 0; q < Q; ++q) {
+        PetscReal h = 0;
+        for (size_t i = 0; i < rows; ++i) h += G[i * Q + p] * G[i * Q + q];
+        d  = std::max(d, std::abs(h - H[(size_t)p * Q + q]));
+        sc = std::max(sc, std::abs(h));
+      }
+    Check(d <= 1e-13 * sc, "CubatureActionGram = G'G of the explicit rows (K' lam_j, K v_j - g; max |diff| / max |G'G|)", d / sc, 1e-13);
   }
 
   { // 2. moments 0..4 of a 60-point rule: a nonnegative rule on <= 5 of its points

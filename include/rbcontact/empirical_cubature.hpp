@@ -20,7 +20,13 @@
 
 namespace rbc {
 
+// What the fit measures (-ecsw_fit): every entry of each state's K^ and g^ (Frobenius), or what the reduced
+// QP uses of them at the training solutions (lambda_j, v_j): the contact force on the primal modes K^' lambda_j
+// and the constraint values K^ v_j - g^ (CubatureActionGram).
+enum class CubatureFit { Terms, Action };
+
 struct CubatureOptions {
+  CubatureFit fit     = CubatureFit::Action; // -ecsw_fit (docs/hyper_reduction.md: fewer points for the same errors)
   PetscReal tol       = 1e-4;  // stop when ||G (xi - 1)|| <= tol ||G 1|| (relative RMS error of the fitted terms)
   PetscInt  maxPoints = 1000;  // at most this many points (the tolerance decides; a safeguard)
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
@@ -42,6 +48,14 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
 // (ms blocks of Q) and P (R x Q row-major). Each state's K^ and g^ enter scaled to unit norm (a state
 // whose K^ or g^ vanishes contributes nothing for that term).
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H);
+
+// The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
+// and Vs (nt x N, row-major),
+//   sum_j ||dK_s' lam_j||^2 / sum_j ||K^_s' lam_j||^2 + sum_j ||dK_s v_j - dg_s||^2 / sum_j (||K^_s v_j||^2 + ||g^_s||^2),
+// dK, dg the cubature's errors: H = ((P'Lam')(Lam P)) o (Zk Zk') + (P'P) o (Y Y'), Zk the scaled kappa
+// columns, Y(p, (s, j)) = kappa_s(p, :) v_j - gamma_s(p) scaled. Weighted Frobenius norms: the row directions
+// no training multiplier takes and the columns no training solution uses weigh little.
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);

@@ -347,7 +347,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     std::vector<PetscReal> H;
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
-    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
+    if (co.fit == CubatureFit::Action) CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, (PetscInt)(rm.warmL.size() / R), &H);
+    else CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
     PetscCall(EmpiricalCubature(H, Q, co, &cr));
     PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
     rm.cPoint.clear();
@@ -423,6 +424,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     JsonValue &c = rep->root["ecsw"];
     c["M"]            = (long long)cr.points.size();
     c["tol"]          = (double)co.tol;
+    c["fit"]          = co.fit == CubatureFit::Action ? "action" : "terms";
     c["residual"]     = (double)cr.residual;
     c["history"]      = cr.history;
     c["iterations"]   = (long long)cr.iterations;

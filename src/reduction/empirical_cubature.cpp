@@ -14,6 +14,12 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, pre, "Empirical cubature of the reduced contact terms", "rbcontact");
+  {
+    const char *fits[] = {"terms", "action"};
+    PetscInt    f      = opt->fit == CubatureFit::Action ? 1 : 0;
+    PetscCall(PetscOptionsEList("-fit", "what the fit measures: K^' lambda and K^ v - g^ at the training solutions (action) or every entry of K^, g^ (terms)", "", fits, 2, fits[f], &f, NULL));
+    opt->fit = f == 1 ? CubatureFit::Action : CubatureFit::Terms;
+  }
   PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
   PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
   flg = opt->monitor ? PETSC_TRUE : PETSC_FALSE;
@@ -92,6 +98,63 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   if (kz > 0) BLASgemm_("N", "T", &q, &q, &kz, &one, Z.data(), &q, Z.data(), &q, &zero, KG.data(), &q);
   if (kr > 0) BLASgemm_("N", "T", &q, &q, &kr, &one, P.data(), &q, P.data(), &q, &zero, H->data(), &q);
   for (size_t i = 0; i < KG.size(); ++i) (*H)[i] *= KG[i];
+}
+
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H)
+{
+  // Lam P (nt x Q): the points' rows seen through the training multipliers
+  std::vector<PetscReal> LP((size_t)nt * Q, 0.0), Zk((size_t)Q * ms * N, 0.0), Y((size_t)Q * ms * nt, 0.0), Kh, gh;
+  for (PetscInt j = 0; j < nt; ++j)
+    for (PetscInt r = 0; r < R; ++r) {
+      const PetscReal l = Lam[(size_t)j * R + r];
+      if (l == 0.0) continue;
+      for (PetscInt p = 0; p < Q; ++p) LP[(size_t)j * Q + p] += l * P[(size_t)r * Q + p];
+    }
+  for (PetscInt s = 0; s < ms; ++s) {
+    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh);
+    PetscReal n1 = 0, n2 = 0, gg = SumSquares(gh);
+    for (PetscInt j = 0; j < nt; ++j) {
+      for (PetscInt n = 0; n < N; ++n) { // (K^' lam_j)_n
+        PetscReal t = 0;
+        for (PetscInt r = 0; r < R; ++r) t += Kh[(size_t)r * N + n] * Lam[(size_t)j * R + r];
+        n1 += t * t;
+      }
+      for (PetscInt r = 0; r < R; ++r) { // (K^ v_j)_r
+        PetscReal t = 0;
+        for (PetscInt n = 0; n < N; ++n) t += Kh[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+        n2 += t * t;
+      }
+      n2 += gg;
+    }
+    const PetscReal s1 = n1 > 0 ? 1 / std::sqrt(n1) : 0, s2 = n2 > 0 ? 1 / std::sqrt(n2) : 0;
+    for (PetscInt n = 0; n < N; ++n) {
+      PetscReal *z = &Zk[(size_t)(s * N + n) * Q];
+      for (PetscInt p = 0; p < Q; ++p) z[p] = s1 * kap[(size_t)p * N + n];
+    }
+    for (PetscInt j = 0; j < nt; ++j) {
+      PetscReal *y = &Y[(size_t)(s * nt + j) * Q];
+      for (PetscInt p = 0; p < Q; ++p) {
+        PetscReal t = -gam[p];
+        for (PetscInt n = 0; n < N; ++n) t += kap[(size_t)p * N + n] * Vs[(size_t)j * N + n];
+        y[p] = s2 * t;
+      }
+    }
+  }
+  std::vector<PetscReal> A((size_t)Q * Q, 0.0), B((size_t)Q * Q, 0.0);
+  const PetscBLASInt     q = (PetscBLASInt)Q, kz = (PetscBLASInt)(ms * N), ky = (PetscBLASInt)(ms * nt), kl = (PetscBLASInt)nt, kr = (PetscBLASInt)R;
+  const PetscReal        one = 1, zero = 0;
+  H->assign((size_t)Q * Q, 0.0);
+  // (Lam P)'(Lam P) o Zk Zk'
+  if (kl > 0) BLASgemm_("N", "T", &q, &q, &kl, &one, LP.data(), &q, LP.data(), &q, &zero, A.data(), &q);
+  if (kz > 0) BLASgemm_("N", "T", &q, &q, &kz, &one, Zk.data(), &q, Zk.data(), &q, &zero, B.data(), &q);
+  for (size_t i = 0; i < H->size(); ++i) (*H)[i] = A[i] * B[i];
+  // P'P o Y Y'
+  std::fill(A.begin(), A.end(), 0.0);
+  std::fill(B.begin(), B.end(), 0.0);
+  if (kr > 0) BLASgemm_("N", "T", &q, &q, &kr, &one, P.data(), &q, P.data(), &q, &zero, A.data(), &q);
+  if (ky > 0) BLASgemm_("N", "T", &q, &q, &ky, &one, Y.data(), &q, Y.data(), &q, &zero, B.data(), &q);
+  for (size_t i = 0; i < H->size(); ++i) (*H)[i] += A[i] * B[i];
 }
 
 namespace {
