@@ -14,7 +14,7 @@ rbc_add_mpi_test(NAME test_kacanov_loop RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE
 #   test_warm_start        the online warm start's weights (WarmStartWeights): the bracketing interpolation with one
 #                          parameter, affine data reproduced and second order with 2 and 3, the collinear fallback
 rbc_test_exe(test_warm_start)
-rbc_add_mpi_test(NAME test_warm_start RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_warm_start> LABELS rom)
+rbc_add_mpi_test(NAME test_warm_start RANKS 1 2 TIMEOUT 60 COMMAND $<TARGET_FILE:test_warm_start> LABELS rom)
 #   test_empirical_cubature  the ECSW fit (-rom_hyper ecsw): Gram matrix vs explicit rows, Caratheodory bound on
 #                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
 rbc_test_exe(test_empirical_cubature)

@@ -55,6 +55,19 @@ PetscReal SumSquares(const std::vector<PetscReal> &v)
   for (PetscReal x : v) s += x * x;
   return s;
 }
+
+// H += (A A') o (B B') for A (Q x ka) and B (Q x kb), column-major: the Gram matrix of the fitting rows
+// whose coefficient of point p is A(p, a) B(p, b) (a Hadamard product of two Gram matrices, two GEMMs).
+void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscReal *B, PetscInt kb, std::vector<PetscReal> *H)
+{
+  if (ka <= 0 || kb <= 0) return;
+  std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q);
+  const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka, b = (PetscBLASInt)kb;
+  const PetscReal        one = 1, zero = 0;
+  BLASgemm_("N", "T", &q, &q, &a, &one, A, &q, A, &q, &zero, GA.data(), &q);
+  BLASgemm_("N", "T", &q, &q, &b, &one, B, &q, B, &q, &zero, GB.data(), &q);
+  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
+}
 } // namespace
 
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
@@ -90,14 +103,9 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
     PetscReal *z = &Z[(size_t)(s * nc + N) * Q];
     for (PetscInt p = 0; p < Q; ++p) z[p] = sg * gam[p];
   }
-  // kernel Gram KG = Z Z' and P'P (P row-major R x Q = column-major Q x R), then the Hadamard product
-  std::vector<PetscReal> KG((size_t)Q * Q, 0.0);
+  // H = (P'P) o (Z Z') (P row-major R x Q = column-major Q x R)
   H->assign((size_t)Q * Q, 0.0);
-  const PetscBLASInt q = (PetscBLASInt)Q, kz = (PetscBLASInt)(ms * nc), kr = (PetscBLASInt)R;
-  const PetscReal    one = 1, zero = 0;
-  if (kz > 0) BLASgemm_("N", "T", &q, &q, &kz, &one, Z.data(), &q, Z.data(), &q, &zero, KG.data(), &q);
-  if (kr > 0) BLASgemm_("N", "T", &q, &q, &kr, &one, P.data(), &q, P.data(), &q, &zero, H->data(), &q);
-  for (size_t i = 0; i < KG.size(); ++i) (*H)[i] *= KG[i];
+  AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H);
 }
 
 void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H)
@@ -141,20 +149,10 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
       }
     }
   }
-  std::vector<PetscReal> A((size_t)Q * Q, 0.0), B((size_t)Q * Q, 0.0);
-  const PetscBLASInt     q = (PetscBLASInt)Q, kz = (PetscBLASInt)(ms * N), ky = (PetscBLASInt)(ms * nt), kl = (PetscBLASInt)nt, kr = (PetscBLASInt)R;
-  const PetscReal        one = 1, zero = 0;
+  // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y'
   H->assign((size_t)Q * Q, 0.0);
-  // (Lam P)'(Lam P) o Zk Zk'
-  if (kl > 0) BLASgemm_("N", "T", &q, &q, &kl, &one, LP.data(), &q, LP.data(), &q, &zero, A.data(), &q);
-  if (kz > 0) BLASgemm_("N", "T", &q, &q, &kz, &one, Zk.data(), &q, Zk.data(), &q, &zero, B.data(), &q);
-  for (size_t i = 0; i < H->size(); ++i) (*H)[i] = A[i] * B[i];
-  // P'P o Y Y'
-  std::fill(A.begin(), A.end(), 0.0);
-  std::fill(B.begin(), B.end(), 0.0);
-  if (kr > 0) BLASgemm_("N", "T", &q, &q, &kr, &one, P.data(), &q, P.data(), &q, &zero, A.data(), &q);
-  if (ky > 0) BLASgemm_("N", "T", &q, &q, &ky, &one, Y.data(), &q, Y.data(), &q, &zero, B.data(), &q);
-  for (size_t i = 0; i < H->size(); ++i) (*H)[i] += A[i] * B[i];
+  AddHadamardGram(Q, LP.data(), nt, Zk.data(), ms * N, H);
+  AddHadamardGram(Q, P.data(), R, Y.data(), ms * nt, H);
 }
 
 namespace {

@@ -1,5 +1,6 @@
 // src/rom/warm_start.cpp: the weights of the online warm start (include/rbcontact/warm_start.hpp).
 #include "rbcontact/warm_start.hpp"
+#include <petscblaslapack.h>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -14,8 +15,6 @@ std::vector<std::pair<size_t, PetscReal>> WarmStartWeights(const std::vector<Pet
   std::vector<PetscReal> d(nw, 0.0);
   for (size_t k = 0; k < nw; ++k)
     for (size_t i = 0; i < np; ++i) d[k] += scaled(k, i) * scaled(k, i);
-  std::vector<size_t> order(nw);
-  std::iota(order.begin(), order.end(), 0);
   const size_t nearest = (size_t)(std::min_element(d.begin(), d.end()) - d.begin());
   if (np == 1) {
     size_t lo = nw, hi = nw;
@@ -28,43 +27,34 @@ std::vector<std::pair<size_t, PetscReal>> WarmStartWeights(const std::vector<Pet
     return {{lo, 1 - t}, {hi, t}};
   }
   // the 2 np + 1 nearest (ties by index: deterministic), affine least squares through them: the fit's
-  // value at mu is c' y with c = X (X'X)^{-1} e_0, X = [1, scaled(k, :)] (the intercept is the value at mu)
-  const size_t k = std::min(nw, 2 * np + 1), m = np + 1;
+  // value at mu is c' y with c = X z, G z = e_0, G = X'X, X = [1, scaled(k, :)] (the intercept is the value at mu)
+  const size_t        k = std::min(nw, 2 * np + 1), m = np + 1;
+  std::vector<size_t> order(nw);
+  std::iota(order.begin(), order.end(), 0);
   std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](size_t a, size_t b) { return d[a] < d[b] || (d[a] == d[b] && a < b); });
-  std::vector<PetscReal> G(m * m, 0.0), x(m);
+  std::vector<PetscReal> X(k * m), G(m * m, 0.0), z(m, 0.0);
   for (size_t j = 0; j < k; ++j) {
-    x[0] = 1;
-    for (size_t i = 0; i < np; ++i) x[i + 1] = scaled(order[j], i);
+    X[j * m] = 1;
+    for (size_t i = 0; i < np; ++i) X[j * m + i + 1] = scaled(order[j], i);
     for (size_t a = 0; a < m; ++a)
-      for (size_t b = 0; b < m; ++b) G[a * m + b] += x[a] * x[b];
+      for (size_t b = 0; b < m; ++b) G[a * m + b] += X[j * m + a] * X[j * m + b];
   }
-  // solve G z = e_0 by Gaussian elimination with partial pivoting; a pivot below 1e-10 of the largest
-  // diagonal entry: the points do not determine an affine fit (collinear), use the nearest
+  // Cholesky of the Gram matrix; a pivot^2 below 1e-10 of its largest diagonal entry: the points do not
+  // determine an affine fit (collinear), use the nearest
   PetscReal gmax = 0;
-  for (size_t a = 0; a < m; ++a) gmax = std::max(gmax, std::abs(G[a * m + a]));
-  std::vector<PetscReal> z(m, 0.0);
+  for (size_t a = 0; a < m; ++a) gmax = std::max(gmax, G[a * m + a]);
+  PetscBLASInt n = (PetscBLASInt)m, one = 1, info = 0;
+  LAPACKpotrf_("L", &n, G.data(), &n, &info);
+  for (size_t a = 0; info == 0 && a < m; ++a)
+    if (!(G[a * m + a] * G[a * m + a] > 1e-10 * gmax)) info = 1;
+  if (info != 0) return {{nearest, 1.0}};
   z[0] = 1;
-  for (size_t c = 0; c < m; ++c) {
-    size_t p = c;
-    for (size_t r = c + 1; r < m; ++r)
-      if (std::abs(G[r * m + c]) > std::abs(G[p * m + c])) p = r;
-    if (!(std::abs(G[p * m + c]) > 1e-10 * gmax)) return {{nearest, 1.0}};
-    for (size_t b = 0; b < m; ++b) std::swap(G[c * m + b], G[p * m + b]);
-    std::swap(z[c], z[p]);
-    for (size_t r = c + 1; r < m; ++r) {
-      const PetscReal f = G[r * m + c] / G[c * m + c];
-      for (size_t b = c; b < m; ++b) G[r * m + b] -= f * G[c * m + b];
-      z[r] -= f * z[c];
-    }
-  }
-  for (size_t c = m; c-- > 0;) {
-    for (size_t b = c + 1; b < m; ++b) z[c] -= G[c * m + b] * z[b];
-    z[c] /= G[c * m + c];
-  }
+  LAPACKpotrs_("L", &n, &one, G.data(), &n, z.data(), &n, &info);
+  if (info != 0) return {{nearest, 1.0}};
   std::vector<std::pair<size_t, PetscReal>> w;
   for (size_t j = 0; j < k; ++j) {
-    PetscReal c = z[0];
-    for (size_t i = 0; i < np; ++i) c += z[i + 1] * scaled(order[j], i);
+    PetscReal c = 0;
+    for (size_t a = 0; a < m; ++a) c += X[j * m + a] * z[a];
     w.emplace_back(order[j], c);
   }
   return w;
