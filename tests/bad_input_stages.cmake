@@ -12,6 +12,7 @@ rbc_bad_stage(contact_quadrature "-contact_quadrature: unknown value 'bogus'" fo
 rbc_bad_stage(kacanov_not_converged "Kacanov iterations did not converge in 2 iterations.*History" fom -options_file runs/ring_on_block.opts -kacanov_max_it 2)
 rbc_bad_stage(offline_stop "-offline_stop eim: unknown step" offline -options_file runs/ring_on_block.opts -offline_stop eim -snapshots /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_fit "Unknown option action2 for -ecsw_fit. Available options: terms action" offline -options_file runs/ring_on_block.opts -ecsw_fit action2 -rom /tmp/rbc_never.h5)
+rbc_bad_stage(supremizers_infsup "-pod_supremizers_infsup 1.5 out of range [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -pod_supremizers_infsup 1.5 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(offline_no_snapshot_file "give the snapshot file with -snapshots" offline -options_file runs/ring_on_block.opts -offline_stop snapshots)
 rbc_bad_stage(snapshots_subcomm "-snapshots_subcomm 3 must lie in [[]1, 1[]]" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm 3)
 rbc_bad_stage(dual_type "bogus" dualbasis -snapshots meshes/nosuch.h5:/x -dual_type bogus)

@@ -94,17 +94,32 @@ def pipeline(args):
           "mesh refined (ndofs x%.2f): largest ROM array x%.2f (R %d -> %d), longest dimension %d -> %d" % (off1["ndofs"] / ndofs, big1 / big, off["rom"]["R"], off1["rom"]["R"], longest, longest1))
     check(off["eim"]["kappa"]["kind"] == "eim" and off["eim"]["kappa"]["depends_on_u"], "kappa depends on u (measured %.2e): EIM" % off["eim"]["kappa"]["u_sensitivity"])
     check(off["eim"]["patch"]["check_max_diff"] <= 1e-12, "local contact data = full contact map at the EIM and cubature points (%.1e)" % off["eim"]["patch"]["check_max_diff"])
-    # the empirical cubature: nonnegative weights, the fit reached, and the reported residual = the RMS of
-    # the relative errors of K^ and g^ over the training states (recomputed offline from the fitted terms)
+    # the empirical cubature: nonnegative weights, the fit reached (the scene's action fit)
     c = off["ecsw"]
     eK, eg = np.array(c["train_err_K"]), np.array(c["train_err_g"])
-    rms = np.sqrt(np.mean(eK ** 2 + eg ** 2) / 2)
     print("  ECSW: Mc %d of %d points, residual %.2e (tol %.0e); per state max err K^ %.2e, g^ %.2e" % (c["M"], off["eim"]["quadrature_points"], c["residual"], c["tol"], eK.max(), eg.max()))
     check(off["rom"]["hyper"] == "ecsw" and c["M"] == off["rom"]["Mc"] and 0 < c["M"] < off["eim"]["quadrature_points"], "ECSW is the default and uses %d < %d points" % (c["M"], off["eim"]["quadrature_points"]))
     check(min(c["weights"]) > 0, "cubature weights > 0 (min %.3e)" % min(c["weights"]))
     check(c["residual"] <= c["tol"] and len(eK) == c["states"], "cubature residual %.2e <= tol %.0e on %d training states" % (c["residual"], c["tol"], c["states"]))
-    check(c["fit"] == "terms", "the scene's -ecsw_fit terms is the fit used (the residual below is in the terms measure)")
-    check(abs(rms - c["residual"]) <= 1e-3 * c["residual"], "training states: RMS of the K^, g^ errors %.4e = reported residual %.4e" % (rms, c["residual"]))
+    check(c["fit"] == "action", "the scene's -ecsw_fit action is the fit used")
+    # the supremizer enrichment (default -pod_supremizers_infsup 1): every compressed direction kept, the
+    # inf-sup constant over the training snapshots positive and growing with the kept directions
+    se = off["pod"]["supremizer_enrichment"]
+    bk = np.array(se["inf_sup_by_kept"])
+    check(se["kept"] == se["rank"] == se["candidates"] == off["pod"]["supremizers"] == off["rom"]["R"] and se["inf_sup"] == se["inf_sup_all"] > 0
+          and np.all(np.diff(bk) >= -1e-12 * bk[-1]),
+          "supremizers: %d of %d directions kept, inf-sup %.2e > 0, nondecreasing in the kept directions" % (se["kept"], se["candidates"], se["inf_sup"]))
+    check(np.all(np.isfinite(eK)) and np.all(np.isfinite(eg)) and eK.max() < 1e-2 and eg.max() < 1e-2,
+          "action fit: the terms K^, g^ themselves within 1e-2 at every training state (max %.2e, %.2e)" % (eK.max(), eg.max()))
+    # the terms fit (-ecsw_fit terms): its residual is the RMS of the relative errors of K^ and g^ over the
+    # training states, recomputed offline from the fitted terms
+    os.makedirs(d + "/terms")
+    _, offt = offline(args, d + "/terms", extra=["-ecsw_fit", "terms"])
+    ct = offt["ecsw"]
+    eKt, egt = np.array(ct["train_err_K"]), np.array(ct["train_err_g"])
+    rms = np.sqrt(np.mean(eKt ** 2 + egt ** 2) / 2)
+    check(ct["fit"] == "terms" and ct["residual"] <= ct["tol"] and min(ct["weights"]) > 0, "-ecsw_fit terms: residual %.2e <= tol %.0e, %d points, weights > 0" % (ct["residual"], ct["tol"], ct["M"]))
+    check(abs(rms - ct["residual"]) <= 1e-3 * ct["residual"], "training states: RMS of the K^, g^ errors %.4e = reported residual %.4e" % (rms, ct["residual"]))
     # the same offline stage on 1 rank: the same ROM
     d2 = d + "/np1"
     os.makedirs(d2)

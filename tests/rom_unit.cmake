@@ -15,6 +15,11 @@ rbc_add_mpi_test(NAME test_kacanov_loop RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE
 #                          parameter, affine data reproduced and second order with 2 and 3, the collinear fallback
 rbc_test_exe(test_warm_start)
 rbc_add_mpi_test(NAME test_warm_start RANKS 1 2 TIMEOUT 60 COMMAND $<TARGET_FILE:test_warm_start> LABELS rom)
+#   test_supremizers       the compressed supremizer enrichment (EnrichWithSupremizers, -pod_supremizers_infsup) on a
+#                          synthetic saddle point: orthonormal basis holding the POD modes, every reported inf-sup
+#                          constant recomputed from the returned basis, the full enrichment spans every supremizer
+rbc_test_exe(test_supremizers)
+rbc_add_mpi_test(NAME test_supremizers RANKS 1 2 TIMEOUT 60 COMMAND $<TARGET_FILE:test_supremizers> LABELS rom)
 #   test_empirical_cubature  the ECSW fit (-rom_hyper ecsw): Gram matrix vs explicit rows, Caratheodory bound on
 #                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
 rbc_test_exe(test_empirical_cubature)

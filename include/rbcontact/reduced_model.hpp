@@ -129,6 +129,7 @@ public:
   KacanovLoop loop{1e-5, 1e-4, "ROM Kacanov"};
   PetscReal   kktTol    = 1e-8;
   PetscBool   warmStart = PETSC_TRUE;
+  PetscInt    warmDegree = 2; // -rom_warm_start_degree: the polynomial fit with several parameters (warm_start.hpp)
   bool      recordIterates = false;
   ReducedQP qp;
 

@@ -4,6 +4,7 @@
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
+#include "rbcontact/supremizers.hpp"
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
@@ -150,24 +151,29 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
 
   // --- supremizers (-pod_supremizers): s_k = A^{-1} K(mu_k)^T xi_k for every dual basis vector xi_k,
   // K(mu_k) the constraint of the snapshot the greedy selected for xi_k (nmf: the snapshot whose
-  // multipliers are most aligned with xi_k), A the reference stiffness; then the enlarged primal basis
-  // is re-orthonormalized in the POD inner product (inf-sup stability of the reduced saddle point).
-  PetscBool supremizers = PETSC_FALSE;
-  PetscInt  nsup        = 0;
+  // multipliers are most aligned with xi_k), A the reference stiffness; their M-orthogonal complement to
+  // the POD modes compressed to the fewest directions that keep -pod_supremizers_infsup (default 1) of
+  // the full enrichment's inf-sup constant over the training snapshots (supremizers.hpp), and the
+  // enlarged primal basis re-orthonormalized in the POD inner product.
+  PetscBool            supremizers = PETSC_FALSE;
+  PetscInt             nsup        = 0;
+  PetscReal            supRatio    = 1;
+  SupremizerEnrichment enr;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-pod_supremizers", &supremizers, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-pod_supremizers_infsup", &supRatio, NULL));
+  PetscCheck(supRatio > 0 && supRatio <= 1, world, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]: the fraction of the full supremizer enrichment's inf-sup constant to keep (1: every supremizer direction)", (double)supRatio);
   if (supremizers && R > 0) {
-    const PetscInt r = dual.W.cols;
-    BV             Vs;
-    PetscInt       lo, hi;
+    const PetscInt   r = dual.W.cols;
+    BV               Vs;
+    PetscInt         lo, hi;
+    std::vector<Vec> sup(r);
     PetscCall(fom.SetMu(ParamValues(fom.scene)));
     PetscCall(fom.AssembleAndFactor());
-    PetscCall(BVDuplicateResize(pod.modes, pod.N + r, &Vs));
-    PetscCall(BVCopy(pod.modes, Vs)); // copies the N active columns
     PetscCall(VecGetOwnershipRange(fom.f, &lo, &hi));
     // global dof of each canonical index (owned entries only)
     std::vector<PetscInt> globalOf(header.ndofs, -1);
     for (PetscInt i = lo; i < hi; ++i) globalOf[order.CanonicalDof(i)] = i;
-    Vec rhs, sv;
+    Vec rhs;
     PetscCall(VecDuplicate(fom.f, &rhs));
     for (PetscInt k = 0; k < r; ++k) {
       PetscInt j = k < (PetscInt)dual.selected.size() ? dual.selected[k] : -1;
@@ -190,29 +196,33 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
       }
       PetscCall(VecAssemblyBegin(rhs));
       PetscCall(VecAssemblyEnd(rhs));
-      PetscCall(BVGetColumn(Vs, pod.N + k, &sv));
-      PetscCall(fom.ApplyInverse(rhs, sv));
-      PetscCall(BVRestoreColumn(Vs, pod.N + k, &sv));
+      PetscCall(VecDuplicate(fom.f, &sup[k]));
+      PetscCall(fom.ApplyInverse(rhs, sup[k]));
     }
     PetscCall(VecDestroy(&rhs));
-    PetscCall(BVSetActiveColumns(Vs, 0, pod.N + r));
-    PetscCall(BVOrthogonalize(Vs, NULL));
+    std::vector<PetscInt> canonical(order.NumDofs());
+    for (PetscInt i = 0; i < order.NumDofs(); ++i) canonical[i] = order.CanonicalDof(i);
+    PetscCall(EnrichWithSupremizers(pod.modes, sup, snaps, dual.W, canonical, supRatio, &Vs, &enr));
+    for (auto &v : sup) PetscCall(VecDestroy(&v));
+    PetscInt nv;
+    PetscCall(BVGetActiveColumns(Vs, NULL, &nv));
     // orthonormality of the enlarged basis (reported as pod.orthonormality_error)
     Mat G;
-    PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, pod.N + r, pod.N + r, NULL, &G));
+    PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, nv, nv, NULL, &G));
     PetscCall(BVDot(Vs, Vs, G));
     PetscReal err = 0;
     const PetscScalar *g;
     PetscCall(MatDenseGetArrayRead(G, &g));
-    for (PetscInt i = 0; i < pod.N + r; ++i)
-      for (PetscInt q = 0; q < pod.N + r; ++q) err = std::max(err, std::abs(PetscRealPart(g[i + q * (pod.N + r)]) - (i == q ? 1.0 : 0.0)));
+    for (PetscInt i = 0; i < nv; ++i)
+      for (PetscInt q = 0; q < nv; ++q) err = std::max(err, std::abs(PetscRealPart(g[i + q * nv]) - (i == q ? 1.0 : 0.0)));
     PetscCall(MatDenseRestoreArrayRead(G, &g));
     PetscCall(MatDestroy(&G));
     PetscCall(BVDestroy(&pod.modes));
     pod.modes               = Vs;
-    nsup                    = r;
-    pod.N                   = pod.N + r;
+    nsup                    = enr.kept;
+    pod.N                   = nv;
     pod.orthonormalityError = err;
+    PetscCall(PetscInfo(NULL, "supremizers: %" PetscInt_FMT " of %" PetscInt_FMT " compressed directions kept (inf-sup %g, all %g)\n", enr.kept, enr.rank, (double)enr.beta[enr.kept], (double)enr.beta.back()));
   }
   PetscCall(MatDestroy(&M));
   std::vector<double> modes; // N x ndofs, canonical order (group rank 0)
@@ -301,6 +311,17 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   p["energy_captured"] = (double)pod.energyCaptured;
   p["orthonormality_error"] = (double)pod.orthonormalityError;
   p["supremizers"]     = (long long)nsup;
+  if (enr.candidates > 0) {
+    JsonValue &ps             = p["supremizer_enrichment"];
+    ps["candidates"]          = (long long)enr.candidates;
+    ps["rank"]                = (long long)enr.rank;
+    ps["kept"]                = (long long)enr.kept;
+    ps["infsup_ratio"]        = (double)enr.ratio;
+    ps["inf_sup"]             = (double)enr.beta[enr.kept];
+    ps["inf_sup_all"]         = (double)enr.beta.back();
+    ps["inf_sup_by_kept"]     = enr.beta;
+    ps["sigma"]               = enr.sigma;
+  }
   if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
   rep->root["time_s"]["pod"]  = (double)(t1 - t0);
   rep->root["time_s"]["dual"] = (double)(t2 - t1);

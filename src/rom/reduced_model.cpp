@@ -340,6 +340,8 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
   PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kkt_tol", &kktTol, NULL));
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_warm_start", &warmStart, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_warm_start_degree", &warmDegree, NULL));
+  PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
@@ -600,7 +602,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     thread_local std::vector<PetscReal> width;
     width.resize(np);
     for (size_t i = 0; i < np; ++i) width[i] = par.params[i].max - par.params[i].min;
-    for (const auto &[k, w] : WarmStartWeights(warmMu, width, mu)) {
+    for (const auto &[k, w] : WarmStartWeights(warmMu, width, mu, (int)warmDegree)) {
       for (PetscInt i = 0; i < Na; ++i) sol->v[i] += w * warmV[k * Nfull + cols_[i]];
       for (PetscInt i = 0; i < r; ++i) sol->lambda[i] += w * warmL[k * Rfull + i];
     }
