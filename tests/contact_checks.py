@@ -8,10 +8,12 @@ test (uniform pressure), the elastic solution (a gap larger than any motion), KK
 1 vs 2 ranks, the matrix-free dual (-fom_dual_matrix shell) against the dense one.
 """
 import argparse
+import atexit
 import json
 import os
 import re
 import subprocess
+import shutil
 import sys
 import tempfile
 
@@ -21,6 +23,13 @@ import numpy as np
 FAILED = []
 
 
+def workdir(prefix):
+    """A temporary directory, removed when the script exits (pass or fail)."""
+    d = tempfile.mkdtemp(prefix=prefix)
+    atexit.register(shutil.rmtree, d, True)
+    return d
+
+
 def check(cond, msg):
     print(("  ok    " if cond else "  FAIL  ") + msg)
     if not cond:
@@ -28,7 +37,7 @@ def check(cond, msg):
 
 
 def run(args, np_, opts, extra, tag):
-    out = tempfile.mkdtemp(prefix="rbc_contact_")
+    out = workdir("rbc_contact_")
     rep = os.path.join(out, tag + ".json")
     h5 = os.path.join(out, tag + ".h5")
     cmd = ["mpirun", "-n", str(np_), args.exe, "fom", "-options_file", opts] + extra + ["-report", rep, "-fom_output", h5]
@@ -200,7 +209,7 @@ def dual_shell(args):
     # TAO phase (-fom_dual_shell_tao, TAO prefix fom_) before the active-set method: BQPIP (default type,
     # a MATSHELL Hessian it shifts in place), BLMVM (no Hessian), GPCG (H(free, free) as a submatrix);
     # the active-set method polishes, so the answer is the dense one
-    out = tempfile.mkdtemp(prefix="rbc_contact_")
+    out = workdir("rbc_contact_")
     for s, opts in [("ring_on_block", ["-mu", "0.95"]), ("hertz", [])]:
         tag = s + "".join(opts)
         rd, h5d = dense[tag]
@@ -240,7 +249,7 @@ def nan_input(args):
     output stays byte-identical (with and without contact)."""
     import hashlib
     print("Non-finite input: refused up front, earlier output kept")
-    out = tempfile.mkdtemp(prefix="rbc_nan_")
+    out = workdir("rbc_nan_")
     h5 = os.path.join(out, "good.h5")
     for contact in ("1", "0"):
         cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts", "-contact", contact, "-fom_output", h5]

@@ -9,6 +9,7 @@
   mismatch    a snapshot file from another scene / parameter box is refused with a clear error.
 """
 import argparse
+import atexit
 import json
 import os
 import signal
@@ -23,6 +24,13 @@ import numpy as np
 
 FAILED = []
 os.environ["HDF5_USE_FILE_LOCKING"] = "FALSE"  # read while another process writes
+
+
+def workdir(prefix):
+    """A temporary directory, removed when the script exits (pass or fail)."""
+    d = tempfile.mkdtemp(prefix=prefix)
+    atexit.register(shutil.rmtree, d, True)
+    return d
 
 
 def check(cond, msg):
@@ -69,7 +77,7 @@ def compare(a, b, tol, what):
 
 
 def ring(args):
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     base = ["-train_type", "grid", "-train_size", "21"]
     run(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", d + "/s1.h5", "-report", d + "/r1.json"])
     run(args, 2, "runs/ring_on_block.opts", base + ["-snapshots", d + "/s2.h5", "-report", d + "/r2.json", "-snapshots_subcomm", "2", "-snapshots_monitor"])
@@ -90,7 +98,7 @@ def ring(args):
 
 
 def half_disks(args):
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     run(args, 2, "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "5", "-snapshots", d + "/s.h5", "-report", d + "/r.json"])
     r = report(d + "/r.json")
     print("  half_disks: %d solves, Kacanov its %s, snapshots %.2f s, affine terms %s" % (r["fom_solves"], r["kacanov_iterations"], r["time_s"]["snapshots"], {k: r["affine_terms"][k] for k in ("A", "f")}))
@@ -103,7 +111,7 @@ def half_disks(args):
 
 
 def resume(args):
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     base = ["-train_type", "grid", "-train_size", "21"]
     run(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", d + "/clean.h5"])
     path = d + "/killed.h5"
@@ -135,7 +143,7 @@ def resume(args):
 
 
 def mismatch(args):
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     run(args, 1, "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-snapshots", d + "/s.h5"])
     cases = [("another scene", "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "3"]),
              ("another parameter box", "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-mu_max", "1.1"]),
@@ -167,7 +175,7 @@ def mismatch(args):
 
 def bases(args):
     """POD + the four dual types on the seed's set-up; 1 vs 2 ranks; nonnegativity; orthonormality."""
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     base = ["-train_type", "grid", "-train_size", "21", "-snapshots", d + "/s.h5", "-pod_tol", "1e-8", "-dual_tol", "1e-3", "-dual_tol_relative"]
     table = []
     for t in ("cpg", "mcpg", "angle", "nmf"):
@@ -211,7 +219,7 @@ def bases(args):
 
 def dualbasis_import(args):
     """`dualbasis` on a multiplier matrix written by another code (HDF5 dataset and the transposed layout)."""
-    d = tempfile.mkdtemp(prefix="rbc_off_")
+    d = workdir("rbc_off_")
     x = np.linspace(-1, 1, 120)
     cols = []
     for k in range(15):

@@ -66,7 +66,7 @@ static std::string RelativeTo(const std::string &path, const std::string &file)
   return ec || r.empty() ? path : r.string();
 }
 
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, const std::string &basisPath)
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath)
 {
   PetscMPIInt    wrank;
   PetscLogDouble t0, t1, t2;
@@ -236,7 +236,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   }
 
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
-  const std::string &bpath = cmap ? basisPath : romPath;
+  const std::string &bpath = onlineRom ? basisPath : romPath;
   RomWriter          w, wr;
   // rom_id: one id for the files of this run (ROM and basis file), checked when they are read together
   std::string romId;
@@ -270,8 +270,9 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   }
   // the bases alone (-offline_stop bases) are written now; with the online ROM, after it is built, so
   // that a failed run leaves the previous ROM and basis file together (and rom_id tells a torn pair)
-  if (!cmap) PetscCall(w.Write(world, bpath));
-  if (cmap) {
+  if (!onlineRom) PetscCall(w.Write(world, bpath));
+  if (onlineRom) {
+    PetscCheck(cmap, world, PETSC_ERR_ARG_WRONGSTATE, "offline: the online ROM needs the contact surfaces (-contact_slave, -contact_master)");
     // the online ROM: everything the online stage needs, nothing of the size of the mesh
     MPI_Comm    fcomm = PetscObjectComm((PetscObject)fom.dm);
     PetscMPIInt frank;

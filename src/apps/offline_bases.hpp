@@ -12,9 +12,10 @@
 namespace rbc {
 
 // group: the ranks of fom (a subcommunicator of world); world rank 0 writes romPath.
-// cmap null: bases only (-offline_stop bases), written to romPath (format_version 1). Otherwise the
-// bases go to basisPath and the online ROM (format_version 2, src/apps/offline_rom.cpp) to romPath.
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, const std::string &basisPath = "");
+// cmap: the scene's contact surfaces (null without contact; -dual_mass_weighted and the online ROM need
+// them). onlineRom false: bases only (-offline_stop bases), written to romPath (format_version 1);
+// true: the bases go to basisPath and the online ROM (format_version 2, src/apps/offline_rom.cpp) to romPath.
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "");
 
 // Report keys dual {type, r, train_max_err, train_max_rel_err, history, tol_abs, norm, gram_cond,
 // selected, min_entry} and nnls {solves, max_kkt, retries}; a negative basis entry is an error.

@@ -329,7 +329,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
     rep.root["snapshots"]             = snapPath;
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
-      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep, full ? &cmap : nullptr, basisPath));
+      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep, scene.contact ? &cmap : nullptr, full, basisPath));
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }
