@@ -218,6 +218,7 @@ def bad_input(args):
     expect_error(args, ["-rom", rom, "-rom_kacanov_relaxation", "1.5"], ["-rom_kacanov_relaxation", "1.5"], "-rom_kacanov_relaxation out of range")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
     expect_error(args, ["-rom", rom, "-rom_kacanov_anderson", "11"], ["-rom_kacanov_anderson", "11"], "-rom_kacanov_anderson out of range")
+    expect_error(args, ["-rom", rom, "-rom_warm_start_degree", "3"], ["-rom_warm_start_degree", "3"], "-rom_warm_start_degree out of range")
     # Anderson mixing (default depth 3) and the plain fixed point reach the same reduced solution
     for m in ("0", "3"):
         run(args, 1, "online", ["-rom", rom, "-mu", "1.11", "-rom_kacanov_anderson", m, "-rom_kacanov_rtol_primal", "1e-10",
