@@ -26,6 +26,9 @@ struct SupremizerEnrichment {
   std::vector<PetscReal> sigma;          // M-norms of the compressed directions before normalization
 };
 
+// -pod_supremizers_infsup (default 1), checked to lie in (0, 1].
+PetscErrorCode SupremizerRatioFromOptions(MPI_Comm comm, PetscReal *ratio);
+
 // pod: the POD modes (Np M-orthonormal columns, active columns 0..Np); sup: the supremizers (same
 // layout); snaps[j].extra "contact_K" (R x nD row-major) and "contact_dofs" (canonical); W: the dual
 // basis (R x r); canonical[g]: the canonical index of global dof g (CanonicalOrder::CanonicalDof).

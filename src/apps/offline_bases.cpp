@@ -157,11 +157,10 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   // enlarged primal basis re-orthonormalized in the POD inner product.
   PetscBool            supremizers = PETSC_FALSE;
   PetscInt             nsup        = 0;
-  PetscReal            supRatio    = 1;
+  PetscReal            supRatio;
   SupremizerEnrichment enr;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-pod_supremizers", &supremizers, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-pod_supremizers_infsup", &supRatio, NULL));
-  PetscCheck(supRatio > 0 && supRatio <= 1, world, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]: the fraction of the full supremizer enrichment's inf-sup constant to keep (1: every supremizer direction)", (double)supRatio);
+  PetscCall(SupremizerRatioFromOptions(world, &supRatio));
   if (supremizers && R > 0) {
     const PetscInt   r = dual.W.cols;
     BV               Vs;

@@ -6,6 +6,7 @@
 #include "offline_bases.hpp"
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
+#include "rbcontact/supremizers.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/fom.hpp"
@@ -98,9 +99,8 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
   { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
-    PetscReal supRatio = 1;
-    PetscCall(PetscOptionsGetReal(NULL, NULL, "-pod_supremizers_infsup", &supRatio, NULL));
-    PetscCheck(supRatio > 0 && supRatio <= 1, world, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]: the fraction of the full supremizer enrichment's inf-sup constant to keep (1: every supremizer direction)", (double)supRatio);
+    PetscReal supRatio;
+    PetscCall(SupremizerRatioFromOptions(world, &supRatio));
   }
   if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
     EIMOptions  eo;

@@ -31,6 +31,15 @@ PetscErrorCode SymmetricEigen(PetscInt n, bool vectors, std::vector<PetscReal> *
 
 } // namespace
 
+PetscErrorCode SupremizerRatioFromOptions(MPI_Comm comm, PetscReal *ratio)
+{
+  PetscFunctionBeginUser;
+  *ratio = 1;
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-pod_supremizers_infsup", ratio, NULL));
+  PetscCheck(*ratio > 0 && *ratio <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]: the fraction of the full supremizer enrichment's inf-sup constant to keep (1: every supremizer direction)", (double)*ratio);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const std::vector<Snapshot> &snaps, const DenseMatrix &W, const std::vector<PetscInt> &canonical, PetscReal ratio, BV *out, SupremizerEnrichment *info)
 {
   MPI_Comm comm;
@@ -40,7 +49,7 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectGetComm((PetscObject)pod, &comm));
-  PetscCheck(ratio > 0 && ratio <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]", (double)ratio);
+  PetscCheck(ratio > 0 && ratio <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "supremizers: inf-sup ratio %g out of range (0, 1]", (double)ratio);
   PetscCall(BVGetActiveColumns(pod, &l0, &Np));
   const PetscInt r = (PetscInt)sup.size(), R = W.rows;
   PetscCheck(W.cols == r && r > 0, comm, PETSC_ERR_ARG_SIZ, "supremizers: %" PetscInt_FMT " supremizers for %" PetscInt_FMT " dual vectors", r, W.cols);

@@ -594,7 +594,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   }
   Operators(mu, &A_, &f_);
   // warm start: a combination of the stored reduced solutions of the training parameters (the bracketing
-  // interpolation with one parameter, an affine least-squares fit with several: warm_start.hpp); the
+  // interpolation with one parameter, a quadratic or affine least-squares fit with several: warm_start.hpp); the
   // multipliers clipped to the cone
   const size_t np = par.params.size(), nw = np ? warmMu.size() / np : 0;
   const bool   warmed = warmStart && nw > 0;

@@ -10,17 +10,14 @@ namespace rbc {
 namespace {
 
 // Least-squares fit by the m monomials of degree <= deg in the scaled offsets (1, x_i, and x_i x_j for
-// i <= j) over the k nearest training parameters (ties by index: deterministic). The fit's value at mu
+// i <= j) over the k nearest training parameters (order: sorted by distance, ties by index). The fit's value at mu
 // is its intercept c' y with c = X z, G z = e_0, G = X'X. Empty when the points do not determine the fit
 // (a pivot^2 of the Cholesky factor of G below 1e-10 of G's largest diagonal entry).
 template <class Scaled>
-std::vector<std::pair<size_t, PetscReal>> FitOver(const std::vector<PetscReal> &mus, size_t np, const std::vector<PetscReal> &d, Scaled scaled, int deg, size_t k)
+std::vector<std::pair<size_t, PetscReal>> FitOver(const std::vector<size_t> &order, size_t np, Scaled scaled, int deg, size_t k)
 {
-  const size_t nw = mus.size() / np, m = deg >= 2 ? (np + 1) * (np + 2) / 2 : np + 1;
-  if (k < m || k > nw) return {};
-  std::vector<size_t> order(nw);
-  std::iota(order.begin(), order.end(), 0);
-  std::partial_sort(order.begin(), order.begin() + k, order.end(), [&](size_t a, size_t b) { return d[a] < d[b] || (d[a] == d[b] && a < b); });
+  const size_t m = deg >= 2 ? (np + 1) * (np + 2) / 2 : np + 1;
+  if (k < m || k > order.size()) return {};
   std::vector<PetscReal> X(k * m), G(m * m, 0.0), z(m, 0.0);
   for (size_t j = 0; j < k; ++j) {
     PetscReal *x = &X[j * m];
@@ -55,11 +52,11 @@ std::vector<std::pair<size_t, PetscReal>> FitOver(const std::vector<PetscReal> &
 // The fit over the 2 m - 1 nearest (2 np + 1 for the affine fit); a quadratic one, when those do not
 // determine it (nearest points on too few grid lines), over 3 m and then 5 m nearest.
 template <class Scaled>
-std::vector<std::pair<size_t, PetscReal>> PolynomialFit(const std::vector<PetscReal> &mus, size_t np, const std::vector<PetscReal> &d, Scaled scaled, int deg)
+std::vector<std::pair<size_t, PetscReal>> PolynomialFit(const std::vector<size_t> &order, size_t np, Scaled scaled, int deg)
 {
-  const size_t nw = mus.size() / np, m = deg >= 2 ? (np + 1) * (np + 2) / 2 : np + 1;
+  const size_t nw = order.size(), m = deg >= 2 ? (np + 1) * (np + 2) / 2 : np + 1;
   for (size_t k : {2 * m - 1, 3 * m, 5 * m}) {
-    auto w = FitOver(mus, np, d, scaled, deg, std::min(k, nw));
+    auto w = FitOver(order, np, scaled, deg, std::min(k, nw));
     if (!w.empty() || deg < 2 || k >= nw) return w;
   }
   return {};
@@ -86,12 +83,18 @@ std::vector<std::pair<size_t, PetscReal>> WarmStartWeights(const std::vector<Pet
     const PetscReal t = (mu[0] - mus[lo]) / (mus[hi] - mus[lo]);
     return {{lo, 1 - t}, {hi, t}};
   }
-  // a quadratic, else an affine least-squares fit over the nearest training parameters, evaluated at mu
+  // a quadratic, else an affine least-squares fit over the nearest training parameters, evaluated at mu;
+  // the nearest sorted once (at most 5 m of the quadratic fit are used)
+  const size_t        ks = std::min(nw, 5 * ((np + 1) * (np + 2) / 2));
+  std::vector<size_t> order(nw);
+  std::iota(order.begin(), order.end(), 0);
+  std::partial_sort(order.begin(), order.begin() + ks, order.end(), [&](size_t a, size_t b) { return d[a] < d[b] || (d[a] == d[b] && a < b); });
+  order.resize(ks);
   if (degree >= 2) {
-    auto w = PolynomialFit(mus, np, d, scaled, 2);
+    auto w = PolynomialFit(order, np, scaled, 2);
     if (!w.empty()) return w;
   }
-  auto w = PolynomialFit(mus, np, d, scaled, 1);
+  auto w = PolynomialFit(order, np, scaled, 1);
   if (!w.empty()) return w;
   return {{nearest, 1.0}};
 }
