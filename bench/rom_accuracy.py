@@ -79,7 +79,7 @@ def rom_table(args, work):
             if t["max_rel_err_u"] > 1.5 * x["max_rel_err_u"] or ratio > 1.5: miss.append("1.5x exact")
             if v["online_time_s"]["median"] > online_target: miss.append("time")
             if name.startswith("ring") and (ro["N"] > 30 or ro["R"] > 30): miss.append("N,R")
-            rows.append(dict(case=name, ndofs=ro["ndofs"], train=off.get("ntrain", off.get("training_parameters")), hyper=hyper,
+            rows.append(dict(case=name, ndofs=ro["ndofs"], train=off.get("greedy", {}).get("training_set_size", off.get("ntrain", off.get("training_parameters"))), hyper=hyper,
                              N=ro["N"], R=ro["R"], size=size, u=t["max_rel_err_u"], lam=t["max_rel_err_lambda"], force=t["max_rel_err_force"],
                              xu=x["max_rel_err_u"], xlam=x["max_rel_err_lambda"], ratio=ratio, online=v["online_time_s"]["median"],
                              offline=off["time_s"].get("total", t_off), miss=",".join(miss) or "-"))

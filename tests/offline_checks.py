@@ -7,6 +7,9 @@
   resume      a run killed (SIGKILL) after a few snapshots, resumed with -snapshots_restart: only the
               missing ones are solved and the file equals a clean run's.
   mismatch    a snapshot file from another scene / parameter box is refused with a clear error.
+  greedy      -train_type greedy on ring_on_block: the same picks on 1 and 2 ranks, each round's first pick
+              the largest indicator, the separation, the snapshot file holding exactly the picks, a
+              resumed run continuing where the budget stopped, the ROM validated against the targets.
 """
 import argparse
 import atexit
@@ -251,9 +254,67 @@ def dualbasis_import(args):
     check(p.returncode != 0 and "nosuch" in p.stdout, "a missing dataset is an error naming it")
 
 
+def greedy(args):
+    d = workdir("rbc_off_")
+    base = ["-options_file", "runs/ring_on_block.opts", "-train_type", "greedy", "-greedy_candidates_size", "60", "-greedy_batch", "2", "-greedy_tol", "1e-12"]
+
+    def off(np_, tag, budget, extra=()):
+        c = ["mpirun", "-n", str(np_), args.exe, "offline"] + base + ["-greedy_max_solves", str(budget), "-rom", "%s/%s.h5" % (d, tag), "-report", "%s/%s.json" % (d, tag)] + list(extra)
+        p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if p.returncode != 0:
+            print(p.stdout[-4000:])
+            sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
+        return report("%s/%s.json" % (d, tag))
+
+    r1, r2 = off(1, "g1", 6, ["-greedy_monitor"]), off(2, "g2", 6)
+    g1, g2 = r1["greedy"], r2["greedy"]
+    for rd in g1["rounds"]:
+        print("  round %d: %d solves, N %d, R %d, max indicator %.3e (residual %.3e, penetration %.3e), picked %s"
+              % (rd["round"], rd["solves"], rd["N"], rd["R"], rd["max_indicator"], rd["max_residual"], rd["max_penetration"], rd["picked"]))
+    check(g1["training_set_size"] == 6 and g1["stop"] == "max_solves" and g1["initial"] == 2 and g1["candidates"] == 60,
+          "6 FOM solves: the 2 ends of the radius box, then 2 picks a round among 60 candidates (stop: %s)" % g1["stop"])
+    check(g1["training_indices"] == g2["training_indices"], "np 1 and np 2 pick the same parameters %s" % g1["training_indices"])
+    check(abs(g1["rounds"][-1]["max_indicator"] - g2["rounds"][-1]["max_indicator"]) <= 1e-6 * g1["rounds"][-1]["max_indicator"],
+          "np 1 and np 2: the same last max indicator (%.6e, %.6e)" % (g1["rounds"][-1]["max_indicator"], g2["rounds"][-1]["max_indicator"]))
+    with h5py.File(d + "/g1.snapshots.h5", "r") as f:
+        pool = np.array(f["train/points"])
+        done = np.nonzero(np.array(f["snapshots/done"]))[0].tolist()
+    check(len(pool) == 62 and done == sorted(int(i) for i in g1["training_indices"]), "the snapshot file's pool has 62 points, its done rows are exactly the 6 picks")
+    ok_arg, ok_sep, ok_res = True, True, True
+    for rd in g1["rounds"]:
+        if rd["picked"]:
+            ok_arg = ok_arg and np.allclose(pool[int(rd["picked"][0])], rd["argmax"], rtol=0, atol=1e-15)
+            p = [pool[int(i)][0] for i in rd["picked"]]
+            ok_sep = ok_sep and all(abs(a - b) / 0.2 >= g1["separation"] for i, a in enumerate(p) for b in p[:i])
+        ok_res = ok_res and rd["max_indicator"] == rd["max_residual"]
+    check(ok_arg, "every round's first pick is the candidate of largest indicator")
+    check(ok_sep, "the picks of a round lie at least -greedy_separation (%.3f of the box) apart" % g1["separation"])
+    check(ok_res and g1["indicator"] == "residual", "the default criterion is the residual")
+    check(g1["rounds"][-1]["max_indicator"] < g1["rounds"][0]["max_indicator"], "the max indicator falls: %.2e after the initial set, %.2e before the last picks" % (g1["rounds"][0]["max_indicator"], g1["rounds"][-1]["max_indicator"]))
+    # a budget reached, then raised on the same files: the run resumes with the snapshots done
+    off(1, "g3", 4)
+    r3 = off(1, "g3", 6)
+    check(r3["resumed"] == 4 and r3["fom_solves"] == 2, "budget 4 then 6 on the same file: 4 resumed, 2 solved (%d, %d)" % (r3["resumed"], r3["fom_solves"]))
+    check(r3["greedy"]["training_indices"] == g1["training_indices"], "the resumed run ends with the same picks as the straight one")
+    # the ROM the greedy built, validated on the test set of the ROM-accuracy targets
+    p = subprocess.run(["mpirun", "-n", "2", args.exe, "validate", "-options_file", "runs/ring_on_block.opts", "-rom", d + "/g2.h5", "-report", d + "/v.json"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode == 0, "validate runs on the greedy ROM")
+    if p.returncode == 0:
+        t = report(d + "/v.json")["test"]
+        print("  validate, 6 FOM solves: max rel err u %.2e, lambda %.2e, force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
+        check(t["max_rel_err_u"] <= 1e-4 and t["max_rel_err_lambda"] <= 1e-2 and t["max_rel_err_force"] <= 1e-3, "the 6-solve greedy ROM meets u <= 1e-4, lambda <= 1e-2, force <= 1e-3 on 20 random radii")
+    # refused: a greedy run that stops before the ROM, an unknown criterion
+    for extra, needle in ((["-offline_stop", "snapshots", "-snapshots", d + "/x.h5"], "-train_type greedy builds the reduced model"),
+                          (["-greedy_indicator", "bogus"], "bogus")):
+        c = ["mpirun", "-n", "1", args.exe, "offline"] + base + ["-rom", d + "/never.h5"] + extra
+        p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and needle in p.stdout, "refused with a message naming '%s'" % needle)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

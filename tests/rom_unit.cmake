@@ -30,3 +30,8 @@ rbc_test_exe(test_dense_kernels)
 rbc_add_mpi_test(NAME test_dense_kernels RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dense_kernels> LABELS rom)
 rbc_add_mpi_test(NAME test_dense_kernels_portable RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dense_kernels> LABELS rom)
 set_property(TEST test_dense_kernels_portable_np1 APPEND PROPERTY ENVIRONMENT RBC_KERNELS_PORTABLE=1)
+#   test_greedy_indicator  the greedy training's indicator (GreedyIndicator) against the FOM: zero at the converged
+#                          contact solution (two radii), ||e||_X / ||u + e||_X for a perturbation off the contact
+#                          surfaces, the penetration of 1.2 u; GreedyPick's order and separation
+rbc_test_exe(test_greedy_indicator)
+rbc_add_mpi_test(NAME test_greedy_indicator RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FILE:test_greedy_indicator> -options_file runs/ring_on_block.opts LABELS rom)

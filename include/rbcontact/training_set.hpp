@@ -20,7 +20,9 @@ struct ParameterSet {
 // a point outside is an error naming the file/line or option. Same result on every rank.
 // (Added) Defaults: type grid, size 10, seed 0. Grid: endpoints exact, one point = the box centre,
 // last parameter fastest; random/lhs: xoshiro256** seeded by splitmix64(seed).
-PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpec> &params, const char *prefix, ParameterSet *set);
+// defType, defSize, defSeed: the type, size and seed when the options do not give them (the greedy's
+// candidate and initial sets have other defaults than a training set).
+PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpec> &params, const char *prefix, ParameterSet *set, const char *defType = "grid", PetscInt defSize = 10, PetscInt defSeed = 0);
 
 // Pure generators (no options): deterministic for a given seed, independent of the platform's
 // std::uniform_real_distribution (use an explicit 64-bit generator, e.g. splitmix64/xoshiro).

@@ -31,7 +31,8 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name)
   static const Family fam[] = {{"train_", "offline"},      {"snapshots", "offline dualbasis"}, {"offline_", "offline"}, {"pod_", "offline"},
                                {"dual_", "offline dualbasis"}, {"nnls_", "offline dualbasis"}, {"mcpg_", "offline dualbasis"}, {"nmf_", "offline dualbasis"},
                                {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate"}, {"online_", "online"},
-                               {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"}};
+                               {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"},
+                               {"greedy_", "offline"}};
   std::string skipped; // families of the offline steps -offline_stop leaves out
   if (stage == "offline") {
     char      stop[32] = "";
@@ -39,6 +40,11 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name)
     (void)PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, &set);
     if (set && !std::strcmp(stop, "snapshots")) skipped = " pod_ dual_ nnls_ mcpg_ nmf_ eim_ ecsw_ rom_ ";
     else if (set && !std::strcmp(stop, "bases")) skipped = " eim_ ecsw_ rom_ ";
+    // a scene file may ship both trainings' settings: the greedy's (-greedy_*) with a grid run, -train_size with a greedy one
+    char type[32] = "";
+    (void)PetscOptionsGetString(NULL, NULL, "-train_type", type, sizeof type, NULL);
+    if (!std::strcmp(type, "greedy") && name != "train_type") skipped += " train_ ";
+    else skipped += " greedy_ ";
   }
   for (const auto &f : fam)
     if (name.compare(0, std::strlen(f.prefix), f.prefix) == 0)

@@ -66,22 +66,18 @@ static std::string RelativeTo(const std::string &path, const std::string &file)
   return ec || r.empty() ? path : r.string();
 }
 
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath)
+PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b)
 {
-  PetscMPIInt    wrank;
   PetscLogDouble t0, t1, t2;
   char           inner[32] = "energy";
+  const PetscInt m = (PetscInt)snaps.size();
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_rank(world, &wrank));
-  std::vector<Snapshot> snaps;
-  PetscCall(SnapshotFile::ReadAll(snapPath, &snaps));
-  const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size();
-  PetscCheck(m == ntrain, world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
-
+  PetscCheck(m > 0, world, PETSC_ERR_ARG_SIZ, "offline: no snapshot to build the bases from");
   // --- primal: POD in the chosen inner product of the reference configuration
   PetscCall(PetscTime(&t0));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pod_inner", inner, sizeof inner, NULL));
+  b->inner = inner;
   Mat M = nullptr;
   if (!strcmp(inner, "energy")) {
     Vec fref = nullptr;
@@ -106,14 +102,15 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     }
     PetscCall(VecDestroy(&tmpl));
   }
-  PODResult pod;
+  PODResult &pod = b->pod;
+  PetscCall(BVDestroy(&pod.modes));
   PetscCall(ComputePOD(X, M, &pod));
   for (auto &v : X) PetscCall(VecDestroy(&v));
   PetscCall(PetscTime(&t1));
 
   // --- dual: nonnegative basis of the multiplier snapshots (every rank, redundant and deterministic)
-  DualBasisResult dual;
-  const PetscInt  R = header.nmult;
+  DualBasisResult &dual = b->dual;
+  dual                  = DualBasisResult();
   if (R > 0) {
     DenseMatrix L;
     L.Resize(R, m);
@@ -140,12 +137,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     if (massWeighted)
       for (PetscInt k = 0; k < dual.W.cols; ++k)
         for (PetscInt i = 0; i < R; ++i) dual.W(i, k) = sw[i] > 0 ? dual.W(i, k) / sw[i] : 0.0;
-    rep->root["dual_mass_weighted"] = (bool)massWeighted;
-    // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
-    // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
-    const bool tooCoarse = dual.W.cols >= m - 1 && m > 2;
-    rep->root["dual_kept_all_snapshots"] = tooCoarse;
-    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", dual.W.cols, m));
+    b->massWeighted = massWeighted;
   }
   PetscCall(PetscTime(&t2));
 
@@ -155,10 +147,12 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   // the POD modes compressed to the fewest directions that keep -pod_supremizers_infsup (default 1) of
   // the full enrichment's inf-sup constant over the training snapshots (supremizers.hpp), and the
   // enlarged primal basis re-orthonormalized in the POD inner product.
-  PetscBool            supremizers = PETSC_FALSE;
-  PetscInt             nsup        = 0;
-  PetscReal            supRatio;
-  SupremizerEnrichment enr;
+  PetscBool             supremizers = PETSC_FALSE;
+  PetscInt             &nsup        = b->nsup;
+  PetscReal             supRatio;
+  SupremizerEnrichment &enr = b->enr;
+  nsup                      = 0;
+  enr                       = SupremizerEnrichment();
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-pod_supremizers", &supremizers, NULL));
   PetscCall(SupremizerRatioFromOptions(world, &supRatio));
   if (supremizers && R > 0) {
@@ -170,7 +164,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(fom.AssembleAndFactor());
     PetscCall(VecGetOwnershipRange(fom.f, &lo, &hi));
     // global dof of each canonical index (owned entries only)
-    std::vector<PetscInt> globalOf(header.ndofs, -1);
+    std::vector<PetscInt> globalOf(order.NumDofs(), -1);
     for (PetscInt i = lo; i < hi; ++i) globalOf[order.CanonicalDof(i)] = i;
     Vec rhs;
     PetscCall(VecDuplicate(fom.f, &rhs));
@@ -224,7 +218,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(PetscInfo(NULL, "supremizers: %" PetscInt_FMT " of %" PetscInt_FMT " compressed directions kept (inf-sup %g, all %g)\n", enr.kept, enr.rank, (double)enr.beta[enr.kept], (double)enr.beta.back()));
   }
   PetscCall(MatDestroy(&M));
-  std::vector<double> modes; // N x ndofs, canonical order (group rank 0)
+  std::vector<double> &modes = b->modes; // N x ndofs, canonical order, on every rank of fom's communicator
+  modes.clear();
   for (PetscInt j = 0; j < pod.N; ++j) {
     Vec                 v;
     std::vector<double> c;
@@ -232,6 +227,44 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(order.DofsToCanonical(v, &c));
     PetscCall(BVRestoreColumn(pod.modes, j, &v));
     modes.insert(modes.end(), c.begin(), c.end());
+  }
+  {
+    MPI_Comm           fcomm = PetscObjectComm((PetscObject)fom.dm);
+    unsigned long long nm    = modes.size();
+    PetscCallMPI(MPI_Bcast(&nm, 1, MPI_UNSIGNED_LONG_LONG, 0, fcomm));
+    modes.resize(nm);
+    PetscCallMPI(MPI_Bcast(modes.data(), (int)nm, MPI_DOUBLE, 0, fcomm));
+  }
+  b->seconds[0] = t1 - t0;
+  b->seconds[1] = t2 - t1;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath, bool partial)
+{
+  PetscMPIInt     wrank;
+  OfflineBasisSet bs;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  std::vector<Snapshot> snaps;
+  PetscCall(SnapshotFile::ReadAll(snapPath, &snaps));
+  const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size(), R = header.nmult;
+  PetscCheck(m == ntrain || (partial && m > 0), world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
+  PetscCall(BuildBases(world, fom, order, snaps, R, cmap, &bs));
+  PODResult            &pod   = bs.pod;
+  DualBasisResult      &dual  = bs.dual;
+  const PetscInt        nsup  = bs.nsup;
+  SupremizerEnrichment &enr   = bs.enr;
+  std::vector<double>  &modes = bs.modes;
+  const char           *inner = bs.inner.c_str();
+  if (R > 0) {
+    rep->root["dual_mass_weighted"] = bs.massWeighted;
+    // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
+    // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
+    const bool tooCoarse = dual.W.cols >= m - 1 && m > 2;
+    rep->root["dual_kept_all_snapshots"] = tooCoarse;
+    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", dual.W.cols, m));
   }
 
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
@@ -273,13 +306,6 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   if (onlineRom) {
     PetscCheck(cmap, world, PETSC_ERR_ARG_WRONGSTATE, "offline: the online ROM needs the contact surfaces (-contact_slave, -contact_master)");
     // the online ROM: everything the online stage needs, nothing of the size of the mesh
-    MPI_Comm    fcomm = PetscObjectComm((PetscObject)fom.dm);
-    PetscMPIInt frank;
-    PetscCallMPI(MPI_Comm_rank(fcomm, &frank));
-    unsigned long long nm = modes.size();
-    PetscCallMPI(MPI_Bcast(&nm, 1, MPI_UNSIGNED_LONG_LONG, 0, fcomm));
-    modes.resize(nm);
-    PetscCallMPI(MPI_Bcast(modes.data(), (int)nm, MPI_DOUBLE, 0, fcomm));
     PetscCheck(R > 0, world, PETSC_ERR_SUP, "offline: no multipliers (R = 0): nothing to reduce for contact");
     wr.version = 2;
     if (wrank == 0) {
@@ -323,8 +349,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     ps["sigma"]               = enr.sigma;
   }
   if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
-  rep->root["time_s"]["pod"]  = (double)(t1 - t0);
-  rep->root["time_s"]["dual"] = (double)(t2 - t1);
+  rep->root["time_s"]["pod"]  = (double)bs.seconds[0];
+  rep->root["time_s"]["dual"] = (double)bs.seconds[1];
   rep->root["rom_file"]       = romPath;
   PetscFunctionReturn(0);
 }

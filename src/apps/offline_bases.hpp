@@ -1,5 +1,5 @@
 // src/apps/offline_bases.hpp: the bases step of the offline stage (-offline_stop bases): primal POD
-// and nonnegative dual basis from a complete snapshot file, written to the ROM file.
+// and nonnegative dual basis from a snapshot file (or snapshots in memory), written to the ROM file.
 #pragma once
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/contact.hpp"
@@ -7,7 +7,9 @@
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/report.hpp"
+#include "rbcontact/pod.hpp"
 #include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/supremizers.hpp"
 
 namespace rbc {
 
@@ -15,7 +17,24 @@ namespace rbc {
 // cmap: the scene's contact surfaces (null without contact; -dual_mass_weighted and the online ROM need
 // them). onlineRom false: bases only (-offline_stop bases), written to romPath (format_version 1);
 // true: the bases go to basisPath and the online ROM (format_version 2, src/apps/offline_rom.cpp) to romPath.
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "");
+// partial: the training set is the done snapshots of the file (a greedy run declares its candidate pool);
+// otherwise every training point must be done.
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "", bool partial = false);
+
+// The bases of a set of snapshots, in memory (the bases step, and every round of the greedy training).
+struct OfflineBasisSet {
+  PODResult            pod;   // pod.modes: N columns on fom's DM, the POD modes then nsup supremizers
+  DualBasisResult      dual;  // the nonnegative dual basis (R > 0)
+  PetscInt             nsup = 0;
+  SupremizerEnrichment enr;
+  std::string          inner = "energy"; // -pod_inner
+  std::vector<double>  modes;            // the same N columns, N x ndofs canonical, on every rank of fom's communicator
+  bool                 massWeighted = false;
+  PetscLogDouble       seconds[2]   = {0, 0}; // POD, dual basis
+};
+// POD (-pod_*), dual basis (-dual_*), supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no
+// contact). Collective on fom's communicator; world names the stage in messages.
+PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b);
 
 // Report keys dual {type, r, train_max_err, train_max_rel_err, history, tol_abs, norm, gram_cond,
 // selected, min_entry} and nnls {solves, max_kkt, retries}; a negative basis entry is an error.

@@ -68,31 +68,23 @@ PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
+PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, ReducedModel *rm, std::shared_ptr<ContactPatch> *fullOut, std::vector<PetscReal> *Pout, PetscInt *nsubOut)
 {
-  PetscLogDouble t0, t1, t2;
-  PetscMPIInt    wrank;
-  ReducedModel   rm;
-
   PetscFunctionBeginUser;
-  if (!OFF_EIM) PetscCall(PetscLogEventRegister("RBCEIM", DM_CLASSID, &OFF_EIM));
   if (!OFF_Affine) PetscCall(PetscLogEventRegister("RBCReducedAffine", DM_CLASSID, &OFF_Affine));
-  PetscCallMPI(MPI_Comm_rank(world, &wrank));
   PetscCheck(fom.scene.contact, world, PETSC_ERR_SUP, "offline: the online ROM needs a contact scene (-contact_slave, -contact_master); use -offline_stop bases for the bases only");
   PetscCheck(fom.useAffine, world, PETSC_ERR_SUP, "offline: the scene has no affine decomposition (see the fom report's affine_terms)");
-  const PetscInt N = Npod + nsup, R = dual.W.cols, Rfom = dual.W.rows, m = (PetscInt)snaps.size();
-  PetscCall(PetscTime(&t0));
-
+  const PetscInt N = Npod + nsup, R = dual.W.cols, Rfom = dual.W.rows;
   // --- reduced affine terms
   PetscCall(PetscLogEventBegin(OFF_Affine, 0, 0, 0, 0));
-  rm.dim   = fom.elas.dim;
-  rm.Nfull = N;
-  rm.Npod  = Npod;
-  rm.nsup  = nsup;
-  rm.Rfull = R;
-  PetscCall(rm.par.FromFOM(fom.elas, fom.map, fom.affine));
-  rm.Aq.assign(fom.affine.Aq.size() * N * N, 0.0);
-  rm.fq.assign(fom.affine.fq.size() * N, 0.0);
+  rm->dim   = fom.elas.dim;
+  rm->Nfull = N;
+  rm->Npod  = Npod;
+  rm->nsup  = nsup;
+  rm->Rfull = R;
+  PetscCall(rm->par.FromFOM(fom.elas, fom.map, fom.affine));
+  rm->Aq.assign(fom.affine.Aq.size() * N * N, 0.0);
+  rm->fq.assign(fom.affine.fq.size() * N, 0.0);
   {
     // explicit products (the BV carries the POD inner product: its BVDot would include it)
     std::vector<Vec> cols(N);
@@ -110,17 +102,17 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       for (PetscInt j = 0; j < N; ++j) {
         PetscCall(MatMult(fom.affine.Aq[q], cols[j], Av));
         PetscCall(VecMDot(Av, N, cols.data(), dots.data()));
-        for (PetscInt i = 0; i < N; ++i) rm.Aq[(q * N + i) * N + j] = PetscRealPart(dots[i]);
+        for (PetscInt i = 0; i < N; ++i) rm->Aq[(q * N + i) * N + j] = PetscRealPart(dots[i]);
       }
     for (size_t q = 0; q < fom.affine.Aq.size(); ++q) // exact symmetry
       for (PetscInt i = 0; i < N; ++i)
         for (PetscInt j = 0; j < i; ++j) {
-          const PetscReal a = 0.5 * (rm.Aq[(q * N + i) * N + j] + rm.Aq[(q * N + j) * N + i]);
-          rm.Aq[(q * N + i) * N + j] = rm.Aq[(q * N + j) * N + i] = a;
+          const PetscReal a = 0.5 * (rm->Aq[(q * N + i) * N + j] + rm->Aq[(q * N + j) * N + i]);
+          rm->Aq[(q * N + i) * N + j] = rm->Aq[(q * N + j) * N + i] = a;
         }
     for (size_t q = 0; q < fom.affine.fq.size(); ++q) {
       PetscCall(VecMDot(fom.affine.fq[q], N, cols.data(), dots.data()));
-      for (PetscInt i = 0; i < N; ++i) rm.fq[q * N + i] = PetscRealPart(dots[i]);
+      for (PetscInt i = 0; i < N; ++i) rm->fq[q * N + i] = PetscRealPart(dots[i]);
     }
     PetscCall(VecDestroy(&Av));
     for (auto &c : cols) PetscCall(VecDestroy(&c));
@@ -128,15 +120,15 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscCall(PetscLogEventEnd(OFF_Affine, 0, 0, 0, 0));
 
   // --- the full contact patch on the support of the dual basis (Dirichlet values at the default mu)
-  PetscCall(PetscLogEventBegin(OFF_EIM, 0, 0, 0, 0));
-  PetscInt nsub = 4;
+  PetscInt &nsub = *nsubOut;
+  nsub           = 4;
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &nsub, NULL));
   PetscCheck(nsub >= 1 && nsub <= 64, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
   std::vector<double> Wt((size_t)R * Rfom);
   for (PetscInt k = 0; k < R; ++k)
     for (PetscInt i = 0; i < Rfom; ++i) Wt[(size_t)k * Rfom + i] = dual.W(i, k);
-  std::shared_ptr<ContactPatch> full;
-  std::vector<PetscReal>        P;
+  std::shared_ptr<ContactPatch> &full = *fullOut;
+  std::vector<PetscReal>        &P    = *Pout;
   PetscCall(BuildFullContact(fom, cmap, order, modes, N, Wt, R, nsub, &full, &P));
   {
     bool bcParam = false, uDnonzero = false;
@@ -144,15 +136,35 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     for (PetscReal v : full->uD) uDnonzero = uDnonzero || v != 0;
     PetscCheck(!(bcParam && uDnonzero), world, PETSC_ERR_SUP, "offline: a parametrized Dirichlet condition (-param_bc_*) acts on the contact surfaces; the reduced contact map does not support it yet");
   }
-  const PetscInt Q = full->NumPoints();
-  rm.dualGram.assign((size_t)R * R, 0.0);
+  rm->dualGram.assign((size_t)R * R, 0.0);
   for (PetscInt a = 0; a < R; ++a)
     for (PetscInt b = 0; b < R; ++b)
-      for (PetscInt i = 0; i < Rfom; ++i) rm.dualGram[(size_t)a * R + b] += dual.W(i, a) * dual.W(i, b);
-  rm.SetExactContact(full, P);
-  rm.SetContactMode(ReducedModel::ContactMode::Exact);
-  PetscCall(rm.SetFromOptions()); // rom_kacanov_*, rom_qp_* (the truncation options are not for this step)
-  PetscCall(rm.Truncate(-1, -1, -1, -1));
+      for (PetscInt i = 0; i < Rfom; ++i) rm->dualGram[(size_t)a * R + b] += dual.W(i, a) * dual.W(i, b);
+  rm->SetExactContact(full, P);
+  rm->SetContactMode(ReducedModel::ContactMode::Exact);
+  PetscCall(rm->SetFromOptions()); // rom_kacanov_*, rom_qp_* (the truncation options are not for this step)
+  PetscCall(rm->Truncate(-1, -1, -1, -1));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
+{
+  PetscLogDouble t0, t1, t2;
+  PetscMPIInt    wrank;
+  ReducedModel   rm;
+
+  PetscFunctionBeginUser;
+  if (!OFF_EIM) PetscCall(PetscLogEventRegister("RBCEIM", DM_CLASSID, &OFF_EIM));
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  const PetscInt N = Npod + nsup, R = dual.W.cols, m = (PetscInt)snaps.size();
+  PetscCall(PetscTime(&t0));
+
+  PetscInt                      nsub;
+  std::shared_ptr<ContactPatch> full;
+  std::vector<PetscReal>        P;
+  PetscCall(BuildExactReducedModel(world, fom, cmap, order, V, modes, Npod, nsup, dual, &rm, &full, &P, &nsub));
+  PetscCall(PetscLogEventBegin(OFF_EIM, 0, 0, 0, 0));
+  const PetscInt Q = full->NumPoints();
   rm.warmStart      = PETSC_FALSE;
   rm.loop.monitor   = PETSC_FALSE;
   rm.recordIterates = true;

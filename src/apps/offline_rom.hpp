@@ -6,6 +6,8 @@
 #include "rbcontact/contact.hpp"
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/fom.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include <memory>
 #include "rbcontact/report.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/snapshot_file.hpp"
@@ -23,5 +25,11 @@ PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h);
 // row-major in canonical order, on every rank of fom's communicator. order's multipliers are numbered
 // here when a resumed run solved no snapshot. Report keys eim {...}, rom {...}.
 PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep);
+
+// The reduced model with exact contact terms: reduced affine terms V'A_qV, V'f_q and the full contact patch
+// (every -eim_quadrature_subdivisions point of the slave facets on the support of the dual basis) with
+// P = W' Psi; mode Exact, -rom_kacanov_*/-rom_qp_* options read. The first part of the online data, and
+// the model of the greedy training's error indicator (offline_greedy.hpp).
+PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, ReducedModel *rm, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P, PetscInt *nsub);
 
 } // namespace rbc

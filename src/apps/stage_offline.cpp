@@ -4,6 +4,7 @@
 // file (SnapshotFile) before the next round starts; -snapshots_restart resumes a killed job.
 #include "stages.hpp"
 #include "offline_bases.hpp"
+#include "offline_greedy.hpp"
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
 #include "rbcontact/supremizers.hpp"
@@ -95,8 +96,20 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_monitor", &monitor, NULL));
   PetscCall(SceneSpecFromOptions(world, &scene));
   PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
-  ParameterSet train;
-  PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
+  // -train_type greedy (docs/greedy_training.md): the snapshot file's training set is the pool (initial
+  // set, then the candidates); the FOM solves the initial set, then the parameters the indicator picks
+  ParameterSet  train;
+  GreedyOptions gopt;
+  PetscInt      ninitial = 0;
+  char          trainType[64] = "grid";
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-train_type", trainType, sizeof trainType, NULL));
+  const bool greedy = !strcmp(trainType, "greedy");
+  if (greedy) {
+    PetscCheck(scene.contact, world, PETSC_ERR_SUP, "-train_type greedy: the indicator is that of a contact scene (-contact_slave, -contact_master)");
+    PetscCheck(full, world, PETSC_ERR_ARG_INCOMP, "-train_type greedy builds the reduced model while it trains: it runs the whole offline stage (not -offline_stop %s)", stop);
+    PetscCall(GreedyOptionsFromOptions(world, &gopt));
+    PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
+  } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
   { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
     PetscReal supRatio;
@@ -197,97 +210,112 @@ PetscErrorCode StageOffline(MPI_Comm world)
     std::vector<PetscReal> pack(L), gathered(wrank == 0 ? L * wsize : 0);
     std::vector<PetscInt>  itsSolved;
     bool                   multOrderBuilt = false;
+    // Solves the training points list (indices into train.points) in rounds of k, one per group of ranks;
+    // every finished round is written before the next starts.
+    PetscInt solvedNow = 0;
+    auto solveList = [&](const std::vector<PetscInt> &list) -> PetscErrorCode {
+      const PetscInt rounds = ((PetscInt)list.size() + k - 1) / k;
+      for (PetscInt r = 0; r < rounds; ++r) {
+        const PetscInt slot = r * k + color;
+        const PetscInt idx  = slot < (PetscInt)list.size() ? list[slot] : -1;
+        std::fill(pack.begin(), pack.end(), 0.0);
+        pack[0] = idx;
+        if (idx >= 0) {
+          PetscLogDouble s0, s1;
+          PetscCall(PetscTime(&s0));
+          const std::vector<PetscReal> &mu = train.points[idx];
+          PetscCall(fom.SetMu(mu));
+          PetscCall(fom.AssembleAndFactor());
+          std::vector<PetscReal> u, lam, gap, KDg;
+          if (scene.contact) {
+            cmap.SetGeometry(&fom.map, mu);
+            PetscCall(kac.Solve(fom, cmap));
+            if (!multOrderBuilt) {
+              PetscCall(order.BuildMultipliers(kac.sys.coordRef, fom.elas.dim));
+              multOrderBuilt = true;
+            }
+            PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));
+            PetscCall(order.MultipliersToCanonical(kac.sys.g, &gap));
+            PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KDg));
+          } else PetscCall(fom.SolveElastic());
+          PetscCall(order.DofsToCanonical(fom.u, &u));
+          PetscCall(PetscTime(&s1));
+          if (grank == 0) {
+            size_t o = 1;
+            pack[o++] = kac.iterations;
+            pack[o++] = s1 - s0;
+            pack[o++] = kac.kkt.primal;
+            pack[o++] = kac.kkt.dual;
+            pack[o++] = kac.kkt.complementarity;
+            pack[o++] = kac.kkt.stationarity;
+            for (PetscInt j = 0; j < np; ++j) pack[o++] = mu[j];
+            for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = u[j];
+            for (PetscInt j = 0; j < R; ++j) pack[o++] = lam[j];
+            for (PetscInt j = 0; j < R; ++j) pack[o++] = gap[j];
+            // K_D: rows in canonical multiplier order, columns in canonical dof order (row-major)
+            for (PetscInt g = 0; g < R; ++g) {
+              const PetscInt c = order.CanonicalMultiplier(g);
+              for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
+            }
+          }
+          itsSolved.push_back(kac.iterations);
+        }
+        // group roots -> world rank 0 (other ranks send an empty slot)
+        if (grank != 0) pack[0] = -1;
+        PetscCallMPI(MPI_Gather(pack.data(), (int)L, MPIU_REAL, gathered.data(), (int)L, MPIU_REAL, 0, world));
+        std::vector<Snapshot> snaps;
+        if (wrank == 0)
+          for (PetscMPIInt q = 0; q < wsize; ++q) {
+            const PetscReal *p = &gathered[(size_t)q * L];
+            if (p[0] < 0) continue;
+            Snapshot s;
+            size_t   o = 0;
+            s.index             = (PetscInt)p[o++];
+            s.kacanovIterations = (PetscInt)p[o++];
+            s.seconds           = p[o++];
+            s.kkt.assign(p + o, p + o + 4);
+            o += 4;
+            s.mu.assign(p + o, p + o + np);
+            o += np;
+            s.u.assign(p + o, p + o + ndofs);
+            o += ndofs;
+            s.lambda.assign(p + o, p + o + R);
+            o += R;
+            if (scene.contact) {
+              s.extra["contact_gap"].assign(p + o, p + o + R);
+              o += R;
+              s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
+              s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
+            }
+            snaps.push_back(s);
+          }
+        PetscInt nsnap = (PetscInt)snaps.size();
+        PetscCallMPI(MPI_Bcast(&nsnap, 1, MPIU_INT, 0, world));
+        for (PetscInt i = 0; i < nsnap; ++i) PetscCall(file.Write(wrank == 0 ? snaps[i] : Snapshot()));
+        if (monitor && wrank == 0) {
+          PetscLogDouble now;
+          PetscCall(PetscTime(&now));
+          const PetscInt  finished = solvedNow + std::min<PetscInt>((r + 1) * k, (PetscInt)list.size());
+          const PetscReal eta      = (now - tSnap0) / finished * (solvedNow + (PetscInt)list.size() - finished);
+          for (const auto &s : snaps) {
+            std::ostringstream m;
+            for (auto v : s.mu) m << " " << v;
+            PetscCall(PetscPrintf(PETSC_COMM_SELF, "  snapshot %3" PetscInt_FMT "/%" PetscInt_FMT "  mu =%s  Kacanov its %2" PetscInt_FMT "  %.2f s  [%" PetscInt_FMT "/%" PetscInt_FMT " done, ETA %.1f s]\n", s.index + 1, ntrain, m.str().c_str(), s.kacanovIterations, (double)s.seconds, finished, solvedNow + (PetscInt)list.size(), (double)eta));
+          }
+        }
+      }
+      solvedNow += (PetscInt)list.size();
+      return 0;
+    };
     PetscCall(PetscTime(&tSnap0));
     PetscCall(PetscLogEventBegin(OFF_Snapshots, 0, 0, 0, 0));
-    const PetscInt rounds = ((PetscInt)todo.size() + k - 1) / k;
-    for (PetscInt r = 0; r < rounds; ++r) {
-      const PetscInt slot = r * k + color;
-      const PetscInt idx  = slot < (PetscInt)todo.size() ? todo[slot] : -1;
-      std::fill(pack.begin(), pack.end(), 0.0);
-      pack[0] = idx;
-      if (idx >= 0) {
-        PetscLogDouble s0, s1;
-        PetscCall(PetscTime(&s0));
-        const std::vector<PetscReal> &mu = train.points[idx];
-        PetscCall(fom.SetMu(mu));
-        PetscCall(fom.AssembleAndFactor());
-        std::vector<PetscReal> u, lam, gap, KDg;
-        if (scene.contact) {
-          cmap.SetGeometry(&fom.map, mu);
-          PetscCall(kac.Solve(fom, cmap));
-          if (!multOrderBuilt) {
-            PetscCall(order.BuildMultipliers(kac.sys.coordRef, fom.elas.dim));
-            multOrderBuilt = true;
-          }
-          PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));
-          PetscCall(order.MultipliersToCanonical(kac.sys.g, &gap));
-          PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KDg));
-        } else PetscCall(fom.SolveElastic());
-        PetscCall(order.DofsToCanonical(fom.u, &u));
-        PetscCall(PetscTime(&s1));
-        if (grank == 0) {
-          size_t o = 1;
-          pack[o++] = kac.iterations;
-          pack[o++] = s1 - s0;
-          pack[o++] = kac.kkt.primal;
-          pack[o++] = kac.kkt.dual;
-          pack[o++] = kac.kkt.complementarity;
-          pack[o++] = kac.kkt.stationarity;
-          for (PetscInt j = 0; j < np; ++j) pack[o++] = mu[j];
-          for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = u[j];
-          for (PetscInt j = 0; j < R; ++j) pack[o++] = lam[j];
-          for (PetscInt j = 0; j < R; ++j) pack[o++] = gap[j];
-          // K_D: rows in canonical multiplier order, columns in canonical dof order (row-major)
-          for (PetscInt g = 0; g < R; ++g) {
-            const PetscInt c = order.CanonicalMultiplier(g);
-            for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
-          }
-        }
-        itsSolved.push_back(kac.iterations);
-      }
-      // group roots -> world rank 0 (other ranks send an empty slot)
-      if (grank != 0) pack[0] = -1;
-      PetscCallMPI(MPI_Gather(pack.data(), (int)L, MPIU_REAL, gathered.data(), (int)L, MPIU_REAL, 0, world));
-      std::vector<Snapshot> snaps;
-      if (wrank == 0)
-        for (PetscMPIInt q = 0; q < wsize; ++q) {
-          const PetscReal *p = &gathered[(size_t)q * L];
-          if (p[0] < 0) continue;
-          Snapshot s;
-          size_t   o = 0;
-          s.index             = (PetscInt)p[o++];
-          s.kacanovIterations = (PetscInt)p[o++];
-          s.seconds           = p[o++];
-          s.kkt.assign(p + o, p + o + 4);
-          o += 4;
-          s.mu.assign(p + o, p + o + np);
-          o += np;
-          s.u.assign(p + o, p + o + ndofs);
-          o += ndofs;
-          s.lambda.assign(p + o, p + o + R);
-          o += R;
-          if (scene.contact) {
-            s.extra["contact_gap"].assign(p + o, p + o + R);
-            o += R;
-            s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
-            s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
-          }
-          snaps.push_back(s);
-        }
-      PetscInt nsnap = (PetscInt)snaps.size();
-      PetscCallMPI(MPI_Bcast(&nsnap, 1, MPIU_INT, 0, world));
-      for (PetscInt i = 0; i < nsnap; ++i) PetscCall(file.Write(wrank == 0 ? snaps[i] : Snapshot()));
-      if (monitor && wrank == 0) {
-        PetscLogDouble now;
-        PetscCall(PetscTime(&now));
-        const PetscInt  finished = std::min<PetscInt>((r + 1) * k, (PetscInt)todo.size());
-        const PetscReal eta      = (now - tSnap0) / finished * ((PetscInt)todo.size() - finished);
-        for (const auto &s : snaps) {
-          std::ostringstream m;
-          for (auto v : s.mu) m << " " << v;
-          PetscCall(PetscPrintf(PETSC_COMM_SELF, "  snapshot %3" PetscInt_FMT "/%" PetscInt_FMT "  mu =%s  Kacanov its %2" PetscInt_FMT "  %.2f s  [%" PetscInt_FMT "/%zu done, ETA %.1f s]\n", s.index + 1, ntrain, m.str().c_str(), s.kacanovIterations, (double)s.seconds, finished, todo.size(), (double)eta));
-        }
-      }
+    if (!greedy) PetscCall(solveList(todo));
+    else {
+      std::vector<PetscInt> init;
+      for (PetscInt i : todo)
+        if (i < ninitial) init.push_back(i);
+      PetscCall(solveList(init));
+      PetscCall(GreedyRounds(world, gopt, k, color, fom, cmap, order, train, ninitial, file, h, solveList, &rep));
     }
     PetscCall(PetscLogEventEnd(OFF_Snapshots, 0, 0, 0, 0));
     PetscCall(file.Close());
@@ -305,7 +333,8 @@ PetscErrorCode StageOffline(MPI_Comm world)
 
     rep.root["stage"]       = "offline";
     rep.root["scene"]       = scene.name;
-    rep.root["ntrain"]      = (long long)ntrain;
+    rep.root["ntrain"]      = (long long)ntrain; // greedy: the pool (greedy.training_set_size: the points solved)
+    rep.root["train_type"]  = trainType;
     rep.root["nparams"]     = (long long)np;
     rep.root["fom_solves"]  = (long long)allIts.size();
     rep.root["resumed"]     = (long long)done.size();
@@ -329,7 +358,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
     rep.root["snapshots"]             = snapPath;
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
-      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep, scene.contact ? &cmap : nullptr, full, basisPath));
+      PetscCall(OfflineBases(world, fom, order, snapPath, romPath, h, &rep, scene.contact ? &cmap : nullptr, full, basisPath, greedy));
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }

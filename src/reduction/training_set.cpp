@@ -184,18 +184,19 @@ std::vector<std::vector<PetscReal>> LatinHypercubeSample(const std::vector<Param
   return pts;
 }
 
-PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpec> &params, const char *prefix, ParameterSet *set)
+PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpec> &params, const char *prefix, ParameterSet *set, const char *defType, PetscInt defSize, PetscInt defSeed)
 {
   const std::string pre = prefix ? prefix : "";
   const std::string optType = "-" + pre + "type", optSize = "-" + pre + "size", optSeed = "-" + pre + "seed", optFile = "-" + pre + "file";
-  char              typeBuf[64] = "grid", fileBuf[PETSC_MAX_PATH_LEN] = "";
-  PetscInt          sizes[64], nsizes = 64, seed = 0;
+  char              typeBuf[64] = "", fileBuf[PETSC_MAX_PATH_LEN] = "";
+  PetscInt          sizes[64], nsizes = 64, seed = defSeed;
   PetscBool         flgSize = PETSC_FALSE, flgFile = PETSC_FALSE;
   std::string       type, file;
   PetscMPIInt       rank;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(PetscStrncpy(typeBuf, defType, sizeof typeBuf));
   PetscOptionsBegin(comm, prefix, "Parameter samples", "rbcontact");
   PetscCall(PetscOptionsString("-type", "Sample type: grid, random, lhs or file", "ParameterSetFromOptions", typeBuf, typeBuf, sizeof typeBuf, NULL));
   type = typeBuf;
@@ -205,7 +206,7 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   file = fileBuf;
   PetscOptionsEnd();
 
-  PetscCheck(type == "grid" || type == "random" || type == "lhs" || type == "file", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "Unknown value '%s' for option %s (grid, random, lhs or file)", type.c_str(), optType.c_str());
+  PetscCheck(type == "grid" || type == "random" || type == "lhs" || type == "file", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "Unknown value '%s' for option %s (grid, random, lhs or file%s)", type.c_str(), optType.c_str(), pre == "train_" ? "; the offline stage also takes greedy" : "");
   PetscCheck(seed >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT " must be >= 0", optSeed.c_str(), seed);
   std::vector<PetscInt> counts;
   if (flgSize) counts.assign(sizes, sizes + nsizes);
@@ -215,14 +216,14 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   for (const auto &p : params) set->names.push_back(p.name);
   set->points.clear();
   if (type == "grid") {
-    if (counts.empty()) counts.assign(1, 10);
+    if (counts.empty()) counts.assign(1, defSize);
     PetscCheck(counts.size() == 1 || counts.size() == params.size(), comm, PETSC_ERR_USER_INPUT, "%s has %zu counts; give one count, or one per parameter (the scene has %zu parameters: %s)", optSize.c_str(), counts.size(), params.size(), Names(params).c_str());
     double total = 1;
     for (size_t j = 0; j < params.size(); ++j) total *= (double)(counts.size() == 1 ? counts[0] : counts[j]);
     PetscCheck(total <= 1e7, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: the tensor grid would have %g points (more than 1e7)", optSize.c_str(), total);
     set->points = GridSample(params, counts);
   } else if (type == "random" || type == "lhs") {
-    if (counts.empty()) counts.assign(1, 10);
+    if (counts.empty()) counts.assign(1, defSize);
     PetscCheck(counts.size() == 1, comm, PETSC_ERR_USER_INPUT, "%s: %s %s takes one number of samples (a list of counts is for %s grid)", optSize.c_str(), optType.c_str(), type.c_str(), optType.c_str());
     set->points = type == "random" ? RandomSample(params, counts[0], (unsigned long long)seed) : LatinHypercubeSample(params, counts[0], (unsigned long long)seed);
   } else {

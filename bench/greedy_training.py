@@ -1,0 +1,107 @@
+#!/usr/bin/python3
+"""greedy_training.py: benchmark (not a test) of the training sets of a scene: which set reaches the ROM
+accuracy targets (u <= 1e-4, lambda <= 1e-2, force <= 1e-3, max relative errors on the validate stage's
+test set) and how many FOM solves it cost.
+
+For each uniform grid of --grids (k x k for a two-parameter scene, k for one parameter) and each budget
+of --budgets of the greedy training (offline -train_type greedy -greedy_max_solves B, one snapshot file
+grown budget after budget: the same picks as separate runs), one offline run with the scene's options
+(runs/<scene>.opts) and one `rbcontact validate`. Columns: training set, FOM solves, N, R, Mc, max relative
+errors u / lambda / force, the greedy's last max indicator, online median, offline time, targets met.
+
+It is a benchmark: it exits 0 unless a run fails. Timings depend on the machine's load.
+Usage: /usr/bin/python3 bench/greedy_training.py [--np 2] [--scene half_disks] [--grids 5 6 7 8 9]
+           [--budgets 12 16 20 24 32 40] [--extra "-greedy_candidates_size 1000"] [--json out.json]
+"""
+import argparse
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TEST = {"half_disks": ["-test_seed", "11"], "ring_on_block": ["-test_seed", "7"]}
+
+
+def run(args, cmd):
+    full = (["mpirun", "-n", str(args.np)] if args.np > 1 else []) + [args.exe] + cmd
+    if args.verbose:
+        print("+ " + " ".join(full), flush=True)
+    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        sys.stderr.write(p.stdout[-3000:])
+        sys.exit("greedy_training.py: error: command failed (exit %d): %s" % (p.returncode, " ".join(full)))
+    return p.stdout
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def one(args, work, label, train_opts, rom):
+    opts = ["-options_file", "runs/%s.opts" % args.scene] + shlex.split(args.extra)
+    t0 = time.time()
+    run(args, ["offline"] + opts + train_opts + ["-rom", rom, "-report", os.path.join(work, "off.json")])
+    t_off = time.time() - t0
+    run(args, ["validate"] + opts + TEST.get(args.scene, []) + ["-rom", rom, "-report", os.path.join(work, "val.json")])
+    off, val = load(os.path.join(work, "off.json")), load(os.path.join(work, "val.json"))
+    g = off.get("greedy", {})
+    solves = g.get("training_set_size", off["ntrain"])
+    t = val["test"]
+    row = dict(set=label, solves=solves, N=val["rom"]["N"], R=val["rom"]["R"], Mc=val["rom"].get("Mc", 0),
+               u=t["max_rel_err_u"], lam=t["max_rel_err_lambda"], force=t["max_rel_err_force"],
+               indicator=(g["rounds"][-1]["max_indicator"] if g.get("rounds") else None),
+               online_us=1e6 * val["online_time_s"]["median"], offline_s=t_off)
+    row["met"] = row["u"] <= 1e-4 and row["lam"] <= 1e-2 and row["force"] <= 1e-3
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--np", type=int, default=2)
+    ap.add_argument("--exe", default=os.path.join(ROOT, "build", "bin", "rbcontact"))
+    ap.add_argument("--scene", default="half_disks")
+    ap.add_argument("--grids", type=int, nargs="*", default=[5, 6, 7, 8, 9])
+    ap.add_argument("--budgets", type=int, nargs="*", default=[12, 16, 20, 24, 32, 40])
+    ap.add_argument("--extra", default="", help="options added to every offline and validate run")
+    ap.add_argument("--json", default="")
+    ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--verbose", action="store_true")
+    args = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="rbc_greedy_")
+    rows = []
+    try:
+        for k in args.grids:
+            rom = os.path.join(work, "grid%d.h5" % k)
+            rows.append(one(args, work, "grid %d" % k, ["-train_type", "grid", "-train_size", str(k)], rom))
+            print(rows[-1], flush=True)
+        rom = os.path.join(work, "greedy.h5")  # one snapshot file, grown budget after budget
+        for b in sorted(args.budgets):
+            rows.append(one(args, work, "greedy %d" % b, ["-train_type", "greedy", "-greedy_tol", "1e-12", "-greedy_max_solves", str(b)], rom))
+            print(rows[-1], flush=True)
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+    print("\n%s, %d ranks: training sets against the targets (u <= 1e-4, lambda <= 1e-2, force <= 1e-3)" % (args.scene, args.np))
+    print("| training set | FOM solves | N | R | Mc | u | lambda | force | last max indicator | online median | offline | targets |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        ind = "%.2e" % r["indicator"] if r["indicator"] is not None else "-"
+        print("| %s | %d | %d | %d | %d | %.2e | %.2e | %.2e | %s | %.0f us | %.1f s | %s |" % (
+            r["set"], r["solves"], r["N"], r["R"], r["Mc"], r["u"], r["lam"], r["force"], ind, r["online_us"], r["offline_s"], "met" if r["met"] else "missed"))
+    met = [r for r in rows if r["met"]]
+    for kind in ("grid", "greedy"):
+        best = min((r for r in met if r["set"].startswith(kind)), key=lambda r: r["solves"], default=None)
+        print("fewest FOM solves reaching the targets, %s: %s" % (kind, "%s (%d solves)" % (best["set"], best["solves"]) if best else "none of those run"))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

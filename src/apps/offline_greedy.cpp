@@ -1,0 +1,198 @@
+// src/apps/offline_greedy.cpp: the greedy training's options, candidate pool, error indicator and picks
+// (offline_greedy.hpp, docs/greedy_training.md).
+#include "offline_greedy.hpp"
+#include "offline_bases.hpp"
+#include "offline_rom.hpp"
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace rbc {
+
+PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, "greedy_", "Greedy training (offline -train_type greedy)", "rbcontact");
+  PetscCall(PetscOptionsReal("-tol", "Stop once the largest indicator over the candidates is at most this", "", o->tol, &o->tol, NULL));
+  PetscCall(PetscOptionsInt("-max_solves", "FOM solves in all (initial set included)", "", o->maxSolves, &o->maxSolves, NULL));
+  PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks)", "", o->batch, &o->batch, NULL));
+  PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
+  {
+    const char *const names[] = {"residual", "penetration", "max", "GreedyCriterion", "GREEDY_", NULL};
+    PetscEnum         c       = (PetscEnum)o->criterion;
+    PetscCall(PetscOptionsEnum("-indicator", "Measure that ranks the candidates", "", names, c, &c, NULL));
+    o->criterion = (GreedyCriterion)c;
+  }
+  PetscCall(PetscOptionsBool("-monitor", "Print every round", "", o->monitor, &o->monitor, NULL));
+  PetscOptionsEnd();
+  auto num = [](PetscReal v) { // as typed (PETSc's %g would print 0 as "0.")
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  PetscCheck(o->tol > 0 && std::isfinite(o->tol), comm, PETSC_ERR_ARG_OUTOFRANGE, "-greedy_tol %s must be > 0", num(o->tol).c_str());
+  PetscCheck(o->maxSolves >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-greedy_max_solves %" PetscInt_FMT " must be >= 1", o->maxSolves);
+  PetscCheck(o->batch >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-greedy_batch %" PetscInt_FMT " must be >= 0 (0: the number of groups of ranks)", o->batch);
+  PetscCheck(o->separation >= 0 && std::isfinite(o->separation), comm, PETSC_ERR_ARG_OUTOFRANGE, "-greedy_separation %s must be >= 0", num(o->separation).c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GreedyPoolFromOptions(MPI_Comm comm, const std::vector<ParamSpec> &params, ParameterSet *pool, PetscInt *ninitial)
+{
+  ParameterSet init, cand;
+
+  PetscFunctionBeginUser;
+  PetscCall(ParameterSetFromOptions(comm, params, "greedy_initial_", &init, "grid", 2));
+  // seed 1: a stream apart from the test sets' default seed 0
+  PetscCall(ParameterSetFromOptions(comm, params, "greedy_candidates_", &cand, "lhs", 1000, 1));
+  PetscCheck(!init.points.empty(), comm, PETSC_ERR_USER_INPUT, "-greedy_initial_*: the initial set is empty");
+  *pool = init;
+  for (const auto &c : cand.points) {
+    bool dup = false;
+    for (const auto &x : init.points) dup = dup || x == c;
+    if (!dup) pool->points.push_back(c);
+  }
+  *ninitial = (PetscInt)init.points.size();
+  PetscCheck((PetscInt)pool->points.size() > *ninitial, comm, PETSC_ERR_USER_INPUT, "-greedy_candidates_*: no candidate besides the initial set");
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
+
+namespace rbc {
+
+PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ngroups, PetscInt color, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const ParameterSet &pool, PetscInt ninitial, SnapshotFile &file, const SnapshotHeader &h, const GreedySolveFn &solve, Report *rep)
+{
+  const PetscInt    npool = (PetscInt)pool.points.size(), np = (PetscInt)fom.scene.params.size();
+  const PetscInt    batch = go.batch > 0 ? go.batch : ngroups;
+  const std::string path  = file.Path();
+  // typical spacing of the candidates in the unit box
+  const PetscReal spacing = std::pow((PetscReal)std::max<PetscInt>(1, npool - ninitial), -1.0 / std::max<PetscInt>(1, np));
+  GreedyIndicator ind;
+  JsonValue       rounds = JsonValue::Array();
+  std::string     stop;
+  PetscInt        failures = 0;
+  PetscMPIInt     wrank;
+  PetscLogDouble  tInd = 0, tModel = 0;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  PetscCall(ind.Setup(fom));
+  ind.criterion = go.criterion;
+  for (PetscInt round = 0;; ++round) {
+    std::vector<PetscInt> done;
+    PetscCall(file.DoneIndices(&done));
+    const PetscInt nsolved = (PetscInt)done.size();
+    if (nsolved >= go.maxSolves) {
+      stop = "max_solves";
+      break;
+    }
+    // the done snapshots, as a restart would read them
+    std::vector<Snapshot> snaps;
+    PetscCall(file.Close());
+    PetscCall(SnapshotFile::ReadAll(path, &snaps));
+    PetscCall(file.Open(world, path, h, true));
+    PetscLogDouble t0, t1, t2;
+    PetscCall(PetscTime(&t0));
+    OfflineBasisSet               bs;
+    ReducedModel                  rm;
+    std::shared_ptr<ContactPatch> full;
+    std::vector<PetscReal>        P;
+    PetscInt                      nsub;
+    PetscCall(BuildBases(world, fom, order, snaps, h.nmult, &cmap, &bs));
+    PetscCall(BuildExactReducedModel(world, fom, cmap, order, bs.pod.modes, bs.modes, bs.pod.N - bs.nsup, bs.nsup, bs.dual, &rm, &full, &P, &nsub));
+    rm.warmStart      = PETSC_FALSE;
+    rm.loop.monitor   = PETSC_FALSE;
+    rm.recordIterates = false;
+    PetscCall(PetscTime(&t1));
+    // the indicator at every candidate not solved; candidate j of those goes to group j mod ngroups
+    std::vector<char> isDone(npool, 0);
+    for (PetscInt d : done) isDone[d] = 1;
+    std::vector<PetscReal> val(3 * npool, -1.0), all(3 * npool);
+    PetscInt               j = 0;
+    for (PetscInt c = ninitial; c < npool; ++c) {
+      if (isDone[c] || j++ % ngroups != color) continue;
+      GreedyEstimate e;
+      PetscCall(ind.EvaluateReduced(fom, cmap, order, rm, *full, bs.pod.modes, bs.dual.W, pool.points[c], &e));
+      val[c]             = e.value;
+      val[npool + c]     = e.residual;
+      val[2 * npool + c] = e.penetration;
+    }
+    PetscCallMPI(MPI_Allreduce(val.data(), all.data(), 3 * npool, MPIU_REAL, MPIU_MAX, world));
+    PetscCall(PetscTime(&t2));
+    tModel += t1 - t0;
+    tInd += t2 - t1;
+    std::vector<PetscReal> eta(all.begin(), all.begin() + npool);
+    PetscInt               best = -1, nfail = 0, ncand = 0;
+    PetscReal              maxRes = 0, maxPen = 0;
+    for (PetscInt c = 0; c < npool; ++c) {
+      if (eta[c] < 0) continue;
+      ++ncand;
+      if (best < 0 || eta[c] > eta[best]) best = c;
+      if (eta[c] >= PETSC_MAX_REAL) ++nfail;
+      else {
+        maxRes = std::max(maxRes, all[npool + c]);
+        maxPen = std::max(maxPen, all[2 * npool + c]);
+      }
+    }
+    failures += nfail;
+    if (best < 0) {
+      stop = "pool";
+      break;
+    }
+    JsonValue r = JsonValue::Object();
+    r["round"]           = (long long)round;
+    r["solves"]          = (long long)nsolved;
+    r["N"]               = (long long)bs.pod.N;
+    r["R"]               = (long long)bs.dual.W.cols;
+    r["candidates"]      = (long long)ncand;
+    r["max_indicator"]   = Finite(std::vector<double>{eta[best]})[0];
+    r["max_residual"]    = (double)maxRes;
+    r["max_penetration"] = (double)maxPen;
+    r["rom_failures"]    = (long long)nfail;
+    r["argmax"]          = std::vector<double>(pool.points[best].begin(), pool.points[best].end());
+    r["seconds_model"]   = (double)(t1 - t0);
+    r["seconds_indicator"] = (double)(t2 - t1);
+    if (go.monitor && wrank == 0) {
+      std::ostringstream m;
+      for (auto v : pool.points[best]) m << " " << v;
+      PetscCall(PetscPrintf(PETSC_COMM_SELF, "  greedy round %2" PetscInt_FMT ": %3" PetscInt_FMT " solves, N %3" PetscInt_FMT " R %3" PetscInt_FMT ", max indicator %.3e (residual %.3e, penetration %.3e, %" PetscInt_FMT " failed) at mu =%s; model %.2f s, indicator %.2f s (%" PetscInt_FMT " candidates)\n", round, nsolved, bs.pod.N, bs.dual.W.cols, (double)eta[best], (double)maxRes, (double)maxPen, nfail, m.str().c_str(), (double)(t1 - t0), (double)(t2 - t1), ncand));
+    }
+    if (eta[best] <= go.tol) {
+      r["picked"] = std::vector<double>();
+      rounds.Push(r);
+      stop = "tol";
+      break;
+    }
+    const std::vector<PetscInt> picks = GreedyPick(eta, pool.points, fom.scene.params, std::min(batch, go.maxSolves - nsolved), go.separation * spacing);
+    r["picked"] = std::vector<double>(picks.begin(), picks.end());
+    rounds.Push(r);
+    PetscCall(solve(picks));
+  }
+  std::vector<PetscInt> done;
+  PetscCall(file.DoneIndices(&done));
+  JsonValue &g              = rep->root["greedy"];
+  g["pool"]                 = (long long)npool;
+  g["initial"]              = (long long)ninitial;
+  g["candidates"]           = (long long)(npool - ninitial);
+  g["batch"]                = (long long)batch;
+  g["tol"]                  = (double)go.tol;
+  g["max_solves"]           = (long long)go.maxSolves;
+  g["separation"]           = (double)(go.separation * spacing);
+  g["indicator"]            = go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : "max"; // of the reduced model with exact contact terms
+  g["stop"]                 = stop;
+  g["reached_tol"]          = stop == "tol";
+  g["training_set_size"]    = (long long)done.size();
+  g["rom_failures"]         = (long long)failures;
+  g["rounds"]               = rounds;
+  g["seconds_model"]        = (double)tModel;
+  g["seconds_indicator"]    = (double)tInd;
+  {
+    std::vector<double> idx(done.begin(), done.end());
+    g["training_indices"] = idx;
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
