@@ -50,7 +50,7 @@ public:
 private:
   KSP           ksp_ = nullptr;
   Mat           X_   = nullptr;
-  Vec           r_ = nullptr, z_ = nullptr, t_ = nullptr, f_ = nullptr, uloc_ = nullptr, u_ = nullptr;
+  Vec           r_ = nullptr, z_ = nullptr, t_ = nullptr, uloc_ = nullptr, u_ = nullptr, lam_ = nullptr, Ku_ = nullptr;
   ContactSystem sys_;
 };
 

@@ -10,7 +10,7 @@ GreedyIndicator::~GreedyIndicator()
 {
   (void)KSPDestroy(&ksp_);
   (void)MatDestroy(&X_);
-  for (Vec *v : {&r_, &z_, &t_, &f_, &uloc_, &u_}) (void)VecDestroy(v);
+  for (Vec *v : {&r_, &z_, &t_, &uloc_, &u_, &lam_, &Ku_}) (void)VecDestroy(v);
 }
 
 PetscErrorCode GreedyIndicator::Setup(ElasticFOM &fom)
@@ -43,7 +43,6 @@ PetscErrorCode GreedyIndicator::Setup(ElasticFOM &fom)
     PetscCall(DMCreateGlobalVector(fom.dm, &r_));
     PetscCall(VecDuplicate(r_, &z_));
     PetscCall(VecDuplicate(r_, &t_));
-    PetscCall(VecDuplicate(r_, &f_));
     PetscCall(VecDuplicate(r_, &u_));
     PetscCall(DMCreateLocalVector(fom.dm, &uloc_));
   }
@@ -56,6 +55,7 @@ PetscErrorCode GreedyIndicator::Evaluate(ElasticFOM &fom, ContactMap &cmap, cons
 
   PetscFunctionBeginUser;
   PetscCheck(ksp_, comm, PETSC_ERR_ORDER, "GreedyIndicator: call Setup first");
+  PetscCheck((PetscInt)lamCanon.size() == order.NumMultipliers(), comm, PETSC_ERR_ARG_SIZ, "GreedyIndicator: %zu multipliers for %" PetscInt_FMT, lamCanon.size(), order.NumMultipliers());
   PetscCall(fom.SetMu(mu)); // the Dirichlet values at mu (no assembly)
   // A(mu) u - f(mu) through the affine terms
   const std::vector<PetscReal> ta = fom.affine.ThetaA(mu), tf = fom.affine.ThetaF(mu);
@@ -64,19 +64,18 @@ PetscErrorCode GreedyIndicator::Evaluate(ElasticFOM &fom, ContactMap &cmap, cons
     PetscCall(MatMult(fom.affine.Aq[q], u, t_));
     PetscCall(VecAXPY(r_, ta[q], t_));
   }
-  PetscCall(VecSet(f_, 0.0));
-  for (size_t q = 0; q < tf.size(); ++q) PetscCall(VecAXPY(f_, tf[q], fom.affine.fq[q]));
-  PetscCall(VecAXPY(r_, -1.0, f_));
+  for (size_t q = 0; q < tf.size(); ++q) PetscCall(VecAXPY(r_, -tf[q], fom.affine.fq[q]));
   // + K(u)' lam: the contact constraint at u in the geometry of mu
   cmap.SetGeometry(&fom.map, mu);
   PetscCall(fom.elas.GlobalToLocalWithBC(u, uloc_));
   PetscCall(cmap.Assemble(fom.elas, uloc_, &sys_));
-  Vec      lam, Ku;
   PetscInt lo, hi;
-  PetscCall(VecDuplicate(sys_.g, &lam));
-  PetscCall(VecDuplicate(sys_.g, &Ku));
+  if (!lam_) { // the multiplier layout is the contact map's, the same at every assembly
+    PetscCall(VecDuplicate(sys_.g, &lam_));
+    PetscCall(VecDuplicate(sys_.g, &Ku_));
+  }
+  Vec lam = lam_, Ku = Ku_;
   PetscCall(VecGetOwnershipRange(lam, &lo, &hi));
-  PetscCheck((PetscInt)lamCanon.size() == order.NumMultipliers(), comm, PETSC_ERR_ARG_SIZ, "GreedyIndicator: %zu multipliers for %" PetscInt_FMT, lamCanon.size(), order.NumMultipliers());
   {
     PetscScalar *a;
     PetscCall(VecGetArray(lam, &a));
@@ -118,8 +117,6 @@ PetscErrorCode GreedyIndicator::Evaluate(ElasticFOM &fom, ContactMap &cmap, cons
     PetscCallMPI(MPI_Allreduce(loc, glob, 2, MPIU_REAL, MPIU_SUM, comm));
     est->penetration = glob[1] > 0 ? std::sqrt(glob[0] / glob[1]) : (glob[0] > 0 ? PETSC_MAX_REAL : 0);
   }
-  PetscCall(VecDestroy(&lam));
-  PetscCall(VecDestroy(&Ku));
   est->value = criterion == GreedyCriterion::Residual ? est->residual : criterion == GreedyCriterion::Penetration ? est->penetration : std::max(est->residual, est->penetration);
   PetscFunctionReturn(0);
 }
