@@ -2,6 +2,7 @@
 // the constraint rows can touch (slave and master facet dofs). With G, each Kacanov iterate's dual
 // Hessian S = K_D G K_D^T costs dense operations only; computed once per parameter.
 // Methods (-contact_compliance): schur (MUMPS Schur complement on D, then G = S_A^{-1}; 1 rank),
+// inverse (MUMPS selected entries of A^{-1} on the KSP's parallel factor: several ranks),
 // redundant (the same on a sequential copy of A on every rank: several ranks), solves (one parallel
 // back-solve per dof of D), auto (schur on 1 rank, redundant otherwise).
 #pragma once

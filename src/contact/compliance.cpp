@@ -1,5 +1,5 @@
-// src/contact/compliance.cpp: G = (A^{-1})_{DD} by a MUMPS Schur complement (serial) or by
-// back-solves with unit right-hand sides (parallel).
+// src/contact/compliance.cpp: G = (A^{-1})_{DD} by a MUMPS Schur complement (serial), by MUMPS's
+// selected entries of the inverse on the parallel factor, or by back-solves with unit right-hand sides.
 #include "rbcontact/compliance.hpp"
 #include <petscblaslapack.h>
 #include <cstring>
@@ -54,6 +54,85 @@ static PetscErrorCode ComplianceBySchur(Mat Aseq, const std::vector<PetscInt> &D
   PetscCall(MatDestroy(&S));
   PetscCall(MatDestroy(&F));
   PetscCall(ISDestroy(&is));
+  PetscFunctionReturn(0);
+}
+
+// The MUMPS factor of the FOM's KSP (preonly or not, Cholesky or LU), or null when A is not factored by MUMPS.
+static PetscErrorCode MumpsFactorOf(ElasticFOM &fom, Mat *F)
+{
+  PC            pc;
+  PetscBool     chol, lu, mumps = PETSC_FALSE;
+  MatSolverType st = NULL;
+
+  PetscFunctionBeginUser;
+  *F = nullptr;
+  PetscCall(KSPGetPC(fom.ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCCHOLESKY, &chol));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCLU, &lu));
+  if (!chol && !lu) PetscFunctionReturn(0);
+  PetscCall(PCFactorGetMatSolverType(pc, &st));
+  if (st) PetscCall(PetscStrcmp(st, MATSOLVERMUMPS, &mumps));
+  if (mumps) PetscCall(PCFactorGetMatrix(pc, F));
+  PetscFunctionReturn(0);
+}
+
+// G = (A^{-1})_{DD} as MUMPS's selected entries of the inverse (ICNTL(30), sparse right-hand sides
+// e_j, j in D, only the D entries of each column computed) on the factor the KSP already holds: no
+// second factorization, and the work is the pruned solves of the parallel factor. The pattern lives on
+// rank 0 (the PETSc interface's layout); G is broadcast. The solve controls it changes (ICNTL 20, 21, 30)
+// are restored for the ordinary solves that follow.
+static PetscErrorCode ComplianceByInverseEntries(ElasticFOM &fom, Mat F, const std::vector<PetscInt> &D, std::vector<PetscReal> *G)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)fom.A);
+  PetscMPIInt    rank;
+  const PetscInt n = (PetscInt)D.size();
+  PetscInt       M, icntl21, icntl30;
+  Mat            Bt, B;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(MatGetSize(fom.A, &M, NULL));
+  // Bt = pattern of (A^{-1})_{DD}^T: row D[j] (the right-hand side e_{D[j]}) holds the columns D, the
+  // other rows are empty (MUMPS wants as many right-hand sides as unknowns); all on rank 0
+  std::vector<PetscInt> nnz(rank ? 0 : M, 0);
+  if (!rank)
+    for (PetscInt j = 0; j < n; ++j) nnz[D[j]] = n;
+  PetscCall(MatCreate(comm, &Bt));
+  PetscCall(MatSetSizes(Bt, rank ? 0 : M, rank ? 0 : M, M, M));
+  PetscCall(MatSetType(Bt, MATAIJ));
+  PetscCall(MatSeqAIJSetPreallocation(Bt, 0, nnz.data()));
+  PetscCall(MatMPIAIJSetPreallocation(Bt, 0, nnz.data(), 0, NULL));
+  if (!rank) {
+    std::vector<PetscScalar> zero(n, 0.0);
+    for (PetscInt j = 0; j < n; ++j) PetscCall(MatSetValues(Bt, 1, &D[j], n, D.data(), zero.data(), INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(Bt, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Bt, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatMumpsGetIcntl(F, 21, &icntl21));
+  PetscCall(MatMumpsGetIcntl(F, 30, &icntl30));
+  PetscCall(MatCreateTranspose(Bt, &B));
+  PetscCall(MatMumpsGetInverse(F, B));
+  PetscCall(MatDestroy(&B));
+  PetscCall(MatMumpsSetIcntl(F, 21, icntl21));
+  PetscCall(MatMumpsSetIcntl(F, 30, icntl30));
+  G->assign((size_t)n * n, 0.0);
+  if (!rank) {
+    Mat                Bl = Bt;
+    PetscBool          mpi;
+    const PetscScalar *a;
+    PetscCall(PetscObjectTypeCompare((PetscObject)Bt, MATMPIAIJ, &mpi));
+    if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(Bt, &Bl, NULL, NULL));
+    PetscCall(MatSeqAIJGetArrayRead(Bl, &a)); // row D[j] holds (A^{-1})_{D[i], D[j]} in the order of D (sorted), rows in order
+    for (size_t k = 0; k < (size_t)n * n; ++k) (*G)[k] = PetscRealPart(a[k]);
+    PetscCall(MatSeqAIJRestoreArrayRead(Bl, &a));
+  }
+  PetscCall(MatDestroy(&Bt));
+  PetscCallMPI(MPI_Bcast(G->data(), (PetscMPIInt)((size_t)n * n), MPIU_REAL, 0, comm));
+  for (PetscInt j = 0; j < n; ++j) // symmetric up to rounding
+    for (PetscInt i = 0; i < j; ++i) {
+      const PetscReal m = 0.5 * ((*G)[i + (size_t)j * n] + (*G)[j + (size_t)i * n]);
+      (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n] = m;
+    }
   PetscFunctionReturn(0);
 }
 
@@ -114,17 +193,26 @@ PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<Pet
   D = Din;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_compliance", m, sizeof m, NULL));
-  PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "redundant") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur, redundant or solves)", m);
+  PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "inverse") || !strcmp(m, "redundant") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur, inverse, redundant or solves)", m);
+  Mat F = nullptr;
+  if (!strcmp(m, "inverse")) {
+    PetscCall(KSPSetUp(fom.ksp));
+    PetscCall(MumpsFactorOf(fom, &F));
+  }
   // auto: the Schur complement (on 1 rank directly, on several ranks on a redundant sequential copy of
-  // A: PETSc 3.18 has no parallel MUMPS Schur complement); one back-solve per contact dof in parallel
-  // was measured 20x slower on 2 ranks (ring_on_block refine 2: 14.5 s of an 18.8 s solve).
+  // A: PETSc 3.18 has no parallel MUMPS Schur complement). One back-solve per contact dof in parallel
+  // was measured 20x slower on 2 ranks (ring_on_block refine 2: 14.5 s of an 18.8 s solve); the selected
+  // entries of the inverse on the parallel factor 1.5-2x slower than the redundant Schur complement
+  // (half_disks P2 refine 1, 2340 contact dofs: 2.7-3.9 s against 1.8 s), but without a copy of A per rank.
   if (!strcmp(m, "auto")) method = size == 1 ? "schur" : "redundant";
   else method = m;
-  PetscCheck(method != "schur" || size == 1, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank (PETSc 3.18 has no parallel MUMPS Schur complement); use redundant or solves");
+  PetscCheck(method != "schur" || size == 1, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank (PETSc 3.18 has no parallel MUMPS Schur complement); use inverse, redundant or solves");
+  PetscCheck(method != "inverse" || F, comm, PETSC_ERR_SUP, "-contact_compliance inverse needs the FOM's stiffness factored by MUMPS (-fom_pc_type cholesky or lu, -fom_pc_factor_mat_solver_type mumps)");
   if (method == "schur" && fom.SchurComplement() && fom.SchurDofs() == D) {
     method = "schur (the factor of the solves)"; // one factorization per parameter
     PetscCall(InverseOfSchur(fom.SchurComplement(), &G));
   } else if (method == "schur") PetscCall(ComplianceBySchur(fom.A, D, &G));
+  else if (method == "inverse") PetscCall(ComplianceByInverseEntries(fom, F, D, &G));
   else if (method == "redundant") {
     Mat Aseq;
     PetscCall(MatCreateRedundantMatrix(fom.A, size, MPI_COMM_NULL, MAT_INITIAL_MATRIX, &Aseq));
