@@ -339,6 +339,23 @@ def paths(args):
         check_kkt(rf)
 
 
+def segments(args):
+    """2D mortar segments: the switch of the closest master facet bisected between the two end facets with a
+    confirming search (the default, pair) against the closest-point search at every bisection step (full):
+    the same cuts, so the same contact force, energy and iterations to rounding (1e-14), on the scenes with
+    curved masters (half_disks P1 and P2, ring_on_block, hertz)."""
+    print("Mortar segment search: pair vs full (np %d)" % args.np)
+    for scene, opts in (("half_disks", ["-mu", "1.0,0.09"]), ("half_disks", ["-mu", "0.8,0.11", "-fem_degree", "2"]),
+                        ("ring_on_block", ["-mu", "1.1"]), ("hertz", [])):
+        tag = scene + "_".join(opts).replace(",", "_").replace(".", "p").replace("-", "")
+        rp, _ = run(args, args.np, "runs/%s.opts" % scene, opts + args.extra, tag + "_pair")
+        rf, _ = run(args, args.np, "runs/%s.opts" % scene, opts + ["-contact_segment_search", "full"] + args.extra, tag + "_full")
+        for key in ("contact_force", "energy"):
+            d = abs(rp[key] - rf[key]) / abs(rf[key])
+            check(d <= 1e-14, "%s %s: %s pair %.16e full %.16e (rel %.1e <= 1e-14)" % (scene, " ".join(opts), key, rp[key], rf[key], d))
+        check(rp["kacanov_iterations"] == rf["kacanov_iterations"], "%s %s: %d Kacanov iterations (full %d)" % (scene, " ".join(opts), rp["kacanov_iterations"], rf["kacanov_iterations"]))
+
+
 def compliance(args):
     """The compliance G = (A^-1)_DD by each method against the default: MUMPS's selected entries of the
     inverse on the KSP's factor (inverse) and one back-solve per contact dof (solves) give the same
@@ -366,7 +383,7 @@ def compliance(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

@@ -63,11 +63,12 @@ public:
   // Deformed vertex positions of facet f.
   const PetscReal *Vertices(PetscInt f) const { return &xdef_[9 * f]; }
   PetscInt NumFacets() const { return (PetscInt)(xdef_.size() / 9); }
+  // Squared distance from p to facet f, b its closest point's barycentric coordinates (the searches
+  // compare squares: no square root per facet).
+  PetscReal DistToFacet2(PetscInt f, const PetscReal p[], PetscReal b[]) const;
 
 private:
   void                  Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const;
-  // squared distance from p to facet f (the searches compare squares: no square root per facet)
-  PetscReal             DistToFacet2(PetscInt f, const PetscReal p[], PetscReal b[]) const;
   PetscInt              dim_ = 2, nv_ = 2;
   std::vector<PetscReal> xdef_;
   std::vector<PetscReal> invLen2_; // 2D: 1 / |x1 - x0|^2 per facet (0 for a degenerate one), set with the vertices
@@ -106,7 +107,9 @@ inline PetscReal MultiplierShape(ContactMultiplier m, PetscInt nv, const PetscRe
 class ContactMap {
 public:
   // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet,
-  // -contact_multiplier dual|standard (nodal quadrature: standard, collocation is already diagonal).
+  // -contact_multiplier dual|standard (nodal quadrature: standard, collocation is already diagonal),
+  // -contact_segment_search pair|full (2D mortar segments: how the switches of the closest master facet
+  // are bisected; the same cuts, full = the closest-point search at every bisection step, the reference).
   PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
   // Moves both surfaces to the physical configuration at mu (reference configuration + map).
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
@@ -134,6 +137,7 @@ public:
   PetscInt          nsub       = 4;
   bool              smoothNormal = true;
   ContactMultiplier multiplier   = ContactMultiplier::Dual;
+  bool              segmentPairSearch = true;
 
 private:
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
