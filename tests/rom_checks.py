@@ -348,6 +348,17 @@ def half_disks(args):
     print("  test (5 random points): max rel err u %.2e lambda %.2e force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
     check(t["n"] == 5 and t["failed"] == 0, "the ROM converges on 5 random (radius, displacement)")
     check(t["max_rel_err_u"] < 1e-2, "2 parameters, 16 training points: u error %.2e < 1e-2" % t["max_rel_err_u"])
+    # the cubature's K^ summed by points and by patch dofs: the same terms, the same reduced solution
+    for k in ("points", "dofs"):
+        run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_sum", k, "-report", "%s/sum_%s.json" % (d, k)])
+    sp, sd = report(d + "/sum_points.json"), report(d + "/sum_dofs.json")
+    up, ud = np.array(sp["u_hat"]), np.array(sd["u_hat"])
+    lp, ld = np.array(sp["lambda_hat"]), np.array(sd["lambda_hat"])
+    du, dl = np.abs(up - ud).max() / np.abs(up).max(), np.abs(lp - ld).max() / np.abs(lp).max()
+    check(sp["rom"]["ecsw_sum"] == "points" and sd["rom"]["ecsw_sum"] == "dofs" and sp["kacanov_iterations"] == sd["kacanov_iterations"]
+          and du <= 1e-12 and dl <= 1e-8, "-rom_ecsw_sum points vs dofs: u_hat rel diff %.1e <= 1e-12, lambda_hat %.1e <= 1e-8 (coefficients of a "
+          "nearly collinear dual basis), %d vs %d iterations" % (du, dl, sp["kacanov_iterations"], sd["kacanov_iterations"]))
+    expect_error(args, ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_sum", "bogus"], ["bogus", "-rom_ecsw_sum"], "unknown -rom_ecsw_sum")
     shutil.rmtree(d, ignore_errors=True)
 
 

@@ -130,6 +130,12 @@ public:
   PetscReal   kktTol    = 1e-8;
   PetscBool   warmStart = PETSC_TRUE;
   PetscInt    warmDegree = 2; // -rom_warm_start_degree: the polynomial fit with several parameters (warm_start.hpp)
+  // -rom_ecsw_sum auto|points|dofs: how the cubature's K^ is summed (the same terms, different order of the
+  // sums): points = kappa(p, :) per point, then sum_p Pw(:, p) kappa(p, :) (Mc (nt N + R N) flops); dofs =
+  // Q = sum_p Pw(:, p) coef(p, a) per patch dof a first, then K^ = Q theta (Mc nt R + nd R N); auto: the
+  // smaller count. docs/online.md, "Where the online time goes".
+  enum class EcswSum { Auto, Points, Dofs } ecswSum = EcswSum::Auto;
+  bool EcswSumsByDofs() const { return cDofs_; }
   bool      recordIterates = false;
   ReducedQP qp;
 
@@ -149,6 +155,9 @@ private:
   std::vector<PetscReal> P_, Pact_;
   std::vector<PetscReal> cPwT_;                       // cubature weights of the active rows, M x PaddedRows(r) (point-major, zero padded)
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
+  bool                   cDofs_ = false;              // the cubature's K^ summed by patch dofs (-rom_ecsw_sum)
+  std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
+  std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
 };

@@ -83,6 +83,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   r["Mg"]                        = (long long)model.Mg();
   r["Mc"]                        = (long long)model.Mc();
   r["hyper"]                     = model.HyperName();
+  r["ecsw_sum"]                  = model.EcswSumsByDofs() ? "dofs" : "points";
   rep.root["time_s"]["open"]     = tOpen;
   rep.root["time_s"]["solve_median"] = times[times.size() / 2];
   rep.root["time_s"]["solve_min"]    = times.front();

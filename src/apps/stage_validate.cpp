@@ -315,6 +315,7 @@ PetscErrorCode StageValidate(MPI_Comm comm)
   ro["Mg"] = (long long)model.Mg();
   ro["Mc"] = (long long)model.Mc();
   ro["hyper"] = model.HyperName();
+  ro["ecsw_sum"] = model.EcswSumsByDofs() ? "dofs" : "points";
   ro["ndofs"] = (long long)order.NumDofs();
 
   // speed against error over truncations of the same ROM

@@ -263,10 +263,11 @@ static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[],
 
 // 2D: pieces [s0, s1] of the slave segment (parameter t, b = (1 - t, t)) on which the closest master
 // facet does not change; the switch points are located by bisection to 1e-13. Where the closest facet is
-// ma at one end of an interval and mb at the other, the bisection compares those two facets only (two
-// squared distances per step, the search's tie rule: the lower index wins) and the closest-point search
-// at the middle of each of the two pieces confirms that no third facet is closest in between; where it is
-// not confirmed, the interval is bisected with the search at every step. So the cuts are those of a
+// ma at one end of an interval and mb at the other and the two are neighbours on the master (a common
+// vertex), the bisection compares those two facets only (two squared distances per step, the search's tie
+// rule: the lower index wins) and the closest-point search at the switch and at the middle of each of the
+// two pieces confirms that no third facet is closest in between; otherwise (facets that are not
+// neighbours: a facet between them may be closest somewhere) the interval is bisected with the search. So the cuts are those of a
 // bisection with the full search at every step (the only method before 2026-11-25, ~45 searches per
 // switch: 90 % of the contact assembly; -contact_segment_search full) whenever the two facets are the only
 // ones closest in the interval.
@@ -293,8 +294,11 @@ void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std
       if (iv[2] != iv[3]) cuts.push_back(0.5 * (iv[0] + iv[1]));
       continue;
     }
-    if (segmentPairSearch) { // the switch between the two end facets, found among them only, then confirmed by the search
-      const PetscInt two[2] = {std::min((PetscInt)iv[2], (PetscInt)iv[3]), std::max((PetscInt)iv[2], (PetscInt)iv[3])};
+    const PetscInt      ma = (PetscInt)iv[2], mb = (PetscInt)iv[3];
+    const SurfaceFacet &Fa = masterAll_[ma], &Fb = masterAll_[mb];
+    const bool adjacent = Fa.vglobal[0] == Fb.vglobal[0] || Fa.vglobal[0] == Fb.vglobal[1] || Fa.vglobal[1] == Fb.vglobal[0] || Fa.vglobal[1] == Fb.vglobal[1];
+    if (segmentPairSearch && adjacent) { // the switch between the two end facets, found among them only, then confirmed by the search
+      const PetscInt two[2] = {std::min(ma, mb), std::max(ma, mb)};
       PetscReal      a = iv[0], b = iv[1];
       while (b - a >= 1e-13) {
         const PetscReal tm = 0.5 * (a + b);
@@ -306,7 +310,8 @@ void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std
         else b = tm;
       }
       const PetscReal t = 0.5 * (a + b);
-      if (facetAt(0.5 * (iv[0] + t)) == (PetscInt)iv[2] && facetAt(0.5 * (t + iv[1])) == (PetscInt)iv[3]) {
+      const PetscInt mt = facetAt(t);
+      if ((mt == ma || mt == mb) && facetAt(0.5 * (iv[0] + t)) == ma && facetAt(0.5 * (t + iv[1])) == mb) {
         cuts.push_back(t);
         continue;
       }

@@ -308,62 +308,80 @@ void ContactPatch::PrepareMaster()
       if (vnormal_[3 * v] != 0 || vnormal_[3 * v + 1] != 0 || vnormal_[3 * v + 2] != 0) NormalizeVertexNormal(&vnormal_[3 * v]);
 }
 
+PetscInt ContactPatch::PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit) const
+{
+  PetscInt            outside = 0;
+  const Point        &P = points[p];
+  const SurfaceFacet &F = slave[P.facet];
+  const PetscReal     w = P.wfrac * meas_[P.facet];
+  const PetscInt     *c = nullptr;
+  PetscInt            nc = 0;
+  if (!binned_) {
+    c  = &cand[candStart[p]];
+    nc = candStart[p + 1] - candStart[p];
+  }
+  ContactPointEval e;
+  EvaluateContactPoint(
+    F, dim, P.b, master, cp_.Vertices(0), smoothNormal,
+    [&](const PetscReal *z, PetscInt *m, PetscReal *bm, PetscReal *dist) {
+      if (binned_) cp_.Find(z, m, bm, dist);
+      else cp_.FindAmong(z, c, nc, m, bm, dist);
+    },
+    [&](const SurfaceFacet &Mf, PetscInt k) { return &vnormal_[3 * Mf.vglobal[k]]; }, &e);
+  const SurfaceFacet &M = master[e.m];
+  if (hit) *hit = e.m;
+  // A projection clamped to a vertex that no other candidate shares (and that does not end the
+  // master surface) may have a closer point outside the patch: out of the EIM's range.
+  if (!binned_)
+    for (PetscInt k = 0; k < M.nv; ++k)
+      if (e.bm[k] == 1.0 && !vertexEnd[M.vglobal[k]]) {
+        PetscInt shared = 0;
+        for (PetscInt j = 0; j < nc; ++j)
+          for (PetscInt kk = 0; kk < master[c[j]].nv; ++kk) shared += master[c[j]].vglobal[kk] == M.vglobal[k];
+        if (shared < 2) ++outside;
+      }
+  // kappa = w sum_a coef_a theta_a over the slave and master nodal dofs
+  PetscReal g = e.gap;
+  *nt         = 0;
+  for (PetscInt side = 0; side < 2; ++side) {
+    const SurfaceFacet &G  = side ? M : F;
+    const PetscReal    *Nb = side ? e.Nm : e.Ns;
+    const PetscReal     sg = side ? 1.0 : -1.0;
+    for (PetscInt a = 0; a < G.nnodes; ++a)
+      for (PetscInt d = 0; d < dim; ++d) {
+        const PetscReal cf = sg * Nb[a] * e.n2[d];
+        if (cf == 0.0) continue;
+        const PetscInt r = G.dof[a * dim + d];
+        g -= cf * uD[r];
+        coef[*nt]     = w * cf;
+        rowIdx[(*nt)++] = r;
+      }
+  }
+  *gamma = w * g;
+  return outside;
+}
+
 PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit) const
 {
   PetscInt outside = 0;
   for (PetscInt i = 0; i < np; ++i) {
-    const PetscInt      p = idx[i];
-    const Point        &P = points[p];
-    const SurfaceFacet &F = slave[P.facet];
-    const PetscReal     w = P.wfrac * meas_[P.facet];
-    const PetscInt     *c = nullptr;
-    PetscInt            nc = 0;
-    if (!binned_) {
-      c  = &cand[candStart[p]];
-      nc = candStart[p + 1] - candStart[p];
-    }
-    ContactPointEval e;
-    EvaluateContactPoint(
-      F, dim, P.b, master, cp_.Vertices(0), smoothNormal,
-      [&](const PetscReal *z, PetscInt *m, PetscReal *bm, PetscReal *dist) {
-        if (binned_) cp_.Find(z, m, bm, dist);
-        else cp_.FindAmong(z, c, nc, m, bm, dist);
-      },
-      [&](const SurfaceFacet &Mf, PetscInt k) { return &vnormal_[3 * Mf.vglobal[k]]; }, &e);
-    const SurfaceFacet &M = master[e.m];
-    if (hit) hit[i] = e.m;
-    // A projection clamped to a vertex that no other candidate shares (and that does not end the
-    // master surface) may have a closer point outside the patch: out of the EIM's range.
-    if (!binned_)
-      for (PetscInt k = 0; k < M.nv; ++k)
-        if (e.bm[k] == 1.0 && !vertexEnd[M.vglobal[k]]) {
-          PetscInt shared = 0;
-          for (PetscInt j = 0; j < nc; ++j)
-            for (PetscInt kk = 0; kk < master[c[j]].nv; ++kk) shared += master[c[j]].vglobal[kk] == M.vglobal[k];
-          if (shared < 2) ++outside;
-        }
-    // kappa = w sum_a coef_a theta_a over the slave and master nodal dofs (one combination kernel)
-    PetscReal        coefs[36]; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
+    PetscReal        coefs[36], g; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
+    PetscInt         ridx[36], nt;
     const PetscReal *rows[36];
-    PetscInt         nt = 0;
-    PetscReal        g  = e.gap;
-    for (PetscInt side = 0; side < 2; ++side) {
-      const SurfaceFacet &G  = side ? M : F;
-      const PetscReal    *Nb = side ? e.Nm : e.Ns;
-      const PetscReal     sg = side ? 1.0 : -1.0;
-      for (PetscInt a = 0; a < G.nnodes; ++a)
-        for (PetscInt d = 0; d < dim; ++d) {
-          const PetscReal coef = sg * Nb[a] * e.n2[d];
-          if (coef == 0.0) continue;
-          const PetscInt r = G.dof[a * dim + d];
-          g -= coef * uD[r];
-          coefs[nt]  = w * coef;
-          rows[nt++] = &theta[r * N];
-        }
+    outside += PointTerms(idx[i], &nt, ridx, coefs, &g, hit ? &hit[i] : nullptr);
+    if (kappa) {
+      for (PetscInt t = 0; t < nt; ++t) rows[t] = &theta[ridx[t] * N];
+      CombineRows(nt, coefs, rows, N, kappa + i * N); // one combination kernel
     }
-    if (kappa) CombineRows(nt, coefs, rows, N, kappa + i * N);
-    if (gamma) gamma[i] = w * g;
+    if (gamma) gamma[i] = g;
   }
+  return outside;
+}
+
+PetscInt ContactPatch::EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma) const
+{
+  PetscInt outside = 0;
+  for (PetscInt i = 0; i < np; ++i) outside += PointTerms(idx[i], &nt[i], rowIdx + (size_t)i * MaxTerms, coef + (size_t)i * MaxTerms, &gamma[i], nullptr);
   return outside;
 }
 

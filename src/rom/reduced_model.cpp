@@ -362,6 +362,13 @@ PetscErrorCode ReducedModel::SetFromOptions()
       } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
     }
   }
+  {
+    const char *sums[] = {"auto", "points", "dofs"};
+    PetscInt    k      = (PetscInt)ecswSum;
+    PetscBool   set    = PETSC_FALSE;
+    PetscCall(PetscOptionsGetEList(NULL, NULL, "-rom_ecsw_sum", sums, 3, &k, &set));
+    if (set) ecswSum = (EcswSum)k;
+  }
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_N", &n, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_R", &r, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mk", &mk, NULL));
@@ -421,6 +428,21 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   cPwT_.assign(cPoint.size() * (size_t)rp, 0.0);
   for (size_t p = 0; p < cPoint.size(); ++p)
     for (PetscInt i = 0; i < r; ++i) cPwT_[p * rp + i] = cPw[(size_t)i * cPoint.size() + p];
+  { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum)
+    const PetscInt nd = patch.nnode * patch.dim, Mc = (PetscInt)cPoint.size(), nt = 4 * patch.dim; // nt: terms per point, 2D P1 / 3D P1
+    const double   byPoints = (double)Mc * (nt * Nfull + rp * (Na + 1)), byDofs = (double)Mc * rp * (nt + 1) + (double)nd * rp * Na;
+    cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
+    cThetaT_.clear();
+    if (cDofs_) {
+      cThetaT_.assign((size_t)Na * nd, 0.0);
+      for (PetscInt c = 0; c < Na; ++c)
+        for (PetscInt a = 0; a < nd; ++a) cThetaT_[(size_t)c * nd + a] = patch.theta[(size_t)a * patch.N + cols_[c]];
+      cQ_.assign((size_t)nd * rp, 0.0);
+      cNt_.assign(Mc, 0);
+      cRow_.assign((size_t)Mc * ContactPatch::MaxTerms, 0);
+      cCoef_.assign((size_t)Mc * ContactPatch::MaxTerms, 0.0);
+    }
+  }
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
@@ -509,9 +531,30 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       geomMu_ = mu;
     }
     patch.SetReduced(vfull.data());
+    const PetscInt rp = PaddedRows(r);
+    if (cDofs_) {
+      // Q(a, :) = sum_p coef(p, a) Pw(:, p) over the patch dofs a, then K^ = Q' theta(:, cols) (one blocked
+      // kernel over the dofs), g^ = sum_p Pw(:, p) gamma(p)
+      const PetscInt nd = patch.nnode * patch.dim;
+      out = patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data());
+      std::fill(cQ_.begin(), cQ_.end(), 0.0);
+      std::fill(g, g + r, 0.0);
+      for (PetscInt p = 0; p < M; ++p) {
+        const PetscReal *w = &cPwT_[(size_t)p * rp];
+        for (PetscInt t = 0; t < cNt_[p]; ++t) {
+          const PetscReal cf = cCoef_[(size_t)p * ContactPatch::MaxTerms + t];
+          PetscReal      *q  = &cQ_[(size_t)cRow_[(size_t)p * ContactPatch::MaxTerms + t] * rp];
+          for (PetscInt i = 0; i < rp; ++i) q[i] += cf * w[i];
+        }
+        for (PetscInt i = 0; i < r; ++i) g[i] += gam_[p] * w[i];
+      }
+      cK_.resize((size_t)rp * Na);
+      SumOfOuterProducts(nd, rp, Na, cQ_.data(), cThetaT_.data(), cK_.data());
+      for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
+      return out;
+    }
     out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr);
     // [K g] = sum_p Pw(:, p) [kappa(p, cols) gamma(p)]: the columns point-contiguous, one blocked kernel
-    const PetscInt rp = PaddedRows(r);
     cX_.resize((size_t)(Na + 1) * M);
     cK_.resize((size_t)rp * (Na + 1));
     for (PetscInt c = 0; c < Na; ++c) {
