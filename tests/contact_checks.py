@@ -340,7 +340,7 @@ def paths(args):
 
 
 def segments(args):
-    """2D mortar segments: the switch of the closest master facet bisected between the two end facets with a
+    """2D mortar segments: the switch of the closest master facet bisected between the two (neighbouring) end facets with a
     confirming search (the default, pair) against the closest-point search at every bisection step (full):
     the same cuts, so the same contact force, energy and iterations to rounding (1e-14), on the scenes with
     curved masters (half_disks P1 and P2, ring_on_block, hertz). At half_disks mu = (0.7, 0.12) a slave facet

@@ -267,10 +267,10 @@ static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[],
 // vertex), the bisection compares those two facets only (two squared distances per step, the search's tie
 // rule: the lower index wins) and the closest-point search at the switch and at the middle of each of the
 // two pieces confirms that no third facet is closest in between; otherwise (facets that are not
-// neighbours: a facet between them may be closest somewhere) the interval is bisected with the search. So the cuts are those of a
-// bisection with the full search at every step (the only method before 2026-11-25, ~45 searches per
-// switch: 90 % of the contact assembly; -contact_segment_search full) whenever the two facets are the only
-// ones closest in the interval.
+// neighbours: a facet between them may be closest somewhere) the interval is bisected with the search.
+// The cuts are then those of the bisection with the full search at every step (the only method before
+// 2026-11-25, ~45 searches per switch: 90 % of the contact assembly; -contact_segment_search full):
+// tests/contact_checks.py segments, docs/fom_speed.md.
 void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const
 {
   auto pointAt = [&](PetscReal t, PetscReal z[3]) {
@@ -306,7 +306,7 @@ void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std
         PetscInt        m;
         pointAt(tm, z);
         cp.FindAmong(z, two, 2, &m, bm, &dist);
-        if (m == (PetscInt)iv[2]) a = tm;
+        if (m == ma) a = tm;
         else b = tm;
       }
       const PetscReal t = 0.5 * (a + b);

@@ -429,7 +429,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   for (size_t p = 0; p < cPoint.size(); ++p)
     for (PetscInt i = 0; i < r; ++i) cPwT_[p * rp + i] = cPw[(size_t)i * cPoint.size() + p];
   { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum)
-    const PetscInt nd = patch.nnode * patch.dim, Mc = (PetscInt)cPoint.size(), nt = 4 * patch.dim; // nt: terms per point, 2D P1 / 3D P1
+    const PetscInt nd = patch.nnode * patch.dim, Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim)
     const double   byPoints = (double)Mc * (nt * Nfull + rp * (Na + 1)), byDofs = (double)Mc * rp * (nt + 1) + (double)nd * rp * Na;
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cThetaT_.clear();
