@@ -18,29 +18,20 @@ import json
 import os
 import shlex
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import rom_accuracy  # noqa: E402  (its run and load: one way to run a stage and read its report)
+from rom_accuracy import load  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TEST = {"half_disks": ["-test_seed", "11"], "ring_on_block": ["-test_seed", "7"]}
 
 
 def run(args, cmd):
-    full = (["mpirun", "-n", str(args.np)] if args.np > 1 else []) + [args.exe] + cmd
-    if args.verbose:
-        print("+ " + " ".join(full), flush=True)
-    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    if p.returncode != 0:
-        sys.stderr.write(p.stdout[-3000:])
-        sys.exit("greedy_training.py: error: command failed (exit %d): %s" % (p.returncode, " ".join(full)))
-    return p.stdout
-
-
-def load(path):
-    with open(path) as f:
-        return json.load(f)
+    return rom_accuracy.run(args, args.np, cmd)
 
 
 def one(args, work, label, train_opts, rom):

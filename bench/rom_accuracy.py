@@ -45,7 +45,7 @@ def run(args, np_, cmd):
     p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     if p.returncode != 0:
         sys.stderr.write(p.stdout[-3000:])
-        sys.exit("rom_accuracy.py: error: command failed (exit %d): %s" % (p.returncode, " ".join(full)))
+        sys.exit("%s: error: command failed (exit %d): %s" % (os.path.basename(sys.argv[0]), p.returncode, " ".join(full)))
     return p.stdout
 
 
