@@ -31,8 +31,8 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REFERENCE = ["-fem_assembly", "petscfe", "-fom_tao_type", "bqpip", "-kacanov_anderson", "0", "-contact_compliance", "redundant"]
-SLAVE_CLAMP = {"ring_on_block": ["-bc_dirichlet", "ring_top,block_bottom,slave", "-bc_slave_u", "0,0"],
-               "half_disks": ["-bc_dirichlet", "upper_top,lower_bottom,slave", "-bc_slave_u", "0,0"]}
+SLAVE_CLAMP = {"ring_on_block": ["-dirichlet", "ring_top,block_bottom,slave", "-dirichlet_slave_u", "0,0"],
+               "half_disks": ["-dirichlet", "upper_top,lower_bottom,slave", "-dirichlet_slave_u", "0,0"]}
 
 
 def run(args, np_, scene, extra):

@@ -256,7 +256,7 @@ def nan_input(args):
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         check(p.returncode == 0, "good run (contact %s) writes %s" % (contact, h5))
         before = hashlib.sha256(open(h5, "rb").read()).hexdigest()
-        for opt, val in (("-bc_ring_top_u", "0,nan"), ("-body_force", "0,inf"), ("-body_E", "nan,100"), ("-bc_block_bottom_u", "0,-inf")):
+        for opt, val in (("-dirichlet_ring_top_u", "0,nan"), ("-body_force", "0,inf"), ("-body_E", "nan,100"), ("-dirichlet_block_bottom_u", "0,-inf")):
             p = subprocess.run(cmd + [opt, val], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
             named = ("option %s: value" % opt) in p.stdout and "not a finite number" in p.stdout
             crash = re.search(r"SEGV|Segmentation|Caught signal", p.stdout) is not None
@@ -272,9 +272,9 @@ def floating(args):
     """A body without Dirichlet values in some direction is refused before the solve, naming it (before:
     -contact 0 gave |u| 8e11 and a negative energy with exit 0; with contact 'Schur complement not SPD')."""
     print("Floating bodies: refused naming the body and the direction")
-    for extra, why in ((["-contact", "0", "-bc_dirichlet", "block_bottom", "-body_force", "0,-1"], "it floats"),
-                       (["-bc_dirichlet", "block_bottom"], "frictionless contact cannot hold it"),
-                       (["-bc_dirichlet", "ring_top,block_bottom", "-bc_block_bottom_comps", "1"], "body 'block' has no Dirichlet condition on its x displacement")):
+    for extra, why in ((["-contact", "0", "-dirichlet", "block_bottom", "-body_force", "0,-1"], "it floats"),
+                       (["-dirichlet", "block_bottom"], "frictionless contact cannot hold it"),
+                       (["-dirichlet", "ring_top,block_bottom", "-dirichlet_block_bottom_comps", "1"], "body 'block' has no Dirichlet condition on its x displacement")):
         cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts"] + extra
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         who = "body 'ring'" in p.stdout or "body 'block'" in p.stdout
@@ -298,7 +298,7 @@ def warnings(args):
     check(q.returncode == 0 and "was not used" not in q.stdout, "the same run without the typo: no unused-option warning (the file's -train_*, -pod_*, -test_* ... belong to other stages)")
     r, _ = run(args, args.np, "runs/flat_punch.opts", args.extra, "punch")
     check(r["nactive"] == r["ncontact"] and r["warnings"] == [], "flat punch, whole face in contact, surface ending at the body's corners: no warning (%s)" % r["warnings"])
-    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-bc_ring_top_u", "0,-0.3"] + args.extra, "deep")
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-dirichlet_ring_top_u", "0,-0.3"] + args.extra, "deep")
     w = [s for s in r["warnings"] if "reaches the end of the slave surface" in s]
     check(len(w) == 2 and r["nactive"] == r["ncontact"], "push 0.3: the whole slave surface in contact (%d/%d), 2 end warnings (%d)" % (r["nactive"], r["ncontact"], len(w)))
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999"] + args.extra, "nu")
@@ -307,10 +307,10 @@ def warnings(args):
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999", "-fem_degree", "2"] + args.extra, "nu_p2")
     check(not any("lock" in s for s in r["warnings"]), "P2, nu = 0.4999: no locking warning")
     # contact running past the end of the master surface (x = 0.6): a lateral push of 0.55 warns, 0.3 does not
-    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-bc_ring_top_u", "0.55,-0.1"] + args.extra, "past_master")
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-dirichlet_ring_top_u", "0.55,-0.1"] + args.extra, "past_master")
     w = [s for s in r["warnings"] if "runs past an end of the master surface" in s]
     check(len(w) == 1, "lateral push 0.55: one warning for contact past the master's end (%s)" % r["warnings"])
-    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-bc_ring_top_u", "0.3,-0.1"] + args.extra, "slide")
+    r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-dirichlet_ring_top_u", "0.3,-0.1"] + args.extra, "slide")
     check(r["warnings"] == [], "lateral push 0.3 (contact inside the master surface): no warning (%s)" % r["warnings"])
     # an initial overlap of 0.01 (ring moved down through the block top): warned, measured, still solved
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-mesh_geo_set", "g0=-0.01", "-map_ring_dilation_center", "0,-0.01"] + args.extra, "overlap")

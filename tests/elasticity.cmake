@@ -16,7 +16,7 @@ rbc_add_mpi_test(NAME two_bodies RANKS 1 2 COMMAND $<TARGET_FILE:test_two_bodies
 
 # Ring on block without contact, the slave arc clamped and the ring top moved: a stressed scene.
 rbc_test_exe(test_fom_parallel)
-set(RBC_FOMPAR_SCENE -options_file runs/ring_on_block.opts -contact 0 -bc_dirichlet ring_top,block_bottom,slave -bc_slave_u 0,0 -bc_ring_top_u 0.01,-0.05)
+set(RBC_FOMPAR_SCENE -options_file runs/ring_on_block.opts -contact 0 -dirichlet ring_top,block_bottom,slave -dirichlet_slave_u 0,0 -dirichlet_ring_top_u 0.01,-0.05)
 rbc_add_mpi_test(NAME fom_parallel_metis RANKS 1 2 COMMAND $<TARGET_FILE:test_fom_parallel> ${RBC_FOMPAR_SCENE} -mesh_partitioner metis LABELS elasticity)
 rbc_add_mpi_test(NAME fom_parallel_ptscotch RANKS 2 COMMAND $<TARGET_FILE:test_fom_parallel> ${RBC_FOMPAR_SCENE} -mesh_partitioner ptscotch LABELS elasticity)
 rbc_add_mpi_test(NAME fom_parallel_p2 RANKS 2 COMMAND $<TARGET_FILE:test_fom_parallel> ${RBC_FOMPAR_SCENE} -mesh_partitioner metis -fem_degree 2 LABELS elasticity)
@@ -29,7 +29,7 @@ function(rbc_bad_input name regex)
   rbc_add_mpi_test(NAME bad_input_${name} RANKS 1 TIMEOUT 120 COMMAND ${RBC_EXPECT_ERROR} "${regex}" ${RBC_FOM_RING} ${ARGN} LABELS elasticity)
 endfunction()
 rbc_bad_input(missing_mesh "Mesh file 'meshes/no_such_mesh[.]geo' not found" -mesh_file meshes/no_such_mesh.geo)
-rbc_bad_input(unknown_physical_name "Physical name 'nosuch' [(]option -bc_dirichlet[)] does not exist in mesh 'meshes/ring_on_block[.]geo'" -bc_dirichlet ring_top,nosuch)
+rbc_bad_input(unknown_physical_name "Physical name 'nosuch' [(]option -dirichlet[)] does not exist in mesh 'meshes/ring_on_block[.]geo'" -dirichlet ring_top,nosuch)
 rbc_bad_input(unknown_body "Physical name 'nosuchbody' [(]option -bodies[)] does not exist" -bodies ring,nosuchbody)
 rbc_bad_input(E_zero "-body_E: Young's modulus 0[.]? of body 'ring' must be > 0" -body_E 0,100)
 rbc_bad_input(E_negative "-body_E: Young's modulus -5[.]? of body 'block' must be > 0" -body_E 100,-5)
@@ -49,5 +49,5 @@ set_tests_properties(bad_input_garbage_msh_np2 PROPERTIES ENVIRONMENT "${RBC_MPI
 # energy to 1e-12 on P1/P2, 2D/3D, mapped bodies at several mu, loads (body force, traction) and liftings.
 rbc_test_exe(test_element_assembly)
 rbc_add_mpi_test(NAME element_assembly_half_disks RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/half_disks.opts -fem_degree 2 -test_mu 0.7,0.06,1.3,0.12 LABELS elasticity)
-rbc_add_mpi_test(NAME element_assembly_ring_loads RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/ring_on_block.opts -body_force 0.3,-1 -bc_traction ring_top -bc_ring_top_t 0.5,-2 -bc_dirichlet block_bottom,slave -bc_slave_u 0.01,0.02 -test_mu 0.95,1.15 LABELS elasticity)
-rbc_add_mpi_test(NAME element_assembly_block3d RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -scene block3d -mesh_file meshes/block3d.geo -bodies block -body_E 100 -body_nu 0.3 -bc_dirichlet bottom,sides -bc_bottom_u 0,0,0 -bc_sides_u 0.01,0,0.02 -bc_sides_comps 0,2 -bc_traction top -bc_top_t 0.1,0,-1 -body_force 0,0,-2 -contact 0 -fem_degree 2 LABELS elasticity)
+rbc_add_mpi_test(NAME element_assembly_ring_loads RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/ring_on_block.opts -body_force 0.3,-1 -traction ring_top -traction_ring_top_t 0.5,-2 -dirichlet block_bottom,slave -dirichlet_slave_u 0.01,0.02 -test_mu 0.95,1.15 LABELS elasticity)
+rbc_add_mpi_test(NAME element_assembly_block3d RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -scene block3d -mesh_file meshes/block3d.geo -bodies block -body_E 100 -body_nu 0.3 -dirichlet bottom,sides -dirichlet_bottom_u 0,0,0 -dirichlet_sides_u 0.01,0,0.02 -dirichlet_sides_comps 0,2 -traction top -traction_top_t 0.1,0,-1 -body_force 0,0,-2 -contact 0 -fem_degree 2 LABELS elasticity)

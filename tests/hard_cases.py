@@ -118,7 +118,7 @@ def rigid_push(push, expect_contact):
     """The ring's top ends pushed by `push` (gap 0.005): a rigid translation, no force."""
     def run(ctx):
         ref = fom(ctx, "runs/ring_on_block.opts", [])
-        r = fom(ctx, "runs/ring_on_block.opts", ["-bc_ring_top_u", "0,-%g" % push])
+        r = fom(ctx, "runs/ring_on_block.opts", ["-dirichlet_ring_top_u", "0,-%g" % push])
         if r.rep is None or ref.rep is None:
             return failed([r, ref], "ring")
         f = r.rep["contact_force"] / ref.rep["contact_force"]
@@ -132,7 +132,7 @@ def rigid_push(push, expect_contact):
 def large_sliding(ctx):
     """Lateral push 0.3 (18 master facets) against the same configuration reached without sliding: the block
     translated by -0.3 under a ring pushed straight down (frictionless: the final state is path independent)."""
-    r = fom(ctx, "runs/ring_on_block.opts", ["-mu", "1.0", "-bc_ring_top_u", "0.3,-0.1"])
+    r = fom(ctx, "runs/ring_on_block.opts", ["-mu", "1.0", "-dirichlet_ring_top_u", "0.3,-0.1"])
     ref = fom(ctx, "runs/ring_on_block.opts", ["-mu_names", "radius,shift", "-mu_min", "0.95,0.5", "-mu_max", "1.15,1.5", "-mu_default", "1,1",
                                                "-mu", "1,0.7", "-map_block", "translation", "-map_block_translation_param", "shift",
                                                "-map_block_translation_dir", "1,0", "-map_block_translation_ref", "1"])
@@ -174,8 +174,8 @@ def conforming_curved(ctx):
 def load_tiny(ctx):
     """Pushes of 2e-10 and 2e-8 (1e-8 and 1e-6 of the shipped Hertz push): one node in contact, the force
     linear in the push (same active set) to 1e-6."""
-    a = fom(ctx, "runs/hertz.opts", ["-bc_cylinder_top_u", "0,-2e-10"])
-    b = fom(ctx, "runs/hertz.opts", ["-bc_cylinder_top_u", "0,-2e-8"])
+    a = fom(ctx, "runs/hertz.opts", ["-dirichlet_cylinder_top_u", "0,-2e-10"])
+    b = fom(ctx, "runs/hertz.opts", ["-dirichlet_cylinder_top_u", "0,-2e-8"])
     if a.rep is None or b.rep is None:
         return failed([a, b], "hertz")
     ratio = b.rep["contact_force"] / a.rep["contact_force"]
@@ -299,7 +299,7 @@ CASES = {
     "slave_10x_finer": ("slave mesh 10x finer than the master: must warn", "Hertz a; the mesh-ratio warning", hertz_case(["-mesh_geo_set", "h_slave=0.002,h_master=0.02"], p0_tol=None, warn="coarser than the slave"), False),
     "slave_10x_coarser": ("slave mesh 10x coarser than the master", "Hertz (analytic)", hertz_case(["-mesh_geo_set", "h_slave=0.02,h_master=0.002"]), False),
     "load_1e-8": ("loads 1e-8 and 1e-6 of the shipped one (one node in contact)", "linearity in the push", load_tiny, False),
-    "load_largest": ("load 5x the shipped one: active zone 72 % of the slave surface", "Hertz (analytic; its own error grows as (a/R)^2, a/R = 0.25)", hertz_case(["-bc_cylinder_top_u", "0,-0.1"], a_tol=0.02, p0_tol=0.02), False),
+    "load_largest": ("load 5x the shipped one: active zone 72 % of the slave surface", "Hertz (analytic; its own error grows as (a/R)^2, a/R = 0.25)", hertz_case(["-dirichlet_cylinder_top_u", "0,-0.1"], a_tol=0.02, p0_tol=0.02), False),
     "rom_onset": ("ROM: parameter box across the onset of contact", "FOM on 10 random parameters", rom_onset, True),
     "rom_split": ("ROM: an active zone that splits in two across the box (twin bumps)", "FOM on 10 random parameters", rom_split, False),
     "dual_duplicates": ("dual greedy + NNLS: duplicate and nearly collinear snapshots", "the same greedy without them", dual_duplicates, False),

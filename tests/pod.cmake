@@ -7,7 +7,7 @@
 #   pod_compare_modes    the checksums of the modes with s_i >= 1e-2 s_0 (synthetic: w.v_i and s_i;
 #                        FOM: sum(v_i), |v_i|_2) on 1 and 2 ranks agree to 1e-10 relative
 rbc_test_exe(test_pod)
-set(RBC_POD_SCENE -options_file runs/ring_on_block.opts -contact 0 -bc_dirichlet ring_top,block_bottom,slave -bc_slave_u 0,0 -bc_ring_top_u 0.01,-0.05)
+set(RBC_POD_SCENE -options_file runs/ring_on_block.opts -contact 0 -dirichlet ring_top,block_bottom,slave -dirichlet_slave_u 0,0 -dirichlet_ring_top_u 0.01,-0.05)
 set(RBC_POD_OUT ${CMAKE_CURRENT_BINARY_DIR})
 foreach(np 1 2)
   rbc_add_mpi_test(NAME pod RANKS ${np} TIMEOUT 300 COMMAND $<TARGET_FILE:test_pod> ${RBC_POD_SCENE}

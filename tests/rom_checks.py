@@ -379,7 +379,7 @@ def files(args):
         p = run(args, np_, "validate", val + ["-body_E", "200,100"], expect_ok=False)
         check(p.returncode != 0 and "was built for another configuration of scene 'ring_on_block'" in p.stdout,
               "validate with -body_E 200,100 on %d rank(s): refused (scene hash), exit %d" % (np_, p.returncode))
-    p = run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-bc_ring_top_u", "0,-0.05",
+    p = run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-dirichlet_ring_top_u", "0,-0.05",
                                 "-rom_reconstruct", d + "/rec.h5"], expect_ok=False)
     check(p.returncode != 0 and "another configuration" in p.stdout and not os.path.exists(d + "/rec.h5"),
           "-rom_reconstruct with another load: refused, nothing written (exit %d)" % p.returncode)

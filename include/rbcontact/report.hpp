@@ -70,7 +70,8 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
 // its directory exists and is writable, and path is not a directory. Collective (rank 0 looks).
 PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option);
 
-// The report of one stage run: filled by the stage, written by Write() if -report was given.
+// The report of one stage run: filled by the stage, written by Write() if -report was given, with the
+// key "provenance" (rbcontact/provenance.hpp) added unless the stage set it. Collective on comm.
 class Report {
 public:
   JsonValue root = JsonValue::Object();

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <sstream>
 #include <string>
+#include <unistd.h>
+#include "rbcontact/provenance.hpp"
 #include "stages.hpp"
 
 static const char help[] = "rbcontact: reduced-basis model reduction of frictionless contact.\n"
@@ -106,11 +108,17 @@ static std::string OptionsHoldingValue(const char *mess)
   return found.empty() ? "" : " (option " + found + ")";
 }
 
+// The first error of the run, for the failure report (FailureReport).
+static std::string firstError;
+
 static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
 {
   PetscMPIInt rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (p == PETSC_ERROR_INITIAL) std::fprintf(stderr, "[%d] rbcontact error: %s%s\n", (int)rank, mess ? mess : "(no message)", OptionsHoldingValue(mess).c_str());
+  if (p == PETSC_ERROR_INITIAL) {
+    std::fprintf(stderr, "[%d] rbcontact error: %s%s\n", (int)rank, mess ? mess : "(no message)", OptionsHoldingValue(mess).c_str());
+    if (firstError.empty()) firstError = std::string(mess ? mess : "(no message)") + OptionsHoldingValue(mess) + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
+  }
   std::fprintf(stderr, "[%d]     in %s() at %s:%d\n", (int)rank, fun ? fun : "?", file ? file : "?", line);
   return n;
 }
@@ -130,6 +138,34 @@ static PetscErrorCode OneBlasThreadPerRank()
     if (auto fn = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) fn(1);
   }
   PetscFunctionReturn(0);
+}
+
+// A failed run still leaves its -report: {"stage", "converged": false, "error": the first message,
+// "error_code", "provenance"}, written by rank 0 alone (the failure need not be collective: no
+// communication here), to a temporary file then renamed. A report the stage wrote before failing
+// is replaced: the run did not finish.
+static void FailureReport(const std::string &stage, PetscErrorCode ierr)
+{
+  char        path[PETSC_MAX_PATH_LEN] = "";
+  PetscBool   set                      = PETSC_FALSE;
+  PetscMPIInt rank                     = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank != 0 || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
+  rbc::JsonValue r = rbc::JsonValue::Object();
+  r["stage"]       = stage;
+  r["converged"]   = false;
+  r["error"]       = firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError;
+  r["error_code"]  = (long long)ierr;
+  r["provenance"]  = rbc::ProvenanceJson(rbc::LocalProvenance());
+  const std::string tmp = std::string(path) + ".tmp." + std::to_string((long)getpid());
+  FILE             *f   = std::fopen(tmp.c_str(), "w");
+  if (!f) return;
+  const std::string text = r.Dump() + "\n";
+  const bool        ok   = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path) != 0) {
+    std::remove(tmp.c_str());
+    std::fprintf(stderr, "rbcontact: could not write the failure report %s\n", path);
+  }
 }
 
 int main(int argc, char **argv)
@@ -157,11 +193,13 @@ int main(int argc, char **argv)
   else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);
   else if (stage == "validate") ierr = rbc::StageValidate(PETSC_COMM_WORLD);
   else {
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: unknown stage '%s' (known: fom, offline, online, validate, dualbasis)\n", stage.c_str()));
+    firstError = "unknown stage '" + stage + "' (known: fom, offline, online, validate, dualbasis)";
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
     ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
   }
   if (ierr) {
-    // The error message was printed by PETSc's handler; exit non-zero.
+    // The error message was printed by PETSc's handler; the report says the run failed; exit non-zero.
+    FailureReport(stage, ierr);
     (void)SlepcFinalize();
     return (int)ierr;
   }

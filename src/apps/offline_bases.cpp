@@ -286,7 +286,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     x->Attr("scene", header.scene);
     x->Attr("scene_hash", hs.str());
     x->Attr("rom_id", romId);
-    x->Attr("code_version", header.codeVersion);
+    x->Attr("snapshots_code_version", header.codeVersion); // the code that computed the snapshots (this file's own: code_version, code_commit)
     x->Attr("snapshots", snapPath);
     x->Attr("options", header.optionsText);
     x->Attr("pod_inner", inner);

@@ -28,9 +28,13 @@ PetscErrorCode StageFom(MPI_Comm comm)
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-fom_output", outPath, sizeof outPath, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-hertz_radius", &hertzRadius, &hertz));
+  PetscBool affine = PETSC_TRUE, affineSet = PETSC_FALSE;
+  PetscOptionsBegin(comm, NULL, "rbcontact fom: the full-order model at one parameter", "rbcontact");
+  PetscCall(PetscOptionsString("-report", "Write the run's summary (JSON) here", "README.md", reportPath, reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsString("-fom_output", "Write the fields (HDF5 + XDMF for ParaView) here", "README.md", outPath, outPath, sizeof outPath, NULL));
+  PetscCall(PetscOptionsReal("-hertz_radius", "Compare with Hertz's line contact of a cylinder of this radius", "docs/contact.md", hertzRadius, &hertzRadius, &hertz));
+  PetscCall(PetscOptionsBool("-fom_affine", "Assemble A(mu), f(mu) from the affine terms (default with parameters)", "docs/reference_configuration.md", affine, &affine, &affineSet));
+  PetscOptionsEnd();
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, outPath, "-fom_output"));
   PetscCall(SceneSpecFromOptions(comm, &scene));
@@ -39,8 +43,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
   KacanovSolver kacanov;
   PetscCall(fom.Create(comm, scene));
   // On the reference mesh: A(mu), f(mu) from the affine decomposition (-fom_affine 0: direct assembly)
-  PetscBool affine = scene.params.empty() ? PETSC_FALSE : PETSC_TRUE;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-fom_affine", &affine, NULL));
+  if (!affineSet) affine = scene.params.empty() ? PETSC_FALSE : PETSC_TRUE;
   if (affine) PetscCall(fom.SetupAffine());
   PetscCall(fom.SetMu(ParamValues(scene)));
   if (scene.contact) {

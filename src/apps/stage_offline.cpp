@@ -7,6 +7,7 @@
 #include "offline_greedy.hpp"
 #include "offline_rom.hpp"
 #include "rom_fields.hpp"
+#include "rbcontact/provenance.hpp"
 #include "rbcontact/supremizers.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/canonical_order.hpp"
@@ -19,10 +20,6 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
-
-#ifndef RBC_VERSION
-  #define RBC_VERSION "unknown"
-#endif
 
 namespace rbc {
 
@@ -185,7 +182,7 @@ PetscErrorCode StageOffline(MPI_Comm world)
     h.scene          = scene.name;
     h.sceneHash      = Fnv1a(SceneFingerprint(scene, fom.map));
     h.meshChecksum   = checksum;
-    h.codeVersion    = RBC_VERSION;
+    h.codeVersion    = CodeVersion();
     h.paramNames     = train.names;
     for (const auto &p : scene.params) { h.paramMin.push_back(p.min); h.paramMax.push_back(p.max); }
     h.trainingPoints = train.points;

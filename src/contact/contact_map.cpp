@@ -90,28 +90,34 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscBool flg;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_quadrature", quad, sizeof quad, NULL));
+  PetscOptionsBegin(comm, NULL, "Contact map: quadrature, normal, multipliers (docs/contact.md)", "ContactMap");
+  PetscCall(PetscOptionsString("-contact_quadrature", "Slave quadrature: gauss (segment by segment), composite, nodal", "docs/contact.md", quad, quad, sizeof quad, NULL));
   if (!strcmp(quad, "gauss")) quadrature = ContactQuadrature::Gauss;
   else if (!strcmp(quad, "nodal")) quadrature = ContactQuadrature::Nodal;
   else if (!strcmp(quad, "composite")) quadrature = ContactQuadrature::Composite;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_quadrature: unknown value '%s' (gauss, composite or nodal)", quad);
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-contact_quadrature_subdivisions", &nsub, NULL));
+  PetscCall(PetscOptionsInt("-contact_quadrature_subdivisions", "composite: pieces per slave facet", "docs/contact.md", nsub, &nsub, NULL));
   PetscCheck(nsub >= 1 && nsub <= 64, comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-contact_quadrature_points", &nquad, &flg));
+  PetscCall(PetscOptionsInt("-contact_quadrature_points", "Gauss points per segment (piece)", "docs/contact.md", nquad, &nquad, &flg));
   PetscCheck(nquad >= 1 && nquad <= 12, comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_quadrature_points %" PetscInt_FMT " out of range [1, 12]", nquad);
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_normal", nrm, sizeof nrm, NULL));
+  PetscCall(PetscOptionsString("-contact_normal", "Master normal: smooth (averaged at the vertices) or facet", "docs/contact.md", nrm, nrm, sizeof nrm, NULL));
   if (!strcmp(nrm, "smooth")) smoothNormal = true;
   else if (!strcmp(nrm, "facet")) smoothNormal = false;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_normal: unknown value '%s' (smooth or facet)", nrm);
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_multiplier", mult, sizeof mult, NULL));
+  PetscCall(PetscOptionsString("-contact_multiplier", "Multiplier space: dual (biorthogonal) or standard", "docs/contact.md", mult, mult, sizeof mult, NULL));
   if (!strcmp(mult, "dual")) multiplier = ContactMultiplier::Dual;
   else if (!strcmp(mult, "standard")) multiplier = ContactMultiplier::Standard;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_multiplier: unknown value '%s' (dual or standard)", mult);
   if (quadrature == ContactQuadrature::Nodal) multiplier = ContactMultiplier::Standard; // collocation: already diagonal
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_segment_search", seg, sizeof seg, NULL));
+  PetscCall(PetscOptionsString("-contact_segment_search", "Mortar segments: pair (bisection between neighbouring facets) or full", "docs/fom_speed.md", seg, seg, sizeof seg, NULL));
   if (!strcmp(seg, "pair")) segmentPairSearch = true;
   else if (!strcmp(seg, "full")) segmentPairSearch = false;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_segment_search: unknown value '%s' (pair or full)", seg);
+  {
+    char cm[32] = "auto"; // read by ElasticFOM and SurfaceCompliance (listed here for -help)
+    PetscCall(PetscOptionsString("-contact_compliance", "Surface compliance (A^-1)_DD: auto, schur, inverse, redundant or solves", "docs/contact.md", cm, cm, sizeof cm, NULL));
+  }
+  PetscOptionsEnd();
 
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));

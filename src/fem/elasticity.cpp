@@ -263,7 +263,7 @@ PetscErrorCode Elasticity::SetMu(const std::vector<PetscReal> &mu)
     if (b >= 0 && !(map_ ? map_->bodies[b].blocks.empty() : true)) {
       const Affine &a   = maps[b];
       const bool    conf = std::abs(a.G[1]) + std::abs(a.G[3]) + std::abs(a.G[2]) + std::abs(a.G[5]) + std::abs(a.G[6]) + std::abs(a.G[7]) < 1e-14 && std::abs(a.G[0] - a.G[4]) <= 1e-14 * std::abs(a.G[0]) && (dim == 2 || std::abs(a.G[0] - a.G[8]) <= 1e-14 * std::abs(a.G[0]));
-      PetscCheck(conf, comm, PETSC_ERR_SUP, "-bc_traction %s: tractions on a body with a non-conformal map (stretch) are not supported", t.label.c_str());
+      PetscCheck(conf, comm, PETSC_ERR_SUP, "-traction %s: tractions on a body with a non-conformal map (stretch) are not supported", t.label.c_str());
       s = std::pow(a.G[0], (PetscReal)(dim - 1));
     }
     tsc.push_back(s * (t.param >= 0 ? mu[t.param] / scene.params[t.param].def : 1.0));
@@ -312,13 +312,13 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   PetscCall(PetscDSSetJacobian(ds, 0, 0, g0_mass, NULL, NULL, g3_stiffness));
 
   // Constants: body force and tractions
-  PetscCheck((PetscInt)scene.tractions.size() <= kMaxTractions, comm, PETSC_ERR_SUP, "-bc_traction: at most %" PetscInt_FMT " traction boundaries", kMaxTractions);
+  PetscCheck((PetscInt)scene.tractions.size() <= kMaxTractions, comm, PETSC_ERR_SUP, "-traction: at most %" PetscInt_FMT " traction boundaries", kMaxTractions);
   std::vector<PetscScalar> constants(3 + 3 * kMaxTractions, 0.0);
   PetscCheck(scene.bodyForce.empty() || (PetscInt)scene.bodyForce.size() == dim, comm, PETSC_ERR_USER_INPUT, "-body_force has %zu components, the mesh is %" PetscInt_FMT "D", scene.bodyForce.size(), dim);
   for (size_t d = 0; d < scene.bodyForce.size(); ++d) constants[d] = scene.bodyForce[d];
   for (size_t k = 0; k < scene.tractions.size(); ++k) {
     const TractionSpec &tr = scene.tractions[k];
-    PetscCheck((PetscInt)tr.traction.size() == dim, comm, PETSC_ERR_USER_INPUT, "-bc_%s_t has %zu components, the mesh is %" PetscInt_FMT "D", tr.label.c_str(), tr.traction.size(), dim);
+    PetscCheck((PetscInt)tr.traction.size() == dim, comm, PETSC_ERR_USER_INPUT, "-traction_%s_t has %zu components, the mesh is %" PetscInt_FMT "D", tr.label.c_str(), tr.traction.size(), dim);
     for (PetscInt d = 0; d < dim; ++d) constants[3 + 3 * k + d] = tr.traction[d];
     DMLabel       label;
     PetscInt      bd;
@@ -327,7 +327,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
     PetscInt      nv = 0;
     const PetscInt *vals = NULL;
     PetscCall(DMGetLabel(dm, tr.label.c_str(), &label));
-    PetscCall(MeshCheckLabel(dm, tr.label, "-bc_traction", scene.mesh.file));
+    PetscCall(MeshCheckLabel(dm, tr.label, "-traction", scene.mesh.file));
     PetscCall(DMLabelGetValueIS(label, &valueIS));
     PetscCall(ISGetLocalSize(valueIS, &nv));
     PetscCall(ISGetIndices(valueIS, &vals));
@@ -348,10 +348,10 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   bcValue_.clear();
   for (auto &bc : bcs_) {
     DMLabel label;
-    PetscCall(MeshCheckLabel(dm, bc.label, "-bc_dirichlet", scene.mesh.file));
+    PetscCall(MeshCheckLabel(dm, bc.label, "-dirichlet", scene.mesh.file));
     PetscCall(DMGetLabel(dm, bc.label.c_str(), &label));
-    if (!bc.fn) PetscCheck((PetscInt)bc.values.size() == dim, comm, PETSC_ERR_USER_INPUT, "-bc_%s_u has %zu components, the mesh is %" PetscInt_FMT "D (give all components; -bc_%s_comps selects the constrained ones)", bc.label.c_str(), bc.values.size(), dim, bc.label.c_str());
-    for (PetscInt c : bc.comps) PetscCheck(c < dim, comm, PETSC_ERR_ARG_OUTOFRANGE, "-bc_%s_comps: component %" PetscInt_FMT " >= dimension %" PetscInt_FMT, bc.label.c_str(), c, dim);
+    if (!bc.fn) PetscCheck((PetscInt)bc.values.size() == dim, comm, PETSC_ERR_USER_INPUT, "-dirichlet_%s_u has %zu components, the mesh is %" PetscInt_FMT "D (give all components; -dirichlet_%s_comps selects the constrained ones)", bc.label.c_str(), bc.values.size(), dim, bc.label.c_str());
+    for (PetscInt c : bc.comps) PetscCheck(c < dim, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dirichlet_%s_comps: component %" PetscInt_FMT " >= dimension %" PetscInt_FMT, bc.label.c_str(), c, dim);
     IS              valueIS;
     PetscInt        nv = 0;
     const PetscInt *vals = NULL;

@@ -175,29 +175,30 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
   PetscFunctionBeginUser;
   bodies.clear();
   bodies.resize(scene.bodies.size());
+  PetscOptionsBegin(comm, NULL, "Geometry maps of the reference configuration, per body (docs/reference_configuration.md)", "GeometryMap");
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
     const std::string pre = "-map_" + scene.bodies[b].name;
-    char              buf[256];
+    char              buf[256] = "";
     PetscBool         flg;
-    PetscCall(PetscOptionsGetString(NULL, NULL, pre.c_str(), buf, sizeof buf, &flg));
+    PetscCall(PetscOptionsString(pre.c_str(), "Map blocks of this body: dilation, stretch, translation (comma separated)", "docs/reference_configuration.md", buf, buf, sizeof buf, &flg));
     if (!flg) continue;
     for (const auto &kind : SplitList(buf)) {
       const std::string bp = pre + "_" + kind;
-      char              pname[128];
-      PetscCall(PetscOptionsGetString(NULL, NULL, (bp + "_param").c_str(), pname, sizeof pname, &flg));
+      char              pname[128] = "";
+      PetscCall(PetscOptionsString((bp + "_param").c_str(), "Parameter (of -mu_names) driving this block", "docs/reference_configuration.md", pname, pname, sizeof pname, &flg));
       PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s lists '%s' but %s_param (the driving parameter) is missing", pre.c_str(), kind.c_str(), bp.c_str());
       PetscInt p = -1;
       for (size_t i = 0; i < scene.params.size(); ++i) if (scene.params[i].name == pname) p = (PetscInt)i;
       PetscCheck(p >= 0, comm, PETSC_ERR_USER_INPUT, "%s_param: unknown parameter '%s' (declared by -mu_names)", bp.c_str(), pname);
       PetscCheck(scene.params[p].geoName.empty(), comm, PETSC_ERR_USER_INPUT, "Parameter '%s' both remeshes (-mu_geo_set) and drives %s: choose one", pname, pre.c_str());
       PetscReal ref = scene.params[p].def;
-      PetscCall(PetscOptionsGetReal(NULL, NULL, (bp + "_ref").c_str(), &ref, NULL));
+      PetscCall(PetscOptionsReal((bp + "_ref").c_str(), "Parameter value of the mesh (default: -mu_default)", "docs/reference_configuration.md", ref, &ref, NULL));
       PetscCheck(ref != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_ref must be nonzero", bp.c_str());
       if (kind == "dilation" || kind == "translation") {
         PetscReal v[3] = {0, 0, 0};
         PetscInt  n    = 3;
         const std::string opt = bp + (kind == "dilation" ? "_center" : "_dir");
-        PetscCall(PetscOptionsGetRealArray(NULL, NULL, opt.c_str(), v, &n, &flg));
+        PetscCall(PetscOptionsRealArray(opt.c_str(), kind == "dilation" ? "Fixed point of the dilation" : "Direction of the translation", "docs/reference_configuration.md", v, &n, &flg));
         PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s is required", opt.c_str());
         const std::array<PetscReal, 3> a = {v[0], v[1], v[2]};
         if (kind == "dilation") bodies[b].blocks.push_back(std::make_unique<Dilation>(p, ref, a));
@@ -205,13 +206,14 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
       } else if (kind == "stretch") {
         PetscInt  axis = -1;
         PetscReal c    = 0;
-        PetscCall(PetscOptionsGetInt(NULL, NULL, (bp + "_axis").c_str(), &axis, NULL));
-        PetscCall(PetscOptionsGetReal(NULL, NULL, (bp + "_center").c_str(), &c, NULL));
+        PetscCall(PetscOptionsInt((bp + "_axis").c_str(), "Stretched axis (0, 1, 2)", "docs/reference_configuration.md", axis, &axis, NULL));
+        PetscCall(PetscOptionsReal((bp + "_center").c_str(), "Fixed coordinate of the stretch", "docs/reference_configuration.md", c, &c, NULL));
         PetscCheck(axis >= 0 && axis < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_axis %" PetscInt_FMT " must be 0, 1 or 2", bp.c_str(), axis);
         bodies[b].blocks.push_back(std::make_unique<Stretch>(p, ref, axis, c));
       } else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "%s: unknown map block '%s' (dilation, stretch, translation)", pre.c_str(), kind.c_str());
     }
   }
+  PetscOptionsEnd();
   PetscFunctionReturn(0);
 }
 

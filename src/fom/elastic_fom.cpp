@@ -188,7 +188,7 @@ PetscErrorCode ElasticFOM::FactorWithSchur(bool *done)
   }
   PetscCall(MatCholeskyFactorNumeric(schurFactor_, A, &info));
   PetscCall(MatFactorGetError(schurFactor_, &err));
-  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-bc_dirichlet); out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure");
+  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet); out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure");
   PetscCall(MatDestroy(&schurS_));
   PetscCall(MatFactorCreateSchurComplement(schurFactor_, &schurS_, &status));
   *done = true;
@@ -286,7 +286,7 @@ PetscErrorCode ElasticFOM::CheckBodiesHeld() const
   for (PetscInt b = 0; b < nb; ++b)
     for (PetscInt d = 0; d < dim; ++d)
       PetscCheck(held[(size_t)b * dim + d] > 0, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
-                 "body '%s' has no Dirichlet condition on its %s displacement: it floats (a rigid translation is a null mode of the stiffness%s). Constrain it with -bc_dirichlet (and -bc_<name>_comps)",
+                 "body '%s' has no Dirichlet condition on its %s displacement: it floats (a rigid translation is a null mode of the stiffness%s). Constrain it with -dirichlet (and -dirichlet_<name>_comps)",
                  scene.bodies[b].name.c_str(), axis[d], scene.contact ? "; frictionless contact cannot hold it" : "");
   PetscFunctionReturn(0);
 }
@@ -315,9 +315,9 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PCGetFailedReasonRank(pc, &pcr));
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &pcr, 1, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)ksp)));
-    SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-bc_dirichlet)", PCFailedReasons[pcr]);
+    SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet)", PCFailedReasons[pcr]);
   }
-  PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-bc_dirichlet)", KSPConvergedReasons[reason]);
+  PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-dirichlet)", KSPConvergedReasons[reason]);
   if (!residualChecked_) { // the first solve with a new factorization: a direct solver on a singular A says nothing
     Vec       r;
     PetscReal nr, nb;
@@ -327,7 +327,7 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
     PetscCall(VecNorm(r, NORM_2, &nr));
     PetscCall(VecNorm(rhs, NORM_2, &nb));
     PetscCall(VecDestroy(&r));
-    PetscCheck(std::isfinite(nr) && nr <= 1e-6 * nb, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) is inaccurate: relative residual %s. The stiffness is singular or nearly so: a body may rotate or move freely (too few Dirichlet conditions, -bc_dirichlet), or the materials are degenerate", std::isfinite(nr) && nb > 0 ? std::to_string(nr / nb).c_str() : "not finite");
+    PetscCheck(std::isfinite(nr) && nr <= 1e-6 * nb, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) is inaccurate: relative residual %s. The stiffness is singular or nearly so: a body may rotate or move freely (too few Dirichlet conditions, -dirichlet), or the materials are degenerate", std::isfinite(nr) && nb > 0 ? std::to_string(nr / nb).c_str() : "not finite");
     residualChecked_ = true;
   }
   PetscFunctionReturn(0);

@@ -25,26 +25,32 @@ void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G)
   *G = E / (2 * (1 + nu));
 }
 
-static PetscErrorCode GetString(const char *name, std::string *value, PetscBool *set)
+// The scene's options are read inside one options block (SceneSpecFromOptions), so that `-help` lists
+// each with its meaning and current value (PETSc's PetscOptionsString etc. need the block's object,
+// PetscOptionsObject, in scope).
+static const char kMan[] = "docs/scenes.md";
+
+static PetscErrorCode GetString(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::string *value, PetscBool *set)
 {
   char      buf[PETSC_MAX_PATH_LEN];
   PetscBool flg;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetString(NULL, NULL, name, buf, sizeof buf, &flg));
+  PetscCall(PetscStrncpy(buf, value->c_str(), sizeof buf));
+  PetscCall(PetscOptionsString(name, text, kMan, buf, buf, sizeof buf, &flg));
   if (flg) *value = buf;
   if (set) *set = flg;
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode GetRealArray(const char *name, std::vector<PetscReal> *v, PetscBool *set)
+static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscReal> *v, PetscBool *set)
 {
-  PetscReal buf[64];
+  PetscReal buf[64] = {0}; // -help prints buf[0] of an unset option
   PetscInt  n = 64;
   PetscBool flg;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetRealArray(NULL, NULL, name, buf, &n, &flg));
+  PetscCall(PetscOptionsRealArray(name, text, kMan, buf, &n, &flg));
   // every rank reads the same options: a local error on each (no collective, no hang)
   PetscBool has = PETSC_FALSE;
   PetscCall(PetscOptionsHasName(NULL, NULL, name, &has));
@@ -56,16 +62,35 @@ static PetscErrorCode GetRealArray(const char *name, std::vector<PetscReal> *v, 
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode GetIntArray(const char *name, std::vector<PetscInt> *v, PetscBool *set)
+static PetscErrorCode GetIntArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscInt> *v, PetscBool *set)
 {
-  PetscInt  buf[64];
+  PetscInt  buf[64] = {0};
   PetscInt  n = 64;
   PetscBool flg;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetIntArray(NULL, NULL, name, buf, &n, &flg));
+  PetscCall(PetscOptionsIntArray(name, text, kMan, buf, &n, &flg));
   if (flg) v->assign(buf, buf + n);
   if (set) *set = flg;
+  PetscFunctionReturn(0);
+}
+
+// The boundary options were -bc_<...> until 2026-11-25, in PETSc's own namespace (PetscDS reads
+// -bc_<boundary name> as the label values of a boundary of that name): the new name is read, the old
+// one still works for one release with a deprecation warning; both at once is an error.
+static PetscErrorCode Renamed(MPI_Comm comm, const std::string &now, const std::string &old, std::string *use)
+{
+  PetscBool hasNew = PETSC_FALSE, hasOld = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsHasName(NULL, NULL, now.c_str(), &hasNew));
+  PetscCall(PetscOptionsHasName(NULL, NULL, old.c_str(), &hasOld));
+  PetscCheck(!(hasNew && hasOld), comm, PETSC_ERR_USER_INPUT, "%s and its deprecated spelling %s are both given: keep %s", now.c_str(), old.c_str(), now.c_str());
+  *use = now;
+  if (hasOld) {
+    PetscCall(PetscPrintf(comm, "rbcontact: warning: option %s is deprecated (PETSc's -bc_ namespace): use %s\n", old.c_str(), now.c_str()));
+    *use = old;
+  }
   PetscFunctionReturn(0);
 }
 
@@ -91,19 +116,20 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscInt    refine = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(GetString("-scene", &scene->name, NULL));
-  PetscCall(GetString("-mesh_file", &scene->mesh.file, &flg));
+  PetscOptionsBegin(comm, NULL, "Scene: mesh, parameters, bodies, boundary conditions, contact pair (docs/scenes.md)", "rbcontact");
+  PetscCall(GetString(PetscOptionsObject, "-scene", "Scene name (reports, file headers)", &scene->name, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-mesh_file", "gmsh mesh: .geo (meshed and cached) or .msh; relative to the working directory, then the installed share/rbcontact", &scene->mesh.file, &flg));
   PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)");
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-mesh_clscale", &scene->mesh.clscale, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-mesh_refine", &refine, NULL));
+  PetscCall(PetscOptionsReal("-mesh_clscale", "gmsh characteristic length factor (.geo)", kMan, scene->mesh.clscale, &scene->mesh.clscale, NULL));
+  PetscCall(PetscOptionsInt("-mesh_refine", "Halve the mesh size this many times (.geo: -mesh_clscale x 0.5^n)", kMan, refine, &refine, NULL));
   PetscCheck(scene->mesh.clscale > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_clscale %g must be > 0", (double)scene->mesh.clscale);
   PetscCheck(refine >= 0 && refine <= 8, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_refine %" PetscInt_FMT " out of range [0, 8]", refine);
   scene->mesh.clscale *= std::pow(0.5, (double)refine);
   if (const char *env = std::getenv("RBC_MESH_CACHE")) scene->mesh.cacheDir = env;
-  PetscCall(GetString("-mesh_cache_dir", &scene->mesh.cacheDir, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-mesh_cache_dir", "Where meshed .geo files are cached (default: $RBC_MESH_CACHE, else ./meshcache)", &scene->mesh.cacheDir, NULL));
   if (scene->mesh.cacheDir.empty()) scene->mesh.cacheDir = "meshcache";
   s.clear();
-  PetscCall(GetString("-mesh_geo_set", &s, &flg));
+  PetscCall(GetString(PetscOptionsObject, "-mesh_geo_set", "NAME=VALUE,... : gmsh constants of the .geo", &s, &flg));
   for (const auto &kv : SplitList(s)) {
     const auto eq = kv.find('=');
     PetscCheck(eq != std::string::npos, comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: item '%s' is not NAME=VALUE", kv.c_str());
@@ -116,16 +142,16 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
 
   // Parameters: names, boxes, defaults, the gmsh constant each one sets, and the values (-mu)
   s.clear();
-  PetscCall(GetString("-mu_names", &s, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-mu_names", "Parameter names, comma separated", &s, NULL));
   const std::vector<std::string> pnames = SplitList(s);
   if (!pnames.empty()) {
     std::vector<PetscReal> lo, hi, def, val;
-    PetscCall(GetRealArray("-mu_min", &lo, NULL));
-    PetscCall(GetRealArray("-mu_max", &hi, NULL));
-    PetscCall(GetRealArray("-mu_default", &def, NULL));
-    PetscCall(GetRealArray("-mu", &val, &flg));
+    PetscCall(GetRealArray(PetscOptionsObject, "-mu_min", "Parameter box: lower bounds, one per parameter", &lo, NULL));
+    PetscCall(GetRealArray(PetscOptionsObject, "-mu_max", "Parameter box: upper bounds", &hi, NULL));
+    PetscCall(GetRealArray(PetscOptionsObject, "-mu_default", "Default parameter values (the reference configuration)", &def, NULL));
+    PetscCall(GetRealArray(PetscOptionsObject, "-mu", "Parameter values of this run (fom, online), inside the box", &val, &flg));
     s.clear();
-    PetscCall(GetString("-mu_geo_set", &s, NULL));
+    PetscCall(GetString(PetscOptionsObject, "-mu_geo_set", "gmsh constant set by each parameter ('-' for none), comma separated", &s, NULL));
     const std::vector<std::string> geo = SplitList(s);
     const size_t np = pnames.size();
     PetscCheck(lo.size() == np && hi.size() == np, comm, PETSC_ERR_USER_INPUT, "-mu_min and -mu_max need one value per parameter of -mu_names (%zu)", np);
@@ -153,12 +179,12 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
 
   // Bodies and materials
   s.clear();
-  PetscCall(GetString("-bodies", &s, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-bodies", "Body names = physical surface (volume) groups of the mesh, comma separated", &s, NULL));
   std::vector<std::string> names = SplitList(s);
   if (names.empty()) names.push_back("all");
   std::vector<PetscReal> E, nu;
-  PetscCall(GetRealArray("-body_E", &E, NULL));
-  PetscCall(GetRealArray("-body_nu", &nu, NULL));
+  PetscCall(GetRealArray(PetscOptionsObject, "-body_E", "Young's modulus: one value, or one per body", &E, NULL));
+  PetscCall(GetRealArray(PetscOptionsObject, "-body_nu", "Poisson ratio: one value, or one per body", &nu, NULL));
   if (E.empty()) E.push_back(1.0);
   if (nu.empty()) nu.push_back(0.3);
   PetscCheck(E.size() == 1 || E.size() == names.size(), comm, PETSC_ERR_USER_INPUT, "-body_E has %zu values for %zu bodies (give one, or one per body of -bodies)", E.size(), names.size());
@@ -174,36 +200,43 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     scene->bodies.push_back(body);
   }
 
-  // Dirichlet boundaries: -bc_dirichlet a,b with -bc_a_u ux,uy[,uz] and optional -bc_a_comps 0,1
+  // Dirichlet boundaries: -dirichlet a,b with -dirichlet_a_u ux,uy[,uz] and optional -dirichlet_a_comps 0,1
+  // (before 2026-11-25: -bc_dirichlet, -bc_a_u, -bc_a_comps; still read, with a warning: Renamed)
+  std::string opt;
   s.clear();
-  PetscCall(GetString("-bc_dirichlet", &s, NULL));
+  PetscCall(Renamed(comm, "-dirichlet", "-bc_dirichlet", &opt));
+  PetscCall(GetString(PetscOptionsObject, opt.c_str(), "Dirichlet boundaries = physical line (surface) groups, comma separated; each with -dirichlet_<name>_u", &s, NULL));
   scene->dirichlet.clear();
   for (const auto &name : SplitList(s)) {
     DirichletSpec bc;
     bc.label = name;
-    PetscCall(GetRealArray(("-bc_" + name + "_u").c_str(), &bc.values, NULL));
-    PetscCall(GetIntArray(("-bc_" + name + "_comps").c_str(), &bc.comps, NULL));
-    for (PetscInt c : bc.comps) PetscCheck(c >= 0 && c < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "-bc_%s_comps: component %" PetscInt_FMT " out of range [0, 2]", name.c_str(), c);
+    PetscCall(Renamed(comm, "-dirichlet_" + name + "_u", "-bc_" + name + "_u", &opt));
+    PetscCall(GetRealArray(PetscOptionsObject, opt.c_str(), "Imposed displacement on this boundary, all components", &bc.values, NULL));
+    PetscCall(Renamed(comm, "-dirichlet_" + name + "_comps", "-bc_" + name + "_comps", &opt));
+    PetscCall(GetIntArray(PetscOptionsObject, opt.c_str(), "Constrained components (default: all)", &bc.comps, NULL));
+    for (PetscInt c : bc.comps) PetscCheck(c >= 0 && c < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: component %" PetscInt_FMT " out of range [0, 2]", opt.c_str(), c);
     scene->dirichlet.push_back(bc);
   }
   s.clear();
-  PetscCall(GetString("-bc_traction", &s, NULL));
+  PetscCall(Renamed(comm, "-traction", "-bc_traction", &opt));
+  PetscCall(GetString(PetscOptionsObject, opt.c_str(), "Traction boundaries, comma separated; each with -traction_<name>_t", &s, NULL));
   scene->tractions.clear();
   for (const auto &name : SplitList(s)) {
     TractionSpec t;
     t.label = name;
-    PetscCall(GetRealArray(("-bc_" + name + "_t").c_str(), &t.traction, &flg));
-    PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "-bc_traction names '%s' but -bc_%s_t (the traction vector) is missing", name.c_str(), name.c_str());
+    PetscCall(Renamed(comm, "-traction_" + name + "_t", "-bc_" + name + "_t", &opt));
+    PetscCall(GetRealArray(PetscOptionsObject, opt.c_str(), "Traction vector on this boundary", &t.traction, &flg));
+    PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "-traction names '%s' but -traction_%s_t (the traction vector) is missing", name.c_str(), name.c_str());
     scene->tractions.push_back(t);
   }
-  PetscCall(GetRealArray("-body_force", &scene->bodyForce, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-fem_degree", &scene->degree, NULL));
+  PetscCall(GetRealArray(PetscOptionsObject, "-body_force", "Body force per unit volume (all bodies)", &scene->bodyForce, NULL));
+  PetscCall(PetscOptionsInt("-fem_degree", "Lagrange degree of the displacement (1 or 2)", kMan, scene->degree, &scene->degree, NULL));
   PetscCheck(scene->degree == 1 || scene->degree == 2, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fem_degree %" PetscInt_FMT " is not supported (1 or 2)", scene->degree);
 
-  PetscCall(GetString("-contact_slave", &scene->slave, NULL));
-  PetscCall(GetString("-contact_master", &scene->master, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-contact_slave", "Slave boundary group (its points are projected; carries the multipliers)", &scene->slave, NULL));
+  PetscCall(GetString(PetscOptionsObject, "-contact_master", "Master boundary group", &scene->master, NULL));
   scene->contact = (!scene->slave.empty() || !scene->master.empty()) ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-contact", &scene->contact, NULL));
+  PetscCall(PetscOptionsBool("-contact", "Solve with contact (default: when a pair is given)", kMan, scene->contact, &scene->contact, NULL));
 
   // Material and load parameters: -param_E_<body>, -param_nu_<body>, -param_bc_<label>, -param_t_<label>
   auto paramIndex = [&](const std::string &opt, PetscInt *idx) -> PetscErrorCode {
@@ -211,7 +244,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     PetscBool set;
     PetscFunctionBeginUser;
     *idx = -1;
-    PetscCall(PetscOptionsGetString(NULL, NULL, opt.c_str(), nm, sizeof nm, &set));
+    nm[0] = 0;
+    PetscCall(PetscOptionsString(opt.c_str(), "Parameter (of -mu_names) that scales this quantity", kMan, nm, nm, sizeof nm, &set));
     if (set) {
       for (size_t i = 0; i < scene->params.size(); ++i) if (scene->params[i].name == nm) *idx = (PetscInt)i;
       PetscCheck(*idx >= 0, comm, PETSC_ERR_USER_INPUT, "%s: unknown parameter '%s' (declared by -mu_names)", opt.c_str(), nm);
@@ -233,6 +267,7 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     if (t.param >= 0) PetscCheck(scene->params[t.param].def != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-param_t_%s: parameter '%s' needs a nonzero -mu_default", t.label.c_str(), scene->params[t.param].name.c_str());
   }
   if (scene->contact) PetscCheck(!scene->slave.empty() && !scene->master.empty(), comm, PETSC_ERR_USER_INPUT, "-contact 1 needs -contact_slave NAME and -contact_master NAME");
+  PetscOptionsEnd();
   PetscFunctionReturn(0);
 }
 

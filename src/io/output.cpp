@@ -1,5 +1,6 @@
 // src/io/output.cpp: HDF5 output of the FOM fields (PetscViewerHDF5, VIZ layout) written to a temp
 // file and renamed, plus an XDMF index so that ParaView opens it.
+#include "rbcontact/provenance.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
 #include <petscviewerhdf5.h>
@@ -110,6 +111,11 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
     PetscCall(PetscViewerHDF5PushGroup(v, "/contact"));
     for (Vec c : contact) PetscCall(VecView(c, v));
     PetscCall(PetscViewerHDF5PopGroup(v));
+  }
+  {
+    Provenance prov;
+    PetscCall(GetProvenance(comm, &prov));
+    for (const auto &a : ProvenanceAttributes(prov)) PetscCall(PetscViewerHDF5WriteAttribute(v, "/", a.first.c_str(), PETSC_STRING, a.second.c_str()));
   }
   PetscCall(PetscViewerDestroy(&v));
   PetscCall(VecDestroy(&vm));

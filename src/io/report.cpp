@@ -1,5 +1,6 @@
 // src/io/report.cpp: JSON tree for the -report summaries and atomic file writing.
 #include "rbcontact/report.hpp"
+#include "rbcontact/provenance.hpp"
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -178,7 +179,14 @@ PetscErrorCode Report::Write(MPI_Comm comm, const std::string &path) const
 {
   PetscFunctionBeginUser;
   if (path.empty()) PetscFunctionReturn(0);
-  PetscCall(WriteFileAtomic(comm, path, root.Dump() + "\n"));
+  if (root.Has("provenance")) PetscCall(WriteFileAtomic(comm, path, root.Dump() + "\n"));
+  else {
+    Provenance p;
+    JsonValue  out = root;
+    PetscCall(GetProvenance(comm, &p));
+    out["provenance"] = ProvenanceJson(p);
+    PetscCall(WriteFileAtomic(comm, path, out.Dump() + "\n"));
+  }
   PetscFunctionReturn(0);
 }
 

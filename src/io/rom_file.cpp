@@ -1,4 +1,6 @@
 // src/io/rom_file.cpp: writing and reading the ROM file (HDF5 C API on rank 0, atomic rename).
+#include <algorithm>
+#include "rbcontact/provenance.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "h5util.hpp"
 #include <cstdio>
@@ -29,6 +31,14 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  // provenance attributes, unless the caller set one of the same name
+  std::vector<std::pair<std::string, std::string>> attrs = attrs_;
+  {
+    Provenance prov;
+    PetscCall(GetProvenance(comm, &prov));
+    for (const auto &a : ProvenanceAttributes(prov))
+      if (std::none_of(attrs_.begin(), attrs_.end(), [&](const auto &b) { return b.first == a.first; })) attrs.push_back(a);
+  }
   if (rank == 0) {
     H5Quiet           quiet;
     Ctx               c{"ROM file '" + path + "'", std::string()};
@@ -42,7 +52,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
         const int v = version;
         ok          = WriteAttr(c, f.get(), "format_version", H5T_STD_I32LE, H5T_NATIVE_INT, &v);
       }
-      for (const auto &a : attrs_)
+      for (const auto &a : attrs)
         if (ok) ok = WriteStringAttr(c, f.get(), a.first.c_str(), a.second);
       for (const auto &it : items_) {
         if (!ok) break;

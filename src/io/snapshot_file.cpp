@@ -28,6 +28,7 @@
 // then done[i] = 1, H5Fflush + fsync. A killed job loses only the snapshot in progress. The file
 // uses the default (oldest) HDF5 file format, which has no "file open for writing" flag, so a file
 // left by a killed job opens normally.
+#include "rbcontact/provenance.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/scene.hpp"
 #include "rbcontact/snapshot_file.hpp"
@@ -76,6 +77,8 @@ bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
   if (!WriteAttr(c, f, "scene_hash", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &sh)) return false;
   if (!WriteAttr(c, f, "mesh_checksum", H5T_STD_U64LE, H5T_NATIVE_ULLONG, &mc)) return false;
   if (!WriteStringAttr(c, f, "code_version", h.codeVersion)) return false;
+  for (const auto &a : ProvenanceAttributes(LocalProvenance())) // the commit, PETSc/SLEPc versions, the date (the options: below)
+    if (a.first != "code_version" && a.first != "run_options" && !WriteStringAttr(c, f, a.first.c_str(), a.second)) return false;
   if (h.optionsText.size() <= kMaxAttrString) {
     if (!WriteStringAttr(c, f, "options", h.optionsText)) return false;
   } else {

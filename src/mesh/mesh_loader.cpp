@@ -308,8 +308,8 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   // Every physical name the scene uses must exist.
   for (const auto &b : scene.bodies)
     if (b.name != "all") PetscCall(MeshCheckLabel(*dm, b.name, "-bodies", scene.mesh.file));
-  for (const auto &bc : scene.dirichlet) PetscCall(MeshCheckLabel(*dm, bc.label, "-bc_dirichlet", scene.mesh.file));
-  for (const auto &t : scene.tractions) PetscCall(MeshCheckLabel(*dm, t.label, "-bc_traction", scene.mesh.file));
+  for (const auto &bc : scene.dirichlet) PetscCall(MeshCheckLabel(*dm, bc.label, "-dirichlet", scene.mesh.file));
+  for (const auto &t : scene.tractions) PetscCall(MeshCheckLabel(*dm, t.label, "-traction", scene.mesh.file));
   if (scene.contact) {
     PetscCall(MeshCheckLabel(*dm, scene.slave, "-contact_slave", scene.mesh.file));
     PetscCall(MeshCheckLabel(*dm, scene.master, "-contact_master", scene.mesh.file));

@@ -1,0 +1,184 @@
+#!/usr/bin/python3
+"""Checks of what a PETSc user meets driving rbcontact from outside, run by ctest (tests/usability.cmake).
+
+Subcommands (exit 0 = pass; a failure prints what was seen):
+  provenance  every report and HDF5 file says where it came from: version, git commit (equal to the
+              source tree's when it is a git checkout), PETSc/SLEPc versions, options, date, ranks
+  failure     a failed run still writes its -report: converged false and the error naming the file or
+              option at fault, replacing an older report of the same name
+  help        `rbcontact fom -help` lists the scene, boundary, parameter, map and output options
+  rename      the boundary options out of PETSc's -bc_ namespace: the old spelling gives the same run
+              with one deprecation warning per option; both spellings at once are refused
+  gamg        the README's iterative elastic solver (-fom_ksp_type cg -fom_pc_type gamg) on a contact
+              scene: the direct solver's contact force to 1e-6
+"""
+import argparse
+import atexit
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+import h5py
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+FAILED = []
+
+
+def check(cond, msg):
+    print(("  ok    " if cond else "  FAIL  ") + msg)
+    if not cond:
+        FAILED.append(msg)
+
+
+def workdir():
+    d = tempfile.mkdtemp(prefix="rbc_usability_")
+    atexit.register(shutil.rmtree, d, True)
+    return d
+
+
+def run(args, np_, cmd, expect_ok=True):
+    full = (["mpirun", "-n", str(np_)] if np_ > 1 else []) + [args.exe] + cmd
+    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, stdin=subprocess.DEVNULL)
+    if expect_ok and p.returncode != 0:
+        print(p.stdout[-3000:])
+        sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(full)))
+    return p
+
+
+def load(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def attr(f, name):
+    v = f.attrs[name]
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def source_commit():
+    """The checkout's commit as the build records it (short, -dirty when tracked files differ), or None."""
+    if not os.path.isdir(os.path.join(ROOT, ".git")) or shutil.which("git") is None:
+        return None
+    c = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short=12", "HEAD"], stdout=subprocess.PIPE, text=True)
+    return c.stdout.strip() if c.returncode == 0 else None
+
+
+def project_version():
+    with open(os.path.join(ROOT, "CMakeLists.txt")) as f:
+        return re.search(r"project\(rbcontact VERSION ([0-9.]+)", f.read()).group(1)
+
+
+def check_provenance(p, np_, what, option="-mesh_file"):
+    keys = ("version", "commit", "petsc", "slepc", "date", "nranks", "options")
+    check(all(k in p for k in keys), "%s: provenance has %s (%s)" % (what, ", ".join(keys), sorted(p)))
+    check(p.get("version") == project_version(), "%s: version %s = CMakeLists.txt's %s" % (what, p.get("version"), project_version()))
+    c = source_commit()
+    if c is not None:
+        check(p.get("commit", "").split("-dirty")[0] == c, "%s: commit %s = the checkout's %s" % (what, p.get("commit"), c))
+    else:
+        check(p.get("commit") not in (None, ""), "%s: commit given (%s; not a git checkout)" % (what, p.get("commit")))
+    check("3.18" in p.get("petsc", "") and "3.18" in p.get("slepc", ""), "%s: PETSc/SLEPc versions '%s', '%s'" % (what, p.get("petsc"), p.get("slepc")))
+    check(p.get("nranks") == np_, "%s: nranks %s = %d" % (what, p.get("nranks"), np_))
+    check(option in p.get("options", ""), "%s: the options are recorded (%s among them)" % (what, option))
+    check(re.match(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$", p.get("date", "")) is not None, "%s: date %s (ISO 8601, UTC)" % (what, p.get("date")))
+
+
+def provenance(args):
+    d = workdir()
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/fom.json", "-fom_output", d + "/fom.h5"])
+    r = load(d + "/fom.json")
+    check_provenance(r.get("provenance", {}), args.np, "fom report")
+    with h5py.File(d + "/fom.h5", "r") as f:
+        check(attr(f, "code_commit") == r["provenance"]["commit"] and attr(f, "code_version") == r["provenance"]["version"],
+              "fom fields file: code_commit %s, code_version %s as in the report" % (attr(f, "code_commit"), attr(f, "code_version")))
+        check("PETSc" in attr(f, "petsc_version") or "Petsc" in attr(f, "petsc_version"), "fom fields file: petsc_version")
+    run(args, args.np, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", d + "/rom.h5", "-snapshots", d + "/snap.h5",
+                        "-report", d + "/off.json"])
+    o = load(d + "/off.json")
+    check_provenance(o.get("provenance", {}), args.np, "offline report")
+    for name in ("rom.h5", "snap.h5"):
+        with h5py.File(os.path.join(d, name), "r") as f:
+            check(attr(f, "code_commit") == o["provenance"]["commit"] and attr(f, "code_version") == project_version() and attr(f, "created") != "",
+                  "%s: code_commit %s, code_version %s, created %s" % (name, attr(f, "code_commit"), attr(f, "code_version"), attr(f, "created")))
+    run(args, args.np, ["online", "-rom", d + "/rom.h5", "-mu", "1.02", "-report", d + "/on.json"])
+    check_provenance(load(d + "/on.json").get("provenance", {}), args.np, "online report", "-rom")
+
+
+def failure(args):
+    d = workdir()
+    rep = d + "/fail.json"
+    with open(rep, "w") as f:
+        f.write('{"stale": true}\n')
+    cases = [(["-mesh_file", "nope.msh"], r"Mesh file 'nope\.msh' not found", "missing mesh"),
+             (["-kacanov_max_it", "2"], r"Kacanov iterations did not converge in 2 iterations", "Kacanov not converged"),
+             (["-contact_quadrature", "bogus"], r"-contact_quadrature: unknown value 'bogus'", "unknown option value")]
+    for extra, pattern, what in cases:
+        p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", rep] + extra, expect_ok=False)
+        check(p.returncode != 0, "%s: exit %d (non-zero)" % (what, p.returncode))
+        r = load(rep)
+        check(r.get("converged") is False and r.get("stage") == "fom" and "stale" not in r, "%s: report says converged false, stage fom (keys %s)" % (what, sorted(r)))
+        check(re.search(pattern, r.get("error", "")) is not None, "%s: report error '%s' matches '%s'" % (what, r.get("error", "")[:160], pattern))
+        check("commit" in r.get("provenance", {}), "%s: report has the provenance" % what)
+        check(not [x for x in os.listdir(d) if ".tmp." in x], "%s: no temporary file left" % what)
+
+
+def help_(args):
+    p = run(args, 1, ["fom", "-options_file", "runs/ring_on_block.opts", "-help"])
+    for opt in ("-mesh_file", "-mesh_refine", "-bodies", "-body_E", "-dirichlet", "-dirichlet_ring_top_u", "-mu_names", "-mu", "-map_ring",
+                "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type"):
+        check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "fom -help lists %s" % opt)
+    check("rbcontact: warning" not in p.stdout, "the shipped scene: no rbcontact warning (deprecated or unused option)")
+
+
+def rename(args):
+    d = workdir()
+    with open(os.path.join(ROOT, "runs/ring_on_block.opts")) as f:
+        text = f.read()
+    old = re.sub(r"^-dirichlet_(\w+)_u\b", r"-bc_\1_u", text, flags=re.M)
+    old = re.sub(r"^-dirichlet\b", "-bc_dirichlet", old, flags=re.M)
+    check(old != text and "-bc_ring_top_u" in old, "an options file in the old spelling (-bc_dirichlet, -bc_<name>_u)")
+    with open(d + "/old.opts", "w") as f:
+        f.write(old)
+    # the old file refers to meshes/ relative to the source tree: run from there
+    a = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/new.json"])
+    b = run(args, args.np, ["fom", "-options_file", d + "/old.opts", "-report", d + "/old.json"])
+    rn, ro = load(d + "/new.json"), load(d + "/old.json")
+    check(rn["contact_force"] == ro["contact_force"] and rn["energy"] == ro["energy"], "old spelling: same force %.12g / %.12g and energy" % (rn["contact_force"], ro["contact_force"]))
+    for opt in ("-bc_dirichlet", "-bc_ring_top_u", "-bc_block_bottom_u"):
+        check(b.stdout.count("option %s is deprecated" % opt) == 1, "one deprecation warning for %s" % opt)
+    check("deprecated" not in a.stdout and "was not used" not in b.stdout, "new spelling: no warning; old spelling: no unused-option warning")
+    p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-bc_ring_top_u", "0,-0.05"], expect_ok=False)
+    check(p.returncode != 0 and "-dirichlet_ring_top_u and its deprecated spelling -bc_ring_top_u are both given" in p.stdout,
+          "both spellings: refused, naming both (exit %d)" % p.returncode)
+
+
+def gamg(args):
+    d = workdir()
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/direct.json"])
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-fom_ksp_type", "cg", "-fom_pc_type", "gamg", "-report", d + "/gamg.json"])
+    a, b = load(d + "/direct.json"), load(d + "/gamg.json")
+    rel = abs(a["contact_force"] - b["contact_force"]) / abs(a["contact_force"])
+    check(b["converged"] and rel <= 1e-6, "cg + gamg: contact force %.12g against the direct %.12g (rel %.1e <= 1e-6)" % (b["contact_force"], a["contact_force"], rel))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg"])
+    ap.add_argument("--exe", default=os.path.join(ROOT, "build/bin/rbcontact"))
+    ap.add_argument("--np", type=int, default=1)
+    args = ap.parse_args()
+    os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg}[args.what](args)
+    if FAILED:
+        print("%d check(s) failed" % len(FAILED))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
