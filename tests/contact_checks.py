@@ -342,7 +342,7 @@ def paths(args):
 def segments(args):
     """2D mortar segments: the switch of the closest master facet bisected between the two (neighbouring) end facets with a
     confirming search (the default, pair) against the closest-point search at every bisection step (full):
-    the same cuts, so the same contact force, energy and iterations to rounding (1e-14), on the scenes with
+    the same cuts, so the same contact force, energy and iterations to rounding (1e-13), on the scenes with
     curved masters (half_disks P1 and P2, ring_on_block, hertz). At half_disks mu = (0.7, 0.12) a slave facet
     spans three master facets: a version that bisected between the two end facets without requiring them to
     be neighbours missed the middle one (force 4e-6 off)."""
@@ -352,9 +352,13 @@ def segments(args):
         tag = scene + "_".join(opts).replace(",", "_").replace(".", "p").replace("-", "")
         rp, _ = run(args, args.np, "runs/%s.opts" % scene, opts + args.extra, tag + "_pair")
         rf, _ = run(args, args.np, "runs/%s.opts" % scene, opts + ["-contact_segment_search", "full"] + args.extra, tag + "_full")
+        # 1e-13: on 2 ranks repeated runs of one setting differ by up to 1.3e-14 in the energy (measured
+        # 2026-11-25, hertz, -contact_segment_search full, 6 runs: 1 of them; the parallel reductions), which
+        # broke the former 1e-14 once in a full ctest run; a different cut moves the force by >= 6e-10 (the
+        # dropped regula-falsi variant), the non-neighbour bug by 4e-6
         for key in ("contact_force", "energy"):
             d = abs(rp[key] - rf[key]) / abs(rf[key])
-            check(d <= 1e-14, "%s %s: %s pair %.16e full %.16e (rel %.1e <= 1e-14)" % (scene, " ".join(opts), key, rp[key], rf[key], d))
+            check(d <= 1e-13, "%s %s: %s pair %.16e full %.16e (rel %.1e <= 1e-13)" % (scene, " ".join(opts), key, rp[key], rf[key], d))
         check(rp["kacanov_iterations"] == rf["kacanov_iterations"], "%s %s: %d Kacanov iterations (full %d)" % (scene, " ".join(opts), rp["kacanov_iterations"], rf["kacanov_iterations"]))
 
 

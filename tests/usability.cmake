@@ -1,6 +1,7 @@
 # tests/usability.cmake -- what a PETSc user meets driving rbcontact from outside: provenance in every
 # report and HDF5 file, the report of a failed run, -help, the boundary options renamed out of PETSc's
-# -bc_ namespace, the README's iterative solver on a contact scene (tests/usability_checks.py).
+# -bc_ namespace, the README's iterative solver on a contact scene (tests/usability_checks.py), the
+# installation (tests/install_check.sh).
 find_program(RBC_PYTHON3_U NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_UC ${RBC_PYTHON3_U} ${CMAKE_CURRENT_SOURCE_DIR}/usability_checks.py)
 foreach(np 1 2)
@@ -13,3 +14,6 @@ add_test(NAME usability_help COMMAND ${RBC_UC} help --exe $<TARGET_FILE:rbcontac
 add_test(NAME usability_gamg_np2 COMMAND ${RBC_UC} gamg --exe $<TARGET_FILE:rbcontact_exe> --np 2 WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(usability_help usability_gamg_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)
 set_tests_properties(usability_gamg_np2 PROPERTIES PROCESSORS 2)
+# cmake --install into a fresh prefix; the installed binary and two outside programs (find_package, pkg-config)
+add_test(NAME usability_install COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/install_check.sh ${CMAKE_BINARY_DIR})
+set_tests_properties(usability_install PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 LABELS usability)

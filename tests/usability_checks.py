@@ -78,7 +78,7 @@ def check_provenance(p, np_, what, option="-mesh_file"):
     check(p.get("version") == project_version(), "%s: version %s = CMakeLists.txt's %s" % (what, p.get("version"), project_version()))
     c = source_commit()
     if c is not None:
-        check(p.get("commit", "").split("-dirty")[0] == c, "%s: commit %s = the checkout's %s" % (what, p.get("commit"), c))
+        check(p.get("commit", "").split("-dirty")[0] == c, "%s: commit %s = the checkout's %s (if not: the binary is older than the checkout, rebuild)" % (what, p.get("commit"), c))
     else:
         check(p.get("commit") not in (None, ""), "%s: commit given (%s; not a git checkout)" % (what, p.get("commit")))
     check("3.18" in p.get("petsc", "") and "3.18" in p.get("slepc", ""), "%s: PETSc/SLEPc versions '%s', '%s'" % (what, p.get("petsc"), p.get("slepc")))

@@ -28,7 +28,7 @@ void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G)
 // The scene's options are read inside one options block (SceneSpecFromOptions), so that `-help` lists
 // each with its meaning and current value (PETSc's PetscOptionsString etc. need the block's object,
 // PetscOptionsObject, in scope).
-static const char kMan[] = "docs/scenes.md";
+static const char kMan[] = "README.md: Options";
 
 static PetscErrorCode GetString(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::string *value, PetscBool *set)
 {
@@ -116,7 +116,7 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscInt    refine = 0;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(comm, NULL, "Scene: mesh, parameters, bodies, boundary conditions, contact pair (docs/scenes.md)", "rbcontact");
+  PetscOptionsBegin(comm, NULL, "Scene: mesh, parameters, bodies, boundary conditions, contact pair (README.md: Options)", "rbcontact");
   PetscCall(GetString(PetscOptionsObject, "-scene", "Scene name (reports, file headers)", &scene->name, NULL));
   PetscCall(GetString(PetscOptionsObject, "-mesh_file", "gmsh mesh: .geo (meshed and cached) or .msh; relative to the working directory, then the installed share/rbcontact", &scene->mesh.file, &flg));
   PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)");

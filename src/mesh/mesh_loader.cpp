@@ -19,6 +19,9 @@
 #ifndef RBC_SOURCE_DIR
   #define RBC_SOURCE_DIR "."
 #endif
+#ifndef RBC_INSTALL_DATA_DIR
+  #define RBC_INSTALL_DATA_DIR "/usr/local/share/rbcontact"
+#endif
 
 namespace rbc {
 
@@ -36,12 +39,41 @@ static bool FileExists(const std::string &p)
   return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+// Where a relative data file (a mesh of runs/<scene>.opts) is looked for, in this order: the working
+// directory, $RBC_DATA_DIR, the installed share/rbcontact beside the running program (<bin>/../share/
+// rbcontact: an installed rbcontact, even moved), the configured install prefix's, the source tree.
+static std::vector<std::string> DataDirs()
+{
+  std::vector<std::string> d;
+  if (const char *e = std::getenv("RBC_DATA_DIR")) d.push_back(e);
+  char          exe[PETSC_MAX_PATH_LEN];
+  const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n > 0) {
+    exe[n]              = 0;
+    const std::string s = exe;
+    d.push_back(s.substr(0, s.find_last_of('/')) + "/../share/rbcontact");
+  }
+  d.push_back(RBC_INSTALL_DATA_DIR);
+  d.push_back(RBC_SOURCE_DIR);
+  return d;
+}
+
 PetscErrorCode ResolveDataFile(MPI_Comm comm, const std::string &file, std::string *path)
 {
   PetscFunctionBeginUser;
+  path->clear();
+  std::string looked = "the working directory";
   if (FileExists(file)) *path = file;
-  else if (file.size() && file[0] != '/' && FileExists(std::string(RBC_SOURCE_DIR) + "/" + file)) *path = std::string(RBC_SOURCE_DIR) + "/" + file;
-  else SETERRQ(comm, PETSC_ERR_FILE_OPEN, "Mesh file '%s' not found (given by -mesh_file; looked in the working directory and in %s)", file.c_str(), RBC_SOURCE_DIR);
+  else if (!file.empty() && file[0] != '/')
+    for (const auto &dir : DataDirs()) {
+      if (FileExists(dir + "/" + file)) {
+        *path = dir + "/" + file;
+        break;
+      }
+      looked += ", " + dir;
+    }
+  PetscCheck(!path->empty(), comm, PETSC_ERR_FILE_OPEN, "Mesh file '%s' not found (given by -mesh_file; looked in %s)", file.c_str(), looked.c_str());
+  PetscCall(PetscInfo(NULL, "mesh file %s -> %s\n", file.c_str(), path->c_str())); // -info shows which copy was used
   PetscFunctionReturn(0);
 }
 
