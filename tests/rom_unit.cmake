@@ -24,7 +24,7 @@ rbc_add_mpi_test(NAME test_supremizers RANKS 1 2 TIMEOUT 60 COMMAND $<TARGET_FIL
 #                          moments, nonnegative weights, the reported residual recomputed from the fitted terms
 rbc_test_exe(test_empirical_cubature)
 rbc_add_mpi_test(NAME test_empirical_cubature RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_empirical_cubature> LABELS rom)
-#   test_dense_kernels     the online contact kernels (SumOfOuterProducts, CombineRows; AVX2+FMA where the CPU has
+#   test_dense_kernels     the online contact kernels (SumOfOuterProducts, CombineRows, ScatterRows, RowDots, the QP set-up; AVX2+FMA where the CPU has
 #                          it) against plain loops, at sizes around the register blocking
 rbc_test_exe(test_dense_kernels)
 rbc_add_mpi_test(NAME test_dense_kernels RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dense_kernels> LABELS rom)

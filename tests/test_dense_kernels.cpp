@@ -1,6 +1,8 @@
 // tests/test_dense_kernels.cpp: the online contact kernels (src/rom/dense_kernels.cpp) against plain
-// loops, serial: SumOfOuterProducts for sizes around the 4 x 4 blocking (rows 1..18 padded, columns
-// 1..21, 0..202 points) and CombineRows for 0..12 terms of length 1..23. The dispatched version (AVX2+FMA
+// loops, serial: SumOfOuterProducts for sizes around the 4 x 4 and 12 x 4 blocking (rows 1..18 padded,
+// columns 1..21, 0..202 points), CombineRows for 0..12 terms of length 1..23, and ScatterRows (the
+// patch-dof accumulation) with repeated target rows, 0..8 terms per point; RightSolveT (through the
+// residual X L' - D) and LowerGram of the reduced QP's set-up, n 1..60; RowDots (U = uD + theta v). The dispatched version (AVX2+FMA
 // where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|).
 #include "../src/rom/dense_kernels.hpp"
 #include <cmath>
@@ -18,7 +20,7 @@ int main(int argc, char **argv)
 
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
   for (PetscInt M : {0, 1, 7, 202})
-    for (PetscInt r : {1, 3, 4, 5, 18})
+    for (PetscInt r : {1, 3, 4, 5, 9, 12, 18})
       for (PetscInt nc : {1, 3, 4, 5, 21}) {
         const PetscInt      rp = PaddedRows(r);
         std::vector<double> W((size_t)M * rp, 0.0), X((size_t)nc * M), K((size_t)rp * nc, -7.0);
@@ -67,6 +69,111 @@ int main(int argc, char **argv)
           PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL CombineRows nt %d n %d entry %d: %g vs %g\n", (int)nt, (int)n, (int)k, out[k], s));
         }
       }
+    }
+  for (PetscInt M : {0, 1, 7, 202})
+    for (PetscInt r : {1, 4, 5, 12, 18}) {
+      const PetscInt        rp = PaddedRows(r), nd = 13, maxT = 36;
+      std::vector<double>   W((size_t)M * rp, 0.0), coef((size_t)M * maxT, 99.0), gamma(M), Q((size_t)nd * rp, 0.5), g(rp, -0.25);
+      std::vector<PetscInt> nt(M), row((size_t)M * maxT, -1);
+      for (PetscInt p = 0; p < M; ++p) {
+        for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rp + i] = u(gen);
+        gamma[p] = u(gen);
+        nt[p]    = p % 9; // 0..8 terms, target rows repeat across points
+        for (PetscInt t = 0; t < nt[p]; ++t) {
+          coef[(size_t)p * maxT + t] = u(gen);
+          row[(size_t)p * maxT + t]  = (p + 3 * t) % nd;
+        }
+      }
+      std::vector<double> Qr(Q), gr(g), Qa(Q.size(), 0.0), ga(rp, 0.0);
+      for (PetscInt p = 0; p < M; ++p) {
+        for (PetscInt t = 0; t < nt[p]; ++t)
+          for (PetscInt i = 0; i < rp; ++i) {
+            const double term = coef[(size_t)p * maxT + t] * W[(size_t)p * rp + i];
+            Qr[(size_t)row[(size_t)p * maxT + t] * rp + i] += term;
+            Qa[(size_t)row[(size_t)p * maxT + t] * rp + i] += std::abs(term);
+          }
+        for (PetscInt i = 0; i < rp; ++i) {
+          gr[i] += gamma[p] * W[(size_t)p * rp + i];
+          ga[i] += std::abs(gamma[p] * W[(size_t)p * rp + i]);
+        }
+      }
+      ScatterRows(M, rp, nt.data(), maxT, row.data(), coef.data(), W.data(), gamma.data(), Q.data(), g.data());
+      auto check = [&](double got, double want, double a, const char *what, PetscInt i) -> PetscErrorCode {
+        PetscFunctionBeginUser;
+        const double e = std::abs(got - want) / (a + 1.0); // the initial values (0.5, -0.25) are part of the sum
+        worst          = std::max(worst, e);
+        ++checks;
+        if (!(e <= 1e-13)) {
+          ++failures;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL ScatterRows M %d r %d %s entry %d: %g vs %g\n", (int)M, (int)r, what, (int)i, got, want));
+        }
+        PetscFunctionReturn(0);
+      };
+      for (size_t k = 0; k < Q.size(); ++k) PetscCall(check(Q[k], Qr[k], Qa[k], "Q", (PetscInt)k));
+      for (PetscInt i = 0; i < rp; ++i) PetscCall(check(g[i], gr[i], ga[i], "g", i));
+    }
+  // RowDots: out = b + A v
+  for (PetscInt rows : {0, 1, 7})
+    for (PetscInt n : {0, 1, 3, 4, 5, 13, 60}) {
+      std::vector<double> A((size_t)rows * n), v(n), b(rows), out(rows, -7.0);
+      for (auto &x : A) x = u(gen);
+      for (auto &x : v) x = u(gen);
+      for (auto &x : b) x = u(gen);
+      RowDots(rows, n, A.data(), v.data(), b.data(), out.data());
+      for (PetscInt r = 0; r < rows; ++r) {
+        double s = b[r], a = std::abs(b[r]);
+        for (PetscInt k = 0; k < n; ++k) {
+          s += A[(size_t)r * n + k] * v[k];
+          a += std::abs(A[(size_t)r * n + k] * v[k]);
+        }
+        const double e = std::abs(out[r] - s) / std::max(a, 1e-300);
+        worst          = std::max(worst, e);
+        ++checks;
+        if (!(e <= 1e-13)) {
+          ++failures;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL RowDots rows %d n %d entry %d: %g vs %g\n", (int)rows, (int)n, (int)r, out[r], s));
+        }
+      }
+    }
+  // RightSolveT: X L' = D for a well-conditioned lower L (checked through the residual), LowerGram = X X'
+  for (PetscInt n : {1, 3, 4, 5, 13, 60})
+    for (PetscInt r : {1, 5, 12}) {
+      std::vector<double> L((size_t)n * n, 0.0), D((size_t)r * n), X((size_t)r * n, -7.0), S((size_t)r * r, -7.0);
+      for (PetscInt j = 0; j < n; ++j)
+        for (PetscInt i = j; i < n; ++i) L[i + (size_t)j * n] = i == j ? 2 + u(gen) : 0.3 * u(gen);
+      for (auto &x : D) x = u(gen);
+      RightSolveT(r, n, L.data(), D.data(), X.data());
+      for (PetscInt i = 0; i < r; ++i)
+        for (PetscInt k = 0; k < n; ++k) { // (X L')(i, k) = sum_{m <= k} X(i, m) L(k, m)
+          double s = 0, a = 0;
+          for (PetscInt m = 0; m <= k; ++m) {
+            s += X[i + (size_t)m * r] * L[k + (size_t)m * n];
+            a += std::abs(X[i + (size_t)m * r] * L[k + (size_t)m * n]);
+          }
+          const double e = std::abs(s - D[i + (size_t)k * r]) / std::max(a, 1e-300);
+          worst          = std::max(worst, e);
+          ++checks;
+          if (!(e <= 1e-13)) {
+            ++failures;
+            PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL RightSolveT n %d r %d entry (%d, %d): residual %g\n", (int)n, (int)r, (int)i, (int)k, s - D[i + (size_t)k * r]));
+          }
+        }
+      LowerGram(r, n, X.data(), S.data());
+      for (PetscInt j = 0; j < r; ++j)
+        for (PetscInt i = j; i < r; ++i) {
+          double s = 0, a = 0;
+          for (PetscInt k = 0; k < n; ++k) {
+            s += X[i + (size_t)k * r] * X[j + (size_t)k * r];
+            a += std::abs(X[i + (size_t)k * r] * X[j + (size_t)k * r]);
+          }
+          const double e = std::abs(S[i + (size_t)j * r] - s) / std::max(a, 1e-300);
+          worst          = std::max(worst, e);
+          ++checks;
+          if (!(e <= 1e-13)) {
+            ++failures;
+            PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL LowerGram n %d r %d entry (%d, %d): %g vs %g\n", (int)n, (int)r, (int)i, (int)j, S[i + (size_t)j * r], s));
+          }
+        }
     }
   PetscCall(PetscPrintf(PETSC_COMM_SELF, "%s: %d entries checked, worst relative difference %.2e (bound 1e-13)\n", failures ? "FAIL" : "ok", checks, worst));
   PetscCall(PetscFinalize());

@@ -157,6 +157,7 @@ private:
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   bool                   cDofs_ = false;              // the cubature's K^ summed by patch dofs (-rom_ecsw_sum)
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
+  std::vector<PetscReal> cG_;                         // dofs sum: g^ padded to rp
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place

@@ -34,6 +34,32 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
 {
   PetscReal best = PETSC_MAX_REAL; // squared
   *facet         = -1;
+  if (dim_ == 2) {
+    // DistToFacet2's 2D branch written into the loop (the same arithmetic, so the same facet and
+    // coordinates): the reduced model's cubature points call this once per point and iterate over
+    // 7-20 candidates, and the call per candidate cost more than the distance (docs/online.md).
+    PetscReal sbest = 0;
+    for (PetscInt i = 0; i < nc; ++i) {
+      const PetscInt   f    = cand[i];
+      const PetscReal *x    = &xdef_[9 * f];
+      const PetscReal  t[2] = {x[2] - x[0], x[3] - x[1]};
+      PetscReal        s    = ((p[0] - x[0]) * t[0] + (p[1] - x[1]) * t[1]) * invLen2_[f];
+      s                     = std::min(1.0, std::max(0.0, s));
+      const PetscReal q[2]  = {x[0] + s * t[0] - p[0], x[1] + s * t[1] - p[1]};
+      const PetscReal dd    = q[0] * q[0] + q[1] * q[1];
+      if (dd < best || (dd == best && f < *facet)) {
+        best   = dd;
+        *facet = f;
+        sbest  = s;
+      }
+    }
+    if (*facet >= 0) {
+      b[0] = 1 - sbest;
+      b[1] = sbest;
+    }
+    *dist = *facet >= 0 ? std::sqrt(best) : PETSC_MAX_REAL;
+    return;
+  }
   for (PetscInt i = 0; i < nc; ++i) {
     const PetscInt  f = cand[i];
     PetscReal       bb[3];

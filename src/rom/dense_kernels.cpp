@@ -1,10 +1,12 @@
-// src/rom/dense_kernels.cpp: CombineRows and SumOfOuterProducts (dense_kernels.hpp). A portable
-// version of each and, on x86-64 with GCC or clang, an AVX2+FMA version written with intrinsics
-// (the auto-vectorizer shuffled the wrong dimension), chosen once from __builtin_cpu_supports. The
+// src/rom/dense_kernels.cpp: CombineRows, SumOfOuterProducts, ScatterRows, RowDots, and the reduced QP's
+// RightSolveT and LowerGram (dense_kernels.hpp). A portable version of each and, on x86-64 with GCC or
+// clang, an AVX2+FMA version (intrinsics for the contact kernels, where the auto-vectorizer shuffled the
+// wrong dimension; the QP's loops compiled for AVX2), chosen once from __builtin_cpu_supports. The
 // blocked sum keeps a 4 x 4 block of K in registers over all points; the plain rank-1 update loop
 // reloaded and stored K at every point. Results differ from the portable ones by rounding (FMA);
 // RBC_KERNELS_PORTABLE=1 in the environment selects the portable ones.
 #include "dense_kernels.hpp"
+#include <algorithm>
 #include <cstdlib>
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -14,6 +16,63 @@
 namespace rbc {
 
 namespace {
+
+#if defined(__GNUC__) || defined(__clang__)
+#define RBC_INLINE inline __attribute__((always_inline))
+#else
+#define RBC_INLINE inline
+#endif
+
+// X = D L^{-T} (D, X: r x n column-major, leading dimension r; L lower n x n): column k of X is
+// (D(:,k) - sum_{m<k} L(k,m) X(:,m)) / L(k,k), four columns m at a time. About 2x faster than the
+// reference BLAS trsm for n <= 60 (same operations, another summation order).
+RBC_INLINE void RightSolveTBody(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X)
+{
+  for (PetscInt k = 0; k < n; ++k) {
+    PetscReal *x = &X[(size_t)k * r];
+    std::copy_n(&D[(size_t)k * r], r, x); // (memcpy from a null pointer is undefined even for 0 bytes: UBSan)
+    PetscInt m = 0;
+    for (; m + 4 <= k; m += 4) {
+      const PetscReal  l0 = L[k + m * n], l1 = L[k + (m + 1) * n], l2 = L[k + (m + 2) * n], l3 = L[k + (m + 3) * n];
+      const PetscReal *x0 = &X[(size_t)m * r], *x1 = x0 + r, *x2 = x1 + r, *x3 = x2 + r;
+      for (PetscInt i = 0; i < r; ++i) x[i] -= l0 * x0[i] + l1 * x1[i] + l2 * x2[i] + l3 * x3[i];
+    }
+    for (; m < k; ++m) {
+      const PetscReal  lm = L[k + m * n], *xm = &X[(size_t)m * r];
+      for (PetscInt i = 0; i < r; ++i) x[i] -= lm * xm[i];
+    }
+    const PetscReal inv = 1.0 / L[k + k * n];
+    for (PetscInt i = 0; i < r; ++i) x[i] *= inv;
+  }
+}
+
+// Lower triangle of S = X X' (X r x n, S r x r, both leading dimension r): rank-4 updates with
+// contiguous columns. About 1.7x faster than the reference BLAS syrk for n <= 60.
+RBC_INLINE void LowerGramBody(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
+{
+  for (PetscInt j = 0; j < r; ++j)
+    for (PetscInt i = j; i < r; ++i) S[i + j * r] = 0;
+  PetscInt k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const PetscReal *x0 = &X[(size_t)k * r], *x1 = x0 + r, *x2 = x1 + r, *x3 = x2 + r;
+    for (PetscInt j = 0; j < r; ++j) {
+      const PetscReal a0 = x0[j], a1 = x1[j], a2 = x2[j], a3 = x3[j];
+      PetscReal      *sj = &S[(size_t)j * r];
+      for (PetscInt i = j; i < r; ++i) sj[i] += a0 * x0[i] + a1 * x1[i] + a2 * x2[i] + a3 * x3[i];
+    }
+  }
+  for (; k < n; ++k) {
+    const PetscReal *x = &X[(size_t)k * r];
+    for (PetscInt j = 0; j < r; ++j) {
+      const PetscReal a = x[j];
+      PetscReal      *sj = &S[(size_t)j * r];
+      for (PetscInt i = j; i < r; ++i) sj[i] += a * x[i];
+    }
+  }
+}
+
+void RightSolveTPortable(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
+void LowerGramPortable(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
 
 void OuterPortable(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K)
 {
@@ -27,6 +86,29 @@ void OuterPortable(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, con
       }
       for (int i = 0; i < 4; ++i) K[(size_t)c * rp + i0 + i] = acc[i];
     }
+}
+
+void ScatterPortable(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
+{
+  for (PetscInt p = 0; p < M; ++p) {
+    const PetscReal *w = W + (size_t)p * rp;
+    for (PetscInt t = 0; t < nt[p]; ++t) {
+      const PetscReal cf = coef[(size_t)p * maxTerms + t];
+      PetscReal      *q  = Q + (size_t)rowIdx[(size_t)p * maxTerms + t] * rp;
+      for (PetscInt i = 0; i < rp; ++i) q[i] += cf * w[i];
+    }
+    for (PetscInt i = 0; i < rp; ++i) g[i] += gamma[p] * w[i];
+  }
+}
+
+void RowDotsPortable(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
+{
+  for (PetscInt r = 0; r < rows; ++r) {
+    const PetscReal *a = A + (size_t)r * n;
+    PetscReal        s = b[r];
+    for (PetscInt k = 0; k < n; ++k) s += a[k] * v[k];
+    out[r] = s;
+  }
 }
 
 void CombinePortable(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out)
@@ -45,7 +127,27 @@ __attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, Pets
   PetscInt c0 = 0;
   for (; c0 + 4 <= nc; c0 += 4) {
     const PetscReal *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
-    for (PetscInt i0 = 0; i0 < rp; i0 += 4) {
+    PetscInt         i0 = 0;
+    // 12 rows x 4 columns in 12 registers: 3 loads and 4 broadcasts per 12 FMAs (the 4 x 4 block
+    // below needs 1 load and 4 broadcasts per 4)
+    for (; i0 + 12 <= rp; i0 += 12) {
+      __m256d a[3][4];
+      for (int b = 0; b < 3; ++b)
+        for (int j = 0; j < 4; ++j) a[b][j] = _mm256_setzero_pd();
+      for (PetscInt p = 0; p < M; ++p) {
+        const PetscReal *wp = W + (size_t)p * rp + i0;
+        const __m256d    w0 = _mm256_loadu_pd(wp), w1 = _mm256_loadu_pd(wp + 4), w2 = _mm256_loadu_pd(wp + 8);
+        const __m256d    xs[4] = {_mm256_broadcast_sd(x0 + p), _mm256_broadcast_sd(x1 + p), _mm256_broadcast_sd(x2 + p), _mm256_broadcast_sd(x3 + p)};
+        for (int j = 0; j < 4; ++j) {
+          a[0][j] = _mm256_fmadd_pd(w0, xs[j], a[0][j]);
+          a[1][j] = _mm256_fmadd_pd(w1, xs[j], a[1][j]);
+          a[2][j] = _mm256_fmadd_pd(w2, xs[j], a[2][j]);
+        }
+      }
+      for (int j = 0; j < 4; ++j)
+        for (int b = 0; b < 3; ++b) _mm256_storeu_pd(K + (size_t)(c0 + j) * rp + i0 + 4 * b, a[b][j]);
+    }
+    for (; i0 < rp; i0 += 4) {
       __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
       for (PetscInt p = 0; p < M; ++p) {
         const __m256d w = _mm256_loadu_pd(W + (size_t)p * rp + i0);
@@ -70,6 +172,34 @@ __attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, Pets
   }
 }
 
+__attribute__((target("avx2,fma"))) void ScatterAvx2(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
+{
+  for (PetscInt p = 0; p < M; ++p) {
+    const PetscReal *w = W + (size_t)p * rp;
+    for (PetscInt t = 0; t < nt[p]; ++t) {
+      const __m256d cf = _mm256_broadcast_sd(coef + (size_t)p * maxTerms + t);
+      PetscReal    *q  = Q + (size_t)rowIdx[(size_t)p * maxTerms + t] * rp;
+      for (PetscInt i = 0; i < rp; i += 4) _mm256_storeu_pd(q + i, _mm256_fmadd_pd(cf, _mm256_loadu_pd(w + i), _mm256_loadu_pd(q + i)));
+    }
+    const __m256d gp = _mm256_broadcast_sd(gamma + p);
+    for (PetscInt i = 0; i < rp; i += 4) _mm256_storeu_pd(g + i, _mm256_fmadd_pd(gp, _mm256_loadu_pd(w + i), _mm256_loadu_pd(g + i)));
+  }
+}
+
+__attribute__((target("avx2,fma"))) void RowDotsAvx2(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
+{
+  for (PetscInt r = 0; r < rows; ++r) {
+    const PetscReal *a   = A + (size_t)r * n;
+    __m256d          acc = _mm256_setzero_pd();
+    PetscInt         k   = 0;
+    for (; k + 4 <= n; k += 4) acc = _mm256_fmadd_pd(_mm256_loadu_pd(a + k), _mm256_loadu_pd(v + k), acc);
+    const __m128d h = _mm_add_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1));
+    PetscReal     s = b[r] + _mm_cvtsd_f64(_mm_add_sd(h, _mm_unpackhi_pd(h, h)));
+    for (; k < n; ++k) s += a[k] * v[k];
+    out[r] = s;
+  }
+}
+
 __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out)
 {
   PetscInt k = 0;
@@ -84,6 +214,10 @@ __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscRea
     out[k] = s;
   }
 }
+
+// The same loops vectorized 4-wide with FMA by the compiler (the inner loops run over the r rows, contiguous)
+__attribute__((target("avx2,fma"))) void RightSolveTAvx2(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
+__attribute__((target("avx2,fma"))) void LowerGramAvx2(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
 
 bool HaveAvx2()
 {
@@ -114,6 +248,38 @@ void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W
   if (HaveAvx2()) return OuterAvx2(M, rp, nc, W, X, K);
 #endif
   OuterPortable(M, rp, nc, W, X, K);
+}
+
+void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return ScatterAvx2(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+#endif
+  ScatterPortable(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+}
+
+void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return RightSolveTAvx2(r, n, L, D, X);
+#endif
+  RightSolveTPortable(r, n, L, D, X);
+}
+
+void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return LowerGramAvx2(r, n, X, S);
+#endif
+  LowerGramPortable(r, n, X, S);
+}
+
+void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return RowDotsAvx2(rows, n, A, v, b, out);
+#endif
+  RowDotsPortable(rows, n, A, v, b, out);
 }
 
 } // namespace rbc

@@ -1,5 +1,5 @@
-// src/rom/dense_kernels.hpp: the two small dense kernels the online contact terms spend their time in
-// (docs/online.md, "Where the online time goes"), register-blocked and compiled twice: for the
+// src/rom/dense_kernels.hpp: the small dense kernels the online stage spends its time in (docs/online.md,
+// "Where the online time goes"): the cubature's contact terms and the reduced QP's set-up, compiled twice: for the
 // baseline x86-64 and for AVX2+FMA, chosen once at run time from the CPU (no -march needed).
 // Internal to the library.
 #pragma once
@@ -13,6 +13,20 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
 // Sum of outer products over M points: K(:, c) = sum_p W(p, :) X(c, p) for c < nc, with W (M x rp,
 // point-major, rp a multiple of 4, padding zero) and X (nc x M, row-major); K is rp x nc, column-major.
 void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K);
+
+// The patch-dof accumulation of the cubature's dof sum: for every point p < M and term t < nt[p],
+// Q(rowIdx[p][t], :) += coef[p][t] W(p, :), and g += gamma[p] W(p, :) (W M x rp point-major, Q nd x rp
+// row-major, g of length rp; rowIdx and coef hold maxTerms entries per point). Accumulates into Q, g.
+void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g);
+
+// out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major): the patch's nodal displacement
+// U = uD + theta v (ContactPatch::SetReduced).
+void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out);
+
+// The reduced QP's set-up (src/rom/reduced_qp.cpp): X = D L^{-T} (D, X: r x n column-major, leading
+// dimension r; L lower n x n, column-major) and the lower triangle of S = X X' (S r x r).
+void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X);
+void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S);
 
 // rp for r rows: r rounded up to the kernel's block (4).
 inline PetscInt PaddedRows(PetscInt r) { return (r + 3) / 4 * 4; }

@@ -275,12 +275,7 @@ void ContactPatch::SetReduced(const PetscReal *v)
 {
   thread_local std::vector<PetscReal> U;
   U.resize(nnode * dim);
-  for (PetscInt r = 0; r < nnode * dim; ++r) {
-    const PetscReal *t = &theta[r * N];
-    PetscReal        s = uD[r];
-    for (PetscInt n = 0; n < N; ++n) s += t[n] * v[n];
-    U[r] = s;
-  }
+  RowDots(nnode * dim, N, theta.data(), v, uD.data(), U.data()); // U = uD + theta v (vectorized over the modes)
   SetNodal(U);
 }
 

@@ -538,16 +538,9 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       const PetscInt nd = patch.nnode * patch.dim;
       out = patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data());
       std::fill(cQ_.begin(), cQ_.end(), 0.0);
-      std::fill(g, g + r, 0.0);
-      for (PetscInt p = 0; p < M; ++p) {
-        const PetscReal *w = &cPwT_[(size_t)p * rp];
-        for (PetscInt t = 0; t < cNt_[p]; ++t) {
-          const PetscReal cf = cCoef_[(size_t)p * ContactPatch::MaxTerms + t];
-          PetscReal      *q  = &cQ_[(size_t)cRow_[(size_t)p * ContactPatch::MaxTerms + t] * rp];
-          for (PetscInt i = 0; i < rp; ++i) q[i] += cf * w[i];
-        }
-        for (PetscInt i = 0; i < r; ++i) g[i] += gam_[p] * w[i];
-      }
+      cG_.assign(rp, 0.0);
+      ScatterRows(M, rp, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwT_.data(), gam_.data(), cQ_.data(), cG_.data());
+      std::copy_n(cG_.data(), r, g);
       cK_.resize((size_t)rp * Na);
       SumOfOuterProducts(nd, rp, Na, cQ_.data(), cThetaT_.data(), cK_.data());
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
