@@ -252,7 +252,8 @@ def dual_duplicates(ctx):
 
 
 def repeated_training(ctx):
-    """A training file with every parameter twice: the offline stage builds the same ROM as without repeats."""
+    """A training file with every parameter twice: the offline stage builds the same ROM as without repeats
+    (the repeated parameters' contact states and warm starts are taken once: offline report eim.repeated_training_parameters)."""
     import numpy as np
     mus = np.linspace(0.95, 1.15, 6)
     files = {}
@@ -260,7 +261,7 @@ def repeated_training(ctx):
         files[k] = os.path.join(ctx.work, "train_%s.txt" % k)
         with open(files[k], "w") as f:
             f.write("# radius\n" + "".join("%.17g\n" % m for m in pts))
-    runs, reps = [], {}
+    runs, reps, offs = [], {}, {}
     for k in files:
         rom = os.path.join(ctx.work, "rep_%s.h5" % k)
         off = stage(ctx, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_type", "file", "-train_file", files[k], "-rom", rom])
@@ -268,14 +269,23 @@ def repeated_training(ctx):
         runs += [off, val]
         if off.rep is None or val.rep is None:
             return failed(runs, "offline " + k)
-        reps[k] = val.rep
+        reps[k], offs[k] = val.rep, off.rep
     a, b = reps["twice"], reps["once"]
+    # the repeats add no contact state to the cubature's fit: the same state count, 6 repeats reported
+    states_ok = offs["twice"]["eim"]["snapshots"] == offs["once"]["eim"]["snapshots"] and offs["twice"]["eim"].get("repeated_training_parameters") == len(mus)
     same = a["rom"]["N"] == b["rom"]["N"] and a["rom"]["R"] == b["rom"]["R"]
-    eu, el = rel(a["test"]["max_rel_err_u"], b["test"]["max_rel_err_u"]), rel(a["test"]["max_rel_err_lambda"], b["test"]["max_rel_err_lambda"])
-    ok = same and eu <= 0.05 and el <= 0.05
-    row = result(runs, ok, "N, R %d, %d (once %d, %d); errors u %.1e, lambda %.1e (once %.1e, %.1e; within 5%%)" % (
-        a["rom"]["N"], a["rom"]["R"], b["rom"]["N"], b["rom"]["R"], a["test"]["max_rel_err_u"], a["test"]["max_rel_err_lambda"], b["test"]["max_rel_err_u"],
-        b["test"]["max_rel_err_lambda"]))
+    # The same bases: the exact-contact ROMs' errors agree to 1e-3. The cubature is compared by its own
+    # standard (within 1.5x of the exact-contact ROM, as the ROM-accuracy targets): its point picks follow the
+    # last POD modes and supremizers, which two runs determine only to rounding (a supremizer of relative
+    # singular value 7e-9), and they moved the hyper-reduced u error by 7 % between the two (docs/hard_cases.md).
+    xa, xb = a["test_exact"], b["test_exact"]
+    eu, el = rel(xa["max_rel_err_u"], xb["max_rel_err_u"]), rel(xa["max_rel_err_lambda"], xb["max_rel_err_lambda"])
+    hyper_ok = all(r["test"]["max_rel_err_u"] <= 1.5 * r["test_exact"]["max_rel_err_u"] and r["test"]["max_rel_err_lambda"] <= 1.5 * r["test_exact"]["max_rel_err_lambda"] for r in (a, b))
+    ok = same and states_ok and eu <= 1e-3 and el <= 1e-3 and hyper_ok
+    row = result(runs, ok, "cubature states %d (once %d, %s repeats skipped); N, R %d, %d (once %d, %d); exact-contact errors u %.4e, lambda %.4e (once %.4e, %.4e; within 1e-3); hyper-reduced u %.1e, lambda %.1e (once %.1e, %.1e; within 1.5x exact)" % (
+        offs["twice"]["eim"]["snapshots"], offs["once"]["eim"]["snapshots"], offs["twice"]["eim"].get("repeated_training_parameters"),
+        a["rom"]["N"], a["rom"]["R"], b["rom"]["N"], b["rom"]["R"], xa["max_rel_err_u"], xa["max_rel_err_lambda"], xb["max_rel_err_u"], xb["max_rel_err_lambda"],
+        a["test"]["max_rel_err_u"], a["test"]["max_rel_err_lambda"], b["test"]["max_rel_err_u"], b["test"]["max_rel_err_lambda"]))
     row["kkt"] = None
     return row
 

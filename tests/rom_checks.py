@@ -162,7 +162,9 @@ def pipeline(args):
     print("  test (20 random radii): max rel err u %.2e lambda %.2e force %.2e; no EIM: u %.2e lambda %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], val[1]["test_no_eim"]["max_rel_err_u"], val[1]["test_no_eim"]["max_rel_err_lambda"]))
     check(t["n"] == 20 and t["max_rel_err_u"] <= 1e-3, "max rel err u %.2e <= 1e-3" % t["max_rel_err_u"])
     check(t["max_rel_err_lambda"] <= 1e-2, "max rel err lambda %.2e <= 1e-2" % t["max_rel_err_lambda"])
-    for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force"):
+    fo = t["max_rel_err_force_online"]
+    check(fo is not None and fo <= 1e-3, "the contact force computed online (no mesh) against the FOM's: max rel err %s <= 1e-3" % fo)
+    for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force", "max_rel_err_force_online"):
         a, b = val[1]["test"][k], val[2]["test"][k]
         check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
     check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
@@ -173,6 +175,7 @@ def pipeline(args):
     run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-rom_hyper", "eim", "-validate_repeat", "2", "-report", d + "/val_eim.json"])
     ve = report(d + "/val_eim.json")
     check(ve["rom"]["hyper"] == "eim" and ve["test"]["max_rel_err_u"] <= 1e-3, "-rom_hyper eim on the same file: EIM (u %.2e, lambda %.2e)" % (ve["test"]["max_rel_err_u"], ve["test"]["max_rel_err_lambda"]))
+    check(ve["test"]["max_rel_err_force_online"] is None, "the EIM computes no online force (null in the validate report)")
     check(val[1]["speedup_median"] > 10, "speedup %.0f (online median %.2e s, FOM %.2e s)" % (val[1]["speedup_median"], val[1]["online_time_s"]["median"], val[1]["fom_time_s"]["median"]))
     with open(d + "/val1_sweep.json") as f:
         sw = json.load(f)
@@ -190,6 +193,9 @@ def pipeline(args):
     check(lr.shape == lf.shape and lr.min() >= 0, "reconstructed pressure: %d slave nodes, nonnegative" % lr.size)
     check(abs(rr["energy"] - rf["energy"]) <= 1e-3 * rf["energy"], "reconstructed energy %.8e vs FOM %.8e" % (rr["energy"], rf["energy"]))
     check(abs(rr["contact_force"] - rf["contact_force"]) <= 1e-2 * rf["contact_force"], "reconstructed contact force %.6e vs FOM %.6e" % (rr["contact_force"], rf["contact_force"]))
+    fo = rr["outputs"]["contact_force"]
+    check(fo is not None and abs(fo - rf["contact_force"]) <= 1e-3 * rf["contact_force"] and len(rr["outputs"]["force"]) == 2,
+          "online contact force (no mesh) %.6e vs FOM %.6e (rel %.1e <= 1e-3)" % (fo, rf["contact_force"], abs(fo - rf["contact_force"]) / rf["contact_force"]))
     check(xr.shape == xf.shape and np.abs(xr - xf).max() <= 1e-12, "reconstructed fields on the FOM's (physical, radius 1.02) configuration")
     shutil.rmtree(d, ignore_errors=True)
 
@@ -355,6 +361,8 @@ def half_disks(args):
     up, ud = np.array(sp["u_hat"]), np.array(sd["u_hat"])
     lp, ld = np.array(sp["lambda_hat"]), np.array(sd["lambda_hat"])
     du, dl = np.abs(up - ud).max() / np.abs(up).max(), np.abs(lp - ld).max() / np.abs(lp).max()
+    fp, fd = sp["outputs"]["contact_force"], sd["outputs"]["contact_force"]
+    check(fp > 0 and abs(fp - fd) <= 1e-10 * fp, "online contact force by points %.10e and by dofs %.10e" % (fp, fd))
     check(sp["rom"]["ecsw_sum"] == "points" and sd["rom"]["ecsw_sum"] == "dofs" and sp["kacanov_iterations"] == sd["kacanov_iterations"]
           and du <= 1e-12 and dl <= 1e-8, "-rom_ecsw_sum points vs dofs: u_hat rel diff %.1e <= 1e-12, lambda_hat %.1e <= 1e-8 (coefficients of a "
           "nearly collinear dual basis), %d vs %d iterations" % (du, dl, sp["kacanov_iterations"], sd["kacanov_iterations"]))

@@ -2,7 +2,8 @@
 // against independent references:
 //  1. CubatureGram against the Gram matrix of the explicitly stacked fitting rows (each state's K^ and
 //     g^ entries as functions of the weights, scaled to unit norm), on random data; CubatureActionGram
-//     likewise against its rows (K^' lam_j and K^ v_j - g^ per training solution j, scaled per state).
+//     likewise against its rows (K^' lam_j and K^ v_j - g^ per training solution j, scaled per state),
+//     and with the resultant-force rows F_s(lam_j) added.
 //  2. Caratheodory/Tchakaloff: moments of degree 0..4 of a 60-point rule on [0, 1] are reproduced by a
 //     nonnegative rule on at most 5 of its points; the sparse NNLS finds one (weights > 0, support <= 5,
 //     residual <= 1e-9) and the moments it gives match the full rule's.
@@ -96,6 +97,30 @@ int main(int argc, char **argv)
     for (auto &x : Lam) x = std::abs(U(gen));
     for (auto &x : Vs) x = U(gen);
     CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &H);
+    // with the force term: w n2 per point (dim 2), F_s(lam_j)_d = sum_p (P' lam_j)(p) xi_p Sw_s(p, d)
+    const PetscInt         dim = 2;
+    std::vector<PetscReal> Sw((size_t)ms * Q * dim), HF;
+    for (auto &x : Sw) x = U(gen);
+    CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HF, Sw, dim);
+    std::vector<PetscReal> GF; // the force rows alone, scaled per state
+    for (PetscInt s = 0; s < ms; ++s) {
+      std::vector<PetscReal> rows((size_t)nt * dim * Q);
+      PetscReal              n3 = 0;
+      for (PetscInt j = 0; j < nt; ++j)
+        for (PetscInt d = 0; d < dim; ++d)
+          for (PetscInt p = 0; p < Q; ++p) {
+            PetscReal l = 0;
+            for (PetscInt r = 0; r < R; ++r) l += Lam[(size_t)j * R + r] * P[(size_t)r * Q + p];
+            rows[((size_t)j * dim + d) * Q + p] = l * Sw[((size_t)s * Q + p) * dim + d];
+          }
+      for (PetscInt k = 0; k < nt * dim; ++k) {
+        PetscReal t = 0;
+        for (PetscInt p = 0; p < Q; ++p) t += rows[(size_t)k * Q + p];
+        n3 += t * t;
+      }
+      for (auto &x : rows) x /= std::sqrt(n3);
+      GF.insert(GF.end(), rows.begin(), rows.end());
+    }
     std::vector<PetscReal> G, K, g, one(Q, 1.0), e(Q);
     for (PetscInt s = 0; s < ms; ++s) {
       Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
@@ -136,6 +161,10 @@ int main(int argc, char **argv)
     }
     const PetscReal d = GramMismatch(G, Q, H);
     Check(d <= 1e-13, "CubatureActionGram = G'G of the explicit rows (K' lam_j, K v_j - g; max |diff| / max |G'G|)", d, 1e-13);
+    std::vector<PetscReal> GG(G);
+    GG.insert(GG.end(), GF.begin(), GF.end());
+    const PetscReal dF = GramMismatch(GG, Q, HF);
+    Check(dF <= 1e-13, "CubatureActionGram with the force rows (F(lam_j) per component) = G'G of the explicit rows", dF, 1e-13);
   }
 
   { // 2. moments 0..4 of a 60-point rule: a nonnegative rule on <= 5 of its points

@@ -30,6 +30,8 @@ struct CubatureOptions {
   PetscReal tol       = 1e-4;  // stop when ||G (xi - 1)|| <= tol ||G 1|| (relative RMS error of the fitted terms)
   PetscInt  maxPoints = 1000;  // at most this many points (the tolerance decides; a safeguard)
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
+  bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
+                               // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
 };
 
 struct CubatureResult {
@@ -40,7 +42,7 @@ struct CubatureResult {
   PetscInt               iterations = 0; // Lawson-Hanson steps (inner removals included)
 };
 
-// Options with prefix pre (e.g. "ecsw_"): -<pre>tol, -<pre>max_points, -<pre>monitor.
+// Options with prefix pre (e.g. "ecsw_"): -<pre>fit, -<pre>fit_force, -<pre>tol, -<pre>max_points, -<pre>monitor.
 PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, CubatureOptions *opt);
 
 // The Gram matrix H (Q x Q, row-major) of the fitting problem from ms states: kappa snapshots Sk (ms
@@ -55,7 +57,11 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
 // dK, dg the cubature's errors: H = ((P'Lam')(Lam P)) o (Zk Zk') + (P'P) o (Y Y'), Zk the scaled kappa
 // columns, Y(p, (s, j)) = kappa_s(p, :) v_j - gamma_s(p) scaled. Weighted Frobenius norms: the row directions
 // no training multiplier takes and the columns no training solution uses weigh little.
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H);
+// With Sw (ms blocks of Q x dim, row-major: each point's weight times its unit master normal, w_p n2(x_p),
+// ContactPatch::Evaluate's wn), a third term fits the resultant contact force F_s(lam_j) = sum_p
+// (P' lam_j)(p) w_p n2(x_p), the output of interest the online stage computes from the cubature (docs/online.md):
+//   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);

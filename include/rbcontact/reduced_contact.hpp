@@ -49,13 +49,15 @@ public:
   void SetNodal(const std::vector<PetscReal> &U);
   // Nodal field (nnode x dim) of a full-order free-dof vector in canonical order (Dirichlet values added).
   void NodalFromCanonical(const std::vector<PetscReal> &u, std::vector<PetscReal> *U) const;
-  // kappa (np x N, row-major) and gamma (np) at points idx[0..np); hit (optional): master facet found.
-  // Returns the number of projections that fell on the edge of a restricted patch (out of range).
-  PetscInt Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit) const;
+  // kappa (np x N, row-major) and gamma (np) at points idx[0..np); hit (optional): master facet found;
+  // wn (optional, np x dim): the point's weight times its unit master normal, w n2 (the resultant contact
+  // force is sum_x lambda(x) w_x n2(x)). Returns the number of projections that fell on the edge of a
+  // restricted patch (out of range).
+  PetscInt Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit, PetscReal *wn = nullptr) const;
   // The same before the combination with theta: kappa(i, :) = sum_{t < nt[i]} coef[i][t] theta(rowIdx[i][t], :)
   // (at most MaxTerms terms per point, stored with stride MaxTerms), and gamma. Same return value.
   static constexpr PetscInt MaxTerms = 36; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
-  PetscInt EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma) const;
+  PetscInt EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn = nullptr) const;
   PetscInt NumPoints() const { return (PetscInt)points.size(); }
 
   // Serialization: named float64 arrays (row-major) and their shapes, for the ROM file.
@@ -75,7 +77,7 @@ public:
 
 private:
   void PrepareMaster();
-  PetscInt PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit) const;
+  PetscInt PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit, PetscReal *wn) const;
   std::vector<PetscReal> meas_;    // slave facet measure at mu
   std::vector<PetscReal> vnormal_; // nvertex x 3
   std::vector<PetscInt>  vcount_;  // per point scratch

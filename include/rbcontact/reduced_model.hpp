@@ -9,6 +9,7 @@
 // -rom_kacanov_monitor; -rom_kacanov_anderson m: Anderson mixing), KKT check -rom_kkt_tol. Nothing in it grows with the mesh.
 // Usage: share/examples/online_loop.cpp.
 #pragma once
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,6 +57,17 @@ struct ReducedSolution {
   PetscInt               outOfRange = 0; // contact projections at the edge of the stored patch (EIM range)
   std::string            message;     // why it failed (empty on success)
   std::vector<PetscReal> iterates;    // with recordIterates: the v (N each) the contact terms were evaluated at
+  // The resultant contact force sum_i lambda_i int psi_i n2 (dim components; its norm is the FOM report's
+  // contact_force), from the reduced multipliers and the cubature's (or the exact terms') points at the
+  // last Kacanov iterate: no mesh. Empty with the EIM (which interpolates K^ and g^, not the normals) and
+  // when the solve failed. docs/online.md, "Outputs of interest".
+  std::vector<PetscReal> force;
+  PetscReal ForceMagnitude() const
+  {
+    PetscReal s = 0;
+    for (PetscReal f : force) s += f * f;
+    return std::sqrt(s);
+  }
 };
 
 class ReducedModel {
@@ -141,6 +153,9 @@ public:
 
 private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  void           ResultantForce(const std::vector<PetscReal> &lambda, std::vector<PetscReal> *F) const;
+  std::vector<PetscReal> wn_;                         // w_p n2(x_p) of the contact terms' last evaluation (points x dim)
+  ContactMode            wnMode_ = ContactMode::EIM;  // the mode of that evaluation (EIM: none)
   ContactMode            mode_ = ContactMode::EIM;
   std::vector<PetscInt>  cols_;
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;

@@ -50,6 +50,8 @@ int main(int argc, char **argv)
     // u ~ sum_n v_n theta_n (reduced coordinates sol.v), lambda ~ sum_r lambda_r xi_r (sol.lambda)
     PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%s = %.4f  iterations %2" PetscInt_FMT "  v[0:3] =", params[0].name.c_str(), (double)mu[0], sol.iterations));
     for (size_t i = 0; i < std::min<size_t>(3, sol.v.size()); ++i) PetscCall(PetscPrintf(PETSC_COMM_WORLD, " % .6e", (double)sol.v[i]));
+    // the resultant contact force, computed online without the mesh (empty with -rom_hyper eim)
+    if (!sol.force.empty()) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  force %.6e", (double)sol.ForceMagnitude()));
     PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  time %.2e s\n", (double)(t1 - t0)));
   }
   PetscCall(SlepcFinalize());

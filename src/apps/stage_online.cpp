@@ -8,6 +8,7 @@
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
 #include <algorithm>
+#include <cstdio>
 
 namespace rbc {
 
@@ -70,6 +71,15 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   rep.root["lambda_hat"]         = sol.lambda;
   rep.root["nactive_hat"]        = (long long)(sol.nactive.empty() ? 0 : sol.nactive.back());
   rep.root["out_of_range"]       = (long long)sol.outOfRange;
+  // outputs of interest from the reduced solution alone (no mesh): the resultant contact force
+  JsonValue &o = rep.root["outputs"];
+  if (sol.force.empty()) {
+    o["contact_force"] = JsonValue();
+    o["force"]         = JsonValue();
+  } else {
+    o["contact_force"] = (double)sol.ForceMagnitude();
+    o["force"]         = std::vector<double>(sol.force.begin(), sol.force.end());
+  }
   JsonValue &k                   = rep.root["kkt"];
   k["primal_infeas"]             = (double)sol.qp.primal;
   k["dual_infeas"]               = (double)sol.qp.dual;
@@ -93,7 +103,9 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     PetscCall(ReconstructFields(comm, model, sol, mu, recPath, &rep));
     rep.root["reconstruct"] = recPath;
   }
-  PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " %s, %" PetscInt_FMT " Kacanov iterations, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.HyperSizes().c_str(), sol.iterations, times[times.size() / 2], repeat));
+  char forceText[64] = "";
+  if (!sol.force.empty()) std::snprintf(forceText, sizeof forceText, ", contact force %.6g", (double)sol.ForceMagnitude());
+  PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " %s, %" PetscInt_FMT " Kacanov iterations%s, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.HyperSizes().c_str(), sol.iterations, forceText, times[times.size() / 2], repeat));
   PetscCall(rep.Write(comm, reportPath));
   PetscFunctionReturn(0);
 }

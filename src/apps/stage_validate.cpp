@@ -26,6 +26,7 @@ static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
 namespace {
 struct Errors {
   std::vector<double> u, lambda, force;
+  std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
   PetscInt            failed = 0;
   std::string         firstFailure;
   void Fill(JsonValue *j) const
@@ -45,6 +46,14 @@ struct Errors {
     (*j)["rel_err_u"]           = u;
     (*j)["rel_err_lambda"]      = lambda;
     (*j)["rel_err_force"]       = force;
+    // the force computed online from the reduced solution (docs/online.md, "Outputs of interest"); null with the EIM
+    if (!forceOnline.empty() && forceOnline.size() == u.size()) {
+      (*j)["max_rel_err_force_online"] = mx(forceOnline);
+      (*j)["rel_err_force_online"]     = forceOnline;
+    } else {
+      (*j)["max_rel_err_force_online"] = JsonValue();
+      (*j)["rel_err_force_online"]     = JsonValue();
+    }
     (*j)["failed"]              = (long long)failed;
     if (failed) (*j)["first_failure"] = firstFailure;
   }
@@ -272,6 +281,14 @@ PetscErrorCode StageValidate(MPI_Comm comm)
       E->u.push_back(eu);
       E->lambda.push_back(el);
       E->force.push_back(ef);
+      if ((PetscInt)sol.force.size() == dim) {
+        PetscReal df = 0, nf = 0;
+        for (PetscInt d = 0; d < dim; ++d) {
+          df += PetscSqr(sol.force[d] - F[j].force[d]);
+          nf += PetscSqr(F[j].force[d]);
+        }
+        E->forceOnline.push_back(nf > 0 ? std::sqrt(df / nf) : std::sqrt(df));
+      }
     }
     PetscFunctionReturn(0);
   };

@@ -20,6 +20,9 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
     PetscCall(PetscOptionsEList("-fit", "what the fit measures: K^' lambda and K^ v - g^ at the training solutions (action) or every entry of K^, g^ (terms)", "", fits, 2, fits[f], &f, NULL));
     opt->fit = f == 1 ? CubatureFit::Action : CubatureFit::Terms;
   }
+  flg = opt->fitForce ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-fit_force", "with -fit action: fit the resultant contact force too (the online stage's output of interest)", "", flg, &flg, NULL));
+  opt->fitForce = flg;
   PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
   PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
   flg = opt->monitor ? PETSC_TRUE : PETSC_FALSE;
@@ -108,7 +111,7 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
   std::vector<PetscReal> LP((size_t)nt * Q, 0.0), Zk((size_t)Q * ms * N, 0.0), Y((size_t)Q * ms * nt, 0.0), Kh, gh;
@@ -153,6 +156,26 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
   H->assign((size_t)Q * Q, 0.0);
   AddHadamardGram(Q, LP.data(), nt, Zk.data(), ms * N, H);
   AddHadamardGram(Q, P.data(), R, Y.data(), ms * nt, H);
+  // the resultant force: F_s(lam_j)_d = sum_p LP(j, p) Sw_s(p, d), scaled to unit norm per state
+  if (dim > 0 && Sw.size() == (size_t)ms * Q * dim) {
+    std::vector<PetscReal> Zf((size_t)Q * ms * dim, 0.0);
+    for (PetscInt s = 0; s < ms; ++s) {
+      const PetscReal *wn = &Sw[(size_t)s * Q * dim];
+      PetscReal        n3 = 0;
+      for (PetscInt j = 0; j < nt; ++j)
+        for (PetscInt d = 0; d < dim; ++d) {
+          PetscReal t = 0;
+          for (PetscInt p = 0; p < Q; ++p) t += LP[(size_t)j * Q + p] * wn[(size_t)p * dim + d];
+          n3 += t * t;
+        }
+      const PetscReal s3 = n3 > 0 ? 1 / std::sqrt(n3) : 0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        PetscReal *z = &Zf[(size_t)(s * dim + d) * Q];
+        for (PetscInt p = 0; p < Q; ++p) z[p] = s3 * wn[(size_t)p * dim + d];
+      }
+    }
+    AddHadamardGram(Q, LP.data(), nt, Zf.data(), ms * dim, H);
+  }
 }
 
 namespace {

@@ -303,7 +303,7 @@ void ContactPatch::PrepareMaster()
       if (vnormal_[3 * v] != 0 || vnormal_[3 * v + 1] != 0 || vnormal_[3 * v + 2] != 0) NormalizeVertexNormal(&vnormal_[3 * v]);
 }
 
-PetscInt ContactPatch::PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit) const
+PetscInt ContactPatch::PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit, PetscReal *wn) const
 {
   PetscInt            outside = 0;
   const Point        &P = points[p];
@@ -353,17 +353,19 @@ PetscInt ContactPatch::PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], P
       }
   }
   *gamma = w * g;
+  if (wn)
+    for (PetscInt d = 0; d < dim; ++d) wn[d] = w * e.n2[d];
   return outside;
 }
 
-PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit) const
+PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kappa, PetscReal *gamma, PetscInt *hit, PetscReal *wn) const
 {
   PetscInt outside = 0;
   for (PetscInt i = 0; i < np; ++i) {
     PetscReal        coefs[36], g; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
     PetscInt         ridx[36], nt;
     const PetscReal *rows[36];
-    outside += PointTerms(idx[i], &nt, ridx, coefs, &g, hit ? &hit[i] : nullptr);
+    outside += PointTerms(idx[i], &nt, ridx, coefs, &g, hit ? &hit[i] : nullptr, wn ? wn + (size_t)i * dim : nullptr);
     if (kappa) {
       for (PetscInt t = 0; t < nt; ++t) rows[t] = &theta[ridx[t] * N];
       CombineRows(nt, coefs, rows, N, kappa + i * N); // one combination kernel
@@ -373,10 +375,10 @@ PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kap
   return outside;
 }
 
-PetscInt ContactPatch::EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma) const
+PetscInt ContactPatch::EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn) const
 {
   PetscInt outside = 0;
-  for (PetscInt i = 0; i < np; ++i) outside += PointTerms(idx[i], &nt[i], rowIdx + (size_t)i * MaxTerms, coef + (size_t)i * MaxTerms, &gamma[i], nullptr);
+  for (PetscInt i = 0; i < np; ++i) outside += PointTerms(idx[i], &nt[i], rowIdx + (size_t)i * MaxTerms, coef + (size_t)i * MaxTerms, &gamma[i], nullptr, wn ? wn + (size_t)i * dim : nullptr);
   return outside;
 }
 

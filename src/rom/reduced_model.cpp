@@ -509,7 +509,9 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     P.SetReduced(vfull.data());
     allPoints_.resize(Q);
     for (PetscInt p = 0; p < Q; ++p) allPoints_[p] = p;
-    out = P.Evaluate(allPoints_.data(), Q, kap_.data(), gam_.data(), nullptr);
+    wn_.resize((size_t)Q * P.dim);
+    out = P.Evaluate(allPoints_.data(), Q, kap_.data(), gam_.data(), nullptr, wn_.data());
+    wnMode_ = ContactMode::Exact;
     for (PetscInt i = 0; i < r; ++i) {
       const PetscReal *pr = &Pact_[(size_t)i * Q];
       PetscReal        gs = 0;
@@ -532,11 +534,13 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     }
     patch.SetReduced(vfull.data());
     const PetscInt rp = PaddedRows(r);
+    wn_.resize((size_t)M * patch.dim);
+    wnMode_ = ContactMode::Cubature;
     if (cDofs_) {
       // Q(a, :) = sum_p coef(p, a) Pw(:, p) over the patch dofs a, then K^ = Q' theta(:, cols) (one blocked
       // kernel over the dofs), g^ = sum_p Pw(:, p) gamma(p)
       const PetscInt nd = patch.nnode * patch.dim;
-      out = patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data());
+      out = patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data());
       std::fill(cQ_.begin(), cQ_.end(), 0.0);
       cG_.assign(rp, 0.0);
       ScatterRows(M, rp, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwT_.data(), gam_.data(), cQ_.data(), cG_.data());
@@ -546,7 +550,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
       return out;
     }
-    out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr);
+    out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
     // [K g] = sum_p Pw(:, p) [kappa(p, cols) gamma(p)]: the columns point-contiguous, one blocked kernel
     cX_.resize((size_t)(Na + 1) * M);
     cK_.resize((size_t)rp * (Na + 1));
@@ -560,6 +564,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
     return out;
   }
+  wnMode_ = ContactMode::EIM; // the EIM interpolates K^ and g^, not the normals: no resultant force
   const PetscInt np = (PetscInt)evalPoints_.size();
   if (np > 0) {
     if (geomMu_ != mu) {
@@ -607,6 +612,24 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
   PetscFunctionReturn(0);
 }
 
+// F = sum_i lambda_i int psi_i n2 (the FOM's resultant) through the contact terms' last evaluation:
+// lambda(x_p) times the point's weight and cubature weight = (Pw(:, p)' lambda^) and w_p n2(x_p) (wn_).
+void ReducedModel::ResultantForce(const std::vector<PetscReal> &lambda, std::vector<PetscReal> *F) const
+{
+  F->clear();
+  const PetscInt r = r_, d = dim;
+  if (wnMode_ == ContactMode::EIM || d <= 0) return;
+  const bool     exact = wnMode_ == ContactMode::Exact;
+  const PetscInt M     = exact ? (PetscInt)(Pact_.size() / std::max<PetscInt>(r, 1)) : (PetscInt)cPoint.size(), rp = PaddedRows(r);
+  if ((PetscInt)wn_.size() != M * d || (PetscInt)lambda.size() != r) return;
+  F->assign(d, 0.0);
+  for (PetscInt p = 0; p < M; ++p) {
+    PetscReal l = 0;
+    for (PetscInt i = 0; i < r; ++i) l += (exact ? Pact_[(size_t)i * M + p] : cPwT_[(size_t)p * rp + i]) * lambda[i];
+    for (PetscInt k = 0; k < d; ++k) (*F)[k] += l * wn_[(size_t)p * d + k];
+  }
+}
+
 PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol)
 {
   const PetscInt Na = (PetscInt)cols_.size(), r = r_;
@@ -620,6 +643,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   sol->dl.clear();
   sol->nactive.clear();
   sol->iterates.clear();
+  sol->force.clear();
   sol->v.assign(Na, 0.0);
   sol->lambda.assign(r, 0.0);
   if (r > Na) {
@@ -695,6 +719,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     if (done) {
       // the KKT residuals of the last QP only (the loop's QPs skip them: -log_view 1-2 % of a solve)
       qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
+      ResultantForce(lnew, &sol->force);
       sol->converged = true;
       break;
     }
