@@ -42,7 +42,9 @@ def workdir():
 
 def run(args, np_, cmd, expect_ok=True):
     full = (["mpirun", "-n", str(np_)] if np_ > 1 else []) + [args.exe] + cmd
-    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, stdin=subprocess.DEVNULL)
+    # errors="replace": PETSc 3.18's -help prints the default of -dm_plex_boundary_label from uninitialized
+    # memory ("<now 3\x0fh\xd7...>"), not always valid UTF-8
+    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", stdin=subprocess.DEVNULL)
     if expect_ok and p.returncode != 0:
         print(p.stdout[-3000:])
         sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(full)))
