@@ -3,7 +3,8 @@
 # empty directory the installed binary runs offline for a scene of the installed share/rbcontact (its mesh
 # found there: the -info line names the installed copy), and an outside program (the installed example
 # share/rbcontact/examples/online_loop.cpp) is built against the installed tree twice, with CMake's
-# find_package(rbcontact) and with pkg-config, and solves online from that ROM file.
+# find_package(rbcontact) and with pkg-config, and solves online from that ROM file; the installed Python
+# module (when built) solves 100 radii from it.
 # Usage: install_check.sh BUILD_DIR
 set -eu
 build=$(cd "$1" && pwd)
@@ -41,7 +42,8 @@ cmake -S "$t/app" -B "$t/app/build" -DCMAKE_PREFIX_PATH="$t/prefix" -DCMAKE_BUIL
 cmake --build "$t/app/build" > "$t/app/build.log" 2>&1 || { tail -30 "$t/app/build.log"; fail "build with find_package(rbcontact)"; }
 "$t/app/build/outside" -rom rom.h5 > cmake_app.log 2>&1 || { cat cmake_app.log; fail "the find_package program"; }
 [ "$(grep -c 'iterations' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: 11 solves expected"; }
-echo "ok: outside program with find_package(rbcontact): 11 online solves"
+[ "$(grep -c 'force [0-9]' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: the online contact force of each solve expected"; }
+echo "ok: outside program with find_package(rbcontact): 11 online solves with their contact force"
 
 # the same with pkg-config
 export PKG_CONFIG_PATH="$t/prefix/lib/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"
@@ -49,3 +51,25 @@ mpicxx -std=c++17 -O2 $(pkg-config --cflags rbcontact) "$share/examples/online_l
 "$t/pc_app" -rom rom.h5 > pc_app.log 2>&1 || { cat pc_app.log; fail "the pkg-config program"; }
 cmp -s <(grep iterations cmake_app.log | sed 's/time.*//') <(grep iterations pc_app.log | sed 's/time.*//') || fail "pkg-config and find_package programs differ"
 echo "ok: outside program with pkg-config: the same 11 solves"
+
+# the installed Python module (when the build has it): 100 radii from the same ROM file, the forces of the
+# C++ program at its 11 radii
+pydir="$t/prefix/lib/python3/dist-packages"
+if [ -d "$build/python/rbcontact" ]; then
+  [ -f "$pydir/rbcontact/__init__.py" ] && ls "$pydir/rbcontact"/_rbcontact*.so > /dev/null 2>&1 || fail "not installed: lib/python3/dist-packages/rbcontact"
+  grep -o 'force [0-9.e+-]*' cmake_app.log | awk '{print $2}' > cpp_forces.txt
+  PYTHONPATH="$pydir" /usr/bin/python3 - <<'PY' > py.log 2>&1 || { cat py.log; fail "the installed Python module"; }
+import numpy as np, rbcontact
+assert rbcontact.__file__.startswith(__import__("os").environ["PYTHONPATH"]), rbcontact.__file__
+m = rbcontact.ReducedModel("rom.h5")
+(name, lo, hi), = m.parameters
+f = m.contact_forces(np.linspace(lo, hi, 100))
+assert f.shape == (100,) and np.all(np.isfinite(f)) and np.all(f > 0), f
+# online_loop.cpp's 11 radii: min + k (max - min) / 10
+g = m.contact_forces(np.array([(1 - k / 10) * lo + (k / 10) * hi for k in range(11)]))
+cpp = np.loadtxt("cpp_forces.txt")
+assert np.allclose(g, cpp, rtol=1e-6, atol=0), (g, cpp)  # the C++ program prints 7 digits
+print("forces", f.min(), f.max())
+PY
+  echo "ok: the installed Python module: 100 contact forces, the C++ program's at its 11 radii"
+fi

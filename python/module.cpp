@@ -1,0 +1,191 @@
+// python/module.cpp: the Python module rbcontact._rbcontact (pybind11): the online stage of a ROM file
+// (rbc::ReducedModel) from Python, with NumPy arrays in and out. PETSc/SLEPc are initialized on the first
+// use (rbcontact.initialize(options) to pass PETSc options first) and finalized at exit; every PETSc error
+// becomes a Python RuntimeError carrying PETSc's message (the file, option or value it names).
+// The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
+#include "rbcontact/reduced_model.hpp"
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <slepcsys.h>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+
+namespace {
+
+std::string lastError; // the first message of the failing PETSc call (PETSC_ERROR_INITIAL)
+
+PetscErrorCode CaptureErrorHandler(MPI_Comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *)
+{
+  if (p == PETSC_ERROR_INITIAL) lastError = std::string(mess ? mess : "(no message)") + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
+  return n;
+}
+
+// Throws the captured PETSc message for a non-zero error code.
+void Check(PetscErrorCode ierr)
+{
+  if (!ierr) return;
+  std::string msg = lastError.empty() ? "PETSc error " + std::to_string((int)ierr) : lastError;
+  lastError.clear();
+  throw std::runtime_error(msg);
+}
+
+bool initializedHere = false, exiting = false;
+int  liveModels      = 0; // PETSc is finalized at exit once no ReducedModel (which may hold PETSc objects) is alive
+
+void Initialize(const std::vector<std::string> &options)
+{
+  if (PetscInitializeCalled) {
+    if (!options.empty()) throw std::runtime_error("rbcontact.initialize: PETSc is already initialized; pass the options before the first ReducedModel");
+    return;
+  }
+  std::vector<std::string> args = {"rbcontact-python"};
+  args.insert(args.end(), options.begin(), options.end());
+  std::vector<char *> argv;
+  for (auto &a : args) argv.push_back(a.data());
+  int    argc = (int)argv.size();
+  char **av   = argv.data();
+  if (SlepcInitialize(&argc, &av, NULL, NULL)) throw std::runtime_error("rbcontact: SlepcInitialize failed");
+  initializedHere = true;
+  if (PetscPushErrorHandler(CaptureErrorHandler, NULL)) throw std::runtime_error("rbcontact: PetscPushErrorHandler failed");
+}
+
+void Finalize()
+{
+  if (initializedHere && PetscInitializeCalled && !PetscFinalizeCalled) (void)SlepcFinalize();
+  initializedHere = false;
+}
+
+// At interpreter exit: finalize now, or when the last model goes.
+void AtExit()
+{
+  exiting = true;
+  if (liveModels == 0) Finalize();
+}
+
+// One reduced solution, as Python sees it.
+struct Solution {
+  py::array_t<double> v, lambda_hat, force;
+  bool                converged = false;
+  PetscInt            iterations = 0;
+  double              contactForce = std::numeric_limits<double>::quiet_NaN();
+  std::string         message;
+};
+
+py::array_t<double> Array(const std::vector<PetscReal> &x)
+{
+  py::array_t<double> a((py::ssize_t)x.size());
+  auto                m = a.mutable_unchecked<1>();
+  for (size_t i = 0; i < x.size(); ++i) m((py::ssize_t)i) = x[i];
+  return a;
+}
+
+class Model {
+public:
+  explicit Model(const std::string &file)
+  {
+    Initialize({});
+    ++liveModels;
+    try {
+      Check(model_.Open(file));
+      Check(model_.SetFromOptions());
+    } catch (...) {
+      --liveModels;
+      throw;
+    }
+  }
+  ~Model()
+  {
+    (void)model_.qp.Reset(); // its PETSc objects, while PETSc is up
+    if (--liveModels == 0 && exiting) Finalize();
+  }
+  Model(const Model &)            = delete;
+  Model &operator=(const Model &) = delete;
+
+  Solution Solve(const std::vector<double> &mu)
+  {
+    const std::vector<PetscReal> m(mu.begin(), mu.end());
+    Check(model_.par.CheckBox(PETSC_COMM_SELF, m)); // a clear error naming the parameter, its value and the box
+    rbc::ReducedSolution sol;
+    Check(model_.Solve(m, &sol));
+    Solution s;
+    s.v          = Array(sol.v);
+    s.lambda_hat = Array(sol.lambda);
+    s.force      = Array(sol.force);
+    s.converged  = sol.converged;
+    s.iterations = sol.iterations;
+    if (!sol.force.empty() && sol.converged) s.contactForce = sol.ForceMagnitude();
+    s.message = sol.message;
+    return s;
+  }
+
+  // The contact force at every row of mus (n x p): one NumPy array of n values. A solve that does not
+  // converge raises (its message names the parameter), unless nan_on_failure.
+  py::array_t<double> ContactForces(py::array_t<double, py::array::c_style | py::array::forcecast> mus, bool nanOnFailure)
+  {
+    const PetscInt np = (PetscInt)model_.par.params.size();
+    if (mus.ndim() == 1 && np == 1) mus = mus.reshape({mus.shape(0), (py::ssize_t)1});
+    if (mus.ndim() != 2 || mus.shape(1) != np) throw std::runtime_error("contact_forces: expected an array of shape (n, " + std::to_string(np) + ") (one row per parameter point)");
+    const py::ssize_t   n = mus.shape(0);
+    py::array_t<double> out(n);
+    auto                in = mus.unchecked<2>();
+    auto                o  = out.mutable_unchecked<1>();
+    std::vector<PetscReal> m(np);
+    rbc::ReducedSolution   sol;
+    for (py::ssize_t k = 0; k < n; ++k) {
+      for (PetscInt i = 0; i < np; ++i) m[i] = in(k, i);
+      Check(model_.par.CheckBox(PETSC_COMM_SELF, m));
+      Check(model_.Solve(m, &sol));
+      if (sol.force.empty() && sol.converged) throw std::runtime_error("contact_forces: this ROM's hyper-reduction (" + std::string(model_.HyperName()) + ") computes no online force; use the ECSW cubature (-rom_hyper ecsw)");
+      if (!sol.converged) {
+        if (!nanOnFailure) throw std::runtime_error("contact_forces: the reduced model did not converge at row " + std::to_string((long long)k) + ": " + sol.message);
+        o(k) = std::numeric_limits<double>::quiet_NaN();
+      } else o(k) = sol.ForceMagnitude();
+    }
+    return out;
+  }
+
+  py::list Parameters() const
+  {
+    py::list l;
+    for (const auto &p : model_.par.params) l.append(py::make_tuple(p.name, (double)p.min, (double)p.max));
+    return l;
+  }
+
+  rbc::ReducedModel model_;
+};
+
+} // namespace
+
+PYBIND11_MODULE(_rbcontact, m)
+{
+  m.doc() = "rbcontact: the online stage of a reduced contact model (ROM file from `rbcontact offline`)";
+  m.def("initialize", &Initialize, py::arg("options") = std::vector<std::string>{},
+        "Initialize PETSc/SLEPc with these command-line options (e.g. ['-rom_kacanov_monitor']); optional, "
+        "done with no options by the first ReducedModel");
+  m.def("finalize", [] { if (liveModels == 0) Finalize(); else throw std::runtime_error("rbcontact.finalize: delete the ReducedModel objects first"); }, "Finalize PETSc/SLEPc (done at exit)");
+  py::class_<Solution>(m, "Solution", "One reduced solution")
+    .def_readonly("v", &Solution::v, "reduced displacement coordinates (N)")
+    .def_readonly("lambda_hat", &Solution::lambda_hat, "reduced multiplier coordinates (R)")
+    .def_readonly("force", &Solution::force, "resultant contact force vector (dim; empty with the EIM)")
+    .def_readonly("contact_force", &Solution::contactForce, "its norm (the FOM report's contact_force; nan with the EIM)")
+    .def_readonly("converged", &Solution::converged)
+    .def_readonly("iterations", &Solution::iterations, "reduced Kacanov iterations")
+    .def_readonly("message", &Solution::message, "why the solve failed (empty on success)")
+    .def("__repr__", [](const Solution &s) { return "<rbcontact.Solution converged=" + std::string(s.converged ? "True" : "False") + " iterations=" + std::to_string((long long)s.iterations) + " contact_force=" + std::to_string(s.contactForce) + ">"; });
+  py::class_<Model>(m, "ReducedModel", "A ROM file opened for online solves (rbc::ReducedModel)")
+    .def(py::init<const std::string &>(), py::arg("file"))
+    .def("solve", &Model::Solve, py::arg("mu"), "The reduced solution at mu (a sequence of parameter values)")
+    .def("contact_forces", &Model::ContactForces, py::arg("mus"), py::arg("nan_on_failure") = false,
+         "The contact force at every row of mus (shape (n, number of parameters), or (n,) with one parameter)")
+    .def_property_readonly("parameters", &Model::Parameters, "[(name, min, max)] of the parameter box")
+    .def_property_readonly("N", [](const Model &x) { return x.model_.N(); })
+    .def_property_readonly("R", [](const Model &x) { return x.model_.R(); })
+    .def_property_readonly("hyper", [](const Model &x) { return std::string(x.model_.HyperName()); })
+    .def_property_readonly("file", [](const Model &x) { return x.model_.file; });
+  py::module_::import("atexit").attr("register")(py::cpp_function([]() { AtExit(); }));
+}

@@ -1,0 +1,101 @@
+#!/usr/bin/python3
+"""Checks of the Python module (python/module.cpp), run by ctest (tests/python.cmake):
+  - a ROM of ring_on_block (offline on 2 ranks) opened from Python: its parameter box, N, R, hyper;
+  - 100 radii through ReducedModel.contact_forces: every force equals the `rbcontact online` report's
+    outputs.contact_force at 5 of them (the same code: relative difference <= 1e-12), and the FOM's at one
+    radius to 1e-3 (an independent reference);
+  - solve(): converged, reduced coordinates of the report's sizes, force vector whose norm is contact_force;
+  - bad input raises RuntimeError naming the cause: a missing ROM file (its path), a radius outside the box
+    (the parameter), an array of the wrong shape; nan_on_failure keeps going past no failure here.
+Usage: python_checks.py --exe build/bin/rbcontact --pythonpath build/python
+"""
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+failures = 0
+
+
+def check(cond, msg):
+    global failures
+    print("  %-4s %s" % ("ok" if cond else "FAIL", msg), flush=True)
+    if not cond:
+        failures += 1
+
+
+def run(exe, np_, args):
+    cmd = (["mpiexec", "-n", str(np_)] if np_ > 1 else []) + [exe] + args
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        sys.stdout.write(p.stdout[-3000:])
+        sys.exit("python_checks.py: error: command failed (exit %d): %s" % (p.returncode, " ".join(cmd)))
+    return p.stdout
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--pythonpath", required=True)
+    args = ap.parse_args()
+    sys.path.insert(0, args.pythonpath)
+    import numpy as np
+    import rbcontact
+
+    d = tempfile.mkdtemp(prefix="rbc_python_")
+    try:
+        rom = os.path.join(d, "rom.h5")
+        run(args.exe, 2, ["offline", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-report", d + "/off.json"])
+        m = rbcontact.ReducedModel(rom)
+        (name, lo, hi), = m.parameters
+        check(name == "radius" and abs(lo - 0.95) < 1e-14 and abs(hi - 1.15) < 1e-14, "parameter box from the file: %s in [%g, %g]" % (name, lo, hi))
+        off = json.load(open(d + "/off.json"))
+        check(m.N == off["rom"]["N"] and m.R == off["rom"]["R"] and m.hyper == "ecsw", "sizes N %d R %d and hyper-reduction %s as the offline report" % (m.N, m.R, m.hyper))
+
+        radii = np.linspace(lo, hi, 100)
+        forces = m.contact_forces(radii)
+        check(forces.shape == (100,) and np.all(np.isfinite(forces)) and np.all(forces > 0), "contact_forces: 100 finite positive forces (%.4f .. %.4f)" % (forces.min(), forces.max()))
+        worst = 0.0
+        for k in (0, 17, 50, 83, 99):
+            rep = d + "/on%d.json" % k
+            run(args.exe, 1, ["online", "-rom", rom, "-mu", repr(float(radii[k])), "-report", rep])
+            f = json.load(open(rep))["outputs"]["contact_force"]
+            worst = max(worst, abs(forces[k] - f) / f)
+        check(worst <= 1e-12, "the same forces as `rbcontact online` at 5 radii (max rel diff %.1e <= 1e-12)" % worst)
+        r = 1.02
+        run(args.exe, 1, ["fom", "-options_file", "runs/ring_on_block.opts", "-mu", str(r), "-report", d + "/fom.json"])
+        ff = json.load(open(d + "/fom.json"))["contact_force"]
+        s = m.solve([r])
+        check(s.converged and s.iterations >= 1 and s.v.shape == (m.N,) and s.lambda_hat.shape == (m.R,) and s.message == "", "solve([%g]): converged in %d iterations, v (%d), lambda_hat (%d)" % (r, s.iterations, m.N, m.R))
+        check(s.force.shape == (2,) and abs(np.linalg.norm(s.force) - s.contact_force) <= 1e-14 * s.contact_force, "force vector %s, its norm = contact_force" % s.force)
+        check(abs(s.contact_force - ff) <= 1e-3 * ff, "contact force %.8f vs the FOM's %.8f (rel %.1e <= 1e-3)" % (s.contact_force, ff, abs(s.contact_force - ff) / ff))
+        check(np.array_equal(m.contact_forces(np.array([[r]])), np.array([s.contact_force])), "contact_forces on an (n, 1) array = solve")
+
+        def raises(f, words, what):
+            try:
+                f()
+            except RuntimeError as e:
+                msg = str(e)
+                check(all(w in msg for w in words), "%s: RuntimeError naming %s (%s)" % (what, ", ".join(words), msg.splitlines()[0][:150]))
+                return
+            check(False, "%s: no exception" % what)
+
+        missing = os.path.join(d, "nonexistent.h5")
+        raises(lambda: rbcontact.ReducedModel(missing), [missing], "a missing ROM file")
+        raises(lambda: m.solve([1.3]), ["radius", "1.3"], "a radius outside the box")
+        raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["radius"], "a radius outside the box in contact_forces")
+        raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
+        raises(lambda: rbcontact.initialize(["-rom_kacanov_monitor"]), ["already initialized"], "options after the first model")
+        check(np.allclose(m.contact_forces(radii[:3], nan_on_failure=True), forces[:3], rtol=0, atol=0), "nan_on_failure: the same forces where every solve converges")
+        del m
+    finally:
+        shutil.rmtree(d, ignore_errors=True)
+    print("%d passed, %d failed" % (0 if failures else 1, 1 if failures else 0))
+    sys.exit(1 if failures else 0)
+
+
+if __name__ == "__main__":
+    main()
