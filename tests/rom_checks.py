@@ -223,6 +223,7 @@ def bad_input(args):
     check(lin["converged"] and lin["kacanov_iterations"] == 1, "-rom_kacanov_max_it 1: the linearized reduced model (1 iterate, converged)")
     expect_error(args, ["-rom", rom, "-rom_kacanov_relaxation", "1.5"], ["-rom_kacanov_relaxation", "1.5"], "-rom_kacanov_relaxation out of range")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
+    expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")
     expect_error(args, ["-rom", rom, "-rom_kacanov_anderson", "11"], ["-rom_kacanov_anderson", "11"], "-rom_kacanov_anderson out of range")
     expect_error(args, ["-rom", rom, "-rom_warm_start_degree", "3"], ["-rom_warm_start_degree", "3"], "-rom_warm_start_degree out of range")
     # Anderson mixing (default depth 3) and the plain fixed point reach the same reduced solution

@@ -134,6 +134,18 @@ def help_(args):
                 "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "fom -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "the shipped scene: no rbcontact warning (deprecated or unused option)")
+    # the online and validate stages list their own options and the reduced model's (a small ROM to open)
+    d = workdir()
+    rom = os.path.join(d, "rom.h5")
+    run(args, 1, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", rom])
+    p = run(args, 1, ["online", "-rom", rom, "-help"])
+    for opt in ("-rom", "-mu", "-report", "-online_repeat", "-rom_reconstruct", "-rom_hyper", "-rom_N", "-rom_R", "-rom_kkt_tol", "-rom_warm_start",
+                "-rom_ecsw_sum", "-rom_kacanov_rtol_primal", "-rom_qp_type"):
+        check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "online -help lists %s" % opt)
+    p = run(args, 1, ["validate", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "1", "-validate_repeat", "1", "-help"])
+    for opt in ("-rom", "-report", "-validate_repeat", "-validate_sweep", "-validate_sweep_fractions", "-validate_sweep_output", "-test_type", "-test_size",
+                "-rom_hyper"):
+        check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "validate -help lists %s" % opt)
 
 
 def rename(args):

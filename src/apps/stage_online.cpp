@@ -8,6 +8,7 @@
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace rbc {
@@ -22,14 +23,28 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   ReducedModel   model;
   ReducedSolution sol;
 
+  PetscInt       nmu = 16;
+  PetscReal      muIn[16] = {0}; // -help prints muIn[0] of an unset -mu
+  PetscBool      muSet = PETSC_FALSE;
+
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, &set));
+  // the stage's own options in one block: -help lists them (the reduced model's follow, prefix rom_)
+  PetscOptionsBegin(comm, NULL, "rbcontact online: one reduced solve from a ROM file", "rbcontact");
+  PetscCall(PetscOptionsString("-rom", "the ROM file (written by rbcontact offline)", "", romPath, romPath, sizeof romPath, &set));
+  PetscCall(PetscOptionsRealArray("-mu", "the parameter values (default: the scene's defaults stored in the file)", "", muIn, &nmu, &muSet));
+  PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsString("-rom_reconstruct", "write the full fields of the reduced solution to this HDF5 file (+ .xmf; needs the scene options and the basis file)", "", recPath, recPath, sizeof recPath, NULL));
+  PetscCall(PetscOptionsInt("-online_repeat", "solve this many times and report the median time", "", repeat, &repeat, NULL));
+  PetscOptionsEnd();
   PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "online: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_reconstruct", recPath, sizeof recPath, NULL));
+  {
+    PetscBool hasMu = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-mu", &hasMu));
+    PetscCheck(!hasMu || (muSet && nmu > 0), comm, PETSC_ERR_USER_INPUT, "option -mu is given without a value (the scene's defaults are used only without -mu)");
+    for (PetscInt i = 0; muSet && i < nmu; ++i) PetscCheck(std::isfinite(muIn[i]), comm, PETSC_ERR_USER_INPUT, "option -mu: value %" PetscInt_FMT " is not a finite number", i + 1);
+  }
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, recPath, "-rom_reconstruct"));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-online_repeat", &repeat, NULL));
   PetscCheck(repeat >= 1 && repeat <= 10000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-online_repeat %" PetscInt_FMT " out of range [1, 1e7]", repeat);
   PetscCall(PetscTime(&t0));
   PetscCall(model.Open(romPath));
@@ -39,12 +54,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   // mu: -mu values, default the parameters' defaults
   std::vector<PetscReal> mu;
   for (const auto &p : model.par.params) mu.push_back(p.def);
-  {
-    PetscInt  n = (PetscInt)mu.size() + 8;
-    std::vector<PetscReal> buf(n);
-    PetscCall(PetscOptionsGetRealArray(NULL, NULL, "-mu", buf.data(), &n, &set));
-    if (set) mu.assign(buf.begin(), buf.begin() + n);
-  }
+  if (muSet) mu.assign(muIn, muIn + nmu); // CheckBox names a wrong count or value
   PetscCall(model.par.CheckBox(comm, mu));
   // one warm-up solve, then the timed ones (the online time: operators + EIM + Kacanov + QP, no I/O)
   PetscCall(model.Solve(mu, &sol));

@@ -139,25 +139,30 @@ PetscErrorCode StageValidate(MPI_Comm comm)
     PetscCall(PetscLogEventRegister("RBCValidateFOM", DM_CLASSID, &VAL_FOM));
     PetscCall(PetscLogEventRegister("RBCValidateROM", DM_CLASSID, &VAL_ROM));
   }
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, &set));
-  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-validate_repeat", &repeat, NULL));
-  PetscCheck(repeat >= 1 && repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", repeat);
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-validate_sweep", &sweep, NULL));
   std::vector<PetscReal> fractions = {0.2, 0.4, 0.6, 0.8, 1.0};
   {
-    PetscInt               n = 32;
-    std::vector<PetscReal> buf(n);
-    PetscCall(PetscOptionsGetRealArray(NULL, NULL, "-validate_sweep_fractions", buf.data(), &n, &set));
-    if (set) fractions.assign(buf.begin(), buf.begin() + n);
+    PetscInt  nf = 32;
+    PetscReal fbuf[32];
+    PetscBool fset = PETSC_FALSE;
+    // the stage's own options in one block: -help lists them (the test set's, prefix test_, and the
+    // reduced model's, prefix rom_, follow)
+    PetscOptionsBegin(comm, NULL, "rbcontact validate: the ROM against the FOM on a test set", "rbcontact");
+    PetscCall(PetscOptionsString("-rom", "the ROM file (written by rbcontact offline)", "", romPath, romPath, sizeof romPath, &set));
+    PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
+    PetscCall(PetscOptionsInt("-validate_repeat", "online solves per test parameter (the median is reported)", "", repeat, &repeat, NULL));
+    PetscCall(PetscOptionsBool("-validate_sweep", "also the speed-against-error sweep over truncated sizes", "", sweep, &sweep, NULL));
+    PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
+    {
+      std::string stem = reportPath[0] ? reportPath : "validate.json";
+      if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
+      PetscCall(PetscStrncpy(sweepOut, (stem + "_sweep").c_str(), sizeof sweepOut));
+    }
+    PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
+    PetscOptionsEnd();
+    PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+    PetscCheck(repeat >= 1 && repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", repeat);
+    if (fset) fractions.assign(fbuf, fbuf + nf);
     for (PetscReal f : fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
-  }
-  {
-    std::string stem = reportPath[0] ? reportPath : "validate.json";
-    if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
-    PetscCall(PetscStrncpy(sweepOut, (stem + "_sweep").c_str(), sizeof sweepOut));
-    PetscCall(PetscOptionsGetString(NULL, NULL, "-validate_sweep_output", sweepOut, sizeof sweepOut, NULL));
   }
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   if (sweep) PetscCall(CheckOutputPath(comm, std::string(sweepOut) + ".json", "-validate_sweep_output"));

@@ -334,45 +334,42 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
 
 PetscErrorCode ReducedModel::SetFromOptions()
 {
-  PetscInt n = -1, r = -1, mk = -1, mg = -1;
+  PetscInt  n = -1, r = -1, mk = -1, mg = -1, k = (PetscInt)ecswSum;
+  char      hyper[64] = "";
+  PetscBool hyperSet = PETSC_FALSE, sumSet = PETSC_FALSE;
+  const char *sums[] = {"auto", "points", "dofs"};
 
   PetscFunctionBeginUser;
   PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rom_kkt_tol", &kktTol, NULL));
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-rom_warm_start", &warmStart, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_warm_start_degree", &warmDegree, NULL));
+  // one block, so that -help lists the reduced model's options with their values (prefix rom_)
+  PetscOptionsBegin(PETSC_COMM_SELF, "rom_", "Reduced model (online solve)", "ReducedModel");
+  PetscCall(PetscOptionsReal("-kkt_tol", "largest scaled KKT residual of the last reduced QP accepted", "", kktTol, &kktTol, NULL));
+  PetscCall(PetscOptionsBool("-warm_start", "start from a fit of the stored training solutions", "", warmStart, &warmStart, NULL));
+  PetscCall(PetscOptionsInt("-warm_start_degree", "degree of that fit with several parameters: 1 (affine) or 2 (quadratic)", "", warmDegree, &warmDegree, NULL));
+  // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
+  if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
+  PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
+  PetscCall(PetscOptionsInt("-N", "POD modes used (default: all in the file)", "", n, &n, NULL));
+  PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: all)", "", r, &r, NULL));
+  PetscCall(PetscOptionsInt("-Mk", "EIM terms of kappa used (default: the offline selection)", "", mk, &mk, NULL));
+  PetscCall(PetscOptionsInt("-Mg", "EIM terms of the gap used (default: the offline selection)", "", mg, &mg, NULL));
+  PetscOptionsEnd();
   PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
-  {
-    char      hyper[64] = "";
-    PetscBool set       = PETSC_FALSE;
-    // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
-    if (!file.empty()) PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_hyper", hyper, sizeof hyper, &set));
-    if (set) {
-      std::string h(hyper);
-      h = h.substr(0, h.find(',')); // a list (the offline stage's form): its first entry
-      if (h == "ecsw") {
-        PetscCheck(HasCubature(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper ecsw: the ROM file %s holds no empirical cubature (build it with offline -rom_hyper ecsw)", file.c_str());
-        SetContactMode(ContactMode::Cubature);
-      } else if (h == "eim") {
-        PetscCheck(HasEIM(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper eim: the ROM file %s holds no EIM (build it with offline -rom_hyper eim or ecsw,eim)", file.c_str());
-        SetContactMode(ContactMode::EIM);
-      } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
-    }
+  if (hyperSet) {
+    std::string h(hyper);
+    h = h.substr(0, h.find(',')); // a list (the offline stage's form): its first entry
+    if (h == "ecsw") {
+      PetscCheck(HasCubature(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper ecsw: the ROM file %s holds no empirical cubature (build it with offline -rom_hyper ecsw)", file.c_str());
+      SetContactMode(ContactMode::Cubature);
+    } else if (h == "eim") {
+      PetscCheck(HasEIM(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "-rom_hyper eim: the ROM file %s holds no EIM (build it with offline -rom_hyper eim or ecsw,eim)", file.c_str());
+      SetContactMode(ContactMode::EIM);
+    } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
   }
-  {
-    const char *sums[] = {"auto", "points", "dofs"};
-    PetscInt    k      = (PetscInt)ecswSum;
-    PetscBool   set    = PETSC_FALSE;
-    PetscCall(PetscOptionsGetEList(NULL, NULL, "-rom_ecsw_sum", sums, 3, &k, &set));
-    if (set) ecswSum = (EcswSum)k;
-  }
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_N", &n, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_R", &r, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mk", &mk, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rom_Mg", &mg, NULL));
+  if (sumSet) ecswSum = (EcswSum)k;
   PetscCall(Truncate(n, r, mk, mg));
   PetscFunctionReturn(0);
 }
