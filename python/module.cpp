@@ -43,11 +43,15 @@ void Initialize(const std::vector<std::string> &options)
     if (!options.empty()) throw std::runtime_error("rbcontact.initialize: PETSc is already initialized; pass the options before the first ReducedModel");
     return;
   }
-  std::vector<std::string> args = {"rbcontact-python"};
+  // MPI and PETSc keep argv: it lives as long as the process, and ends with a null pointer (MPI_Init reads it)
+  static std::vector<std::string> args;
+  static std::vector<char *>      argv;
+  args = {"rbcontact-python"};
   args.insert(args.end(), options.begin(), options.end());
-  std::vector<char *> argv;
+  argv.clear();
   for (auto &a : args) argv.push_back(a.data());
-  int    argc = (int)argv.size();
+  argv.push_back(nullptr);
+  int    argc = (int)args.size();
   char **av   = argv.data();
   if (SlepcInitialize(&argc, &av, NULL, NULL)) throw std::runtime_error("rbcontact: SlepcInitialize failed");
   initializedHere = true;

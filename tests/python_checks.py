@@ -89,6 +89,13 @@ def main():
         raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["radius"], "a radius outside the box in contact_forces")
         raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
         raises(lambda: rbcontact.initialize(["-rom_kacanov_monitor"]), ["already initialized"], "options after the first model")
+        # options before the first model, in a fresh interpreter: they reach the reduced model
+        code = ("import rbcontact; rbcontact.initialize(['-rom_kacanov_monitor', '-rom_R', '2']); m = rbcontact.ReducedModel(%r); "
+                "s = m.solve([1.02]); print('R', m.R, 'lambda_hat', len(s.lambda_hat), 'converged', s.converged)" % rom)
+        p = subprocess.run([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                           env=dict(os.environ, PYTHONPATH=args.pythonpath))
+        check(p.returncode == 0 and "R 2 lambda_hat 2 converged True" in p.stdout and "ROM Kacanov" in p.stdout,
+              "initialize(options) before the first model: -rom_R 2 and the Kacanov monitor take effect (exit %d)" % p.returncode)
         check(np.allclose(m.contact_forces(radii[:3], nan_on_failure=True), forces[:3], rtol=0, atol=0), "nan_on_failure: the same forces where every solve converges")
         del m
     finally:
