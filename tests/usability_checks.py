@@ -134,10 +134,17 @@ def help_(args):
                 "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "fom -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "the shipped scene: no rbcontact warning (deprecated or unused option)")
-    # the online and validate stages list their own options and the reduced model's (a small ROM to open)
+    # the offline, online and validate stages list their own options and the reduced model's (the offline
+    # run writes the small ROM the others open)
     d = workdir()
     rom = os.path.join(d, "rom.h5")
-    run(args, 1, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", rom])
+    p = run(args, 1, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", rom, "-help"])
+    for opt in ("-rom", "-rom_basis", "-snapshots", "-snapshots_restart", "-snapshots_monitor", "-snapshots_subcomm", "-offline_stop", "-train_type",
+                "-train_size", "-report", "-pod_inner", "-pod_tol", "-pod_supremizers", "-pod_supremizers_infsup", "-dual_type", "-dual_tol",
+                "-dual_mass_weighted", "-rom_hyper", "-ecsw_tol", "-ecsw_fit", "-ecsw_fit_force", "-eim_quadrature_subdivisions", "-eim_patch_rings",
+                "-eim_select", "-eim_select_slack", "-eim_kappa_tol", "-rom_kacanov_max_it"):
+        check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "offline -help lists %s" % opt)
+    check("rbcontact: warning" not in p.stdout, "offline with the shipped scene: no rbcontact warning (unused option)")
     p = run(args, 1, ["online", "-rom", rom, "-help"])
     for opt in ("-rom", "-mu", "-report", "-online_repeat", "-rom_reconstruct", "-rom_hyper", "-rom_N", "-rom_R", "-rom_kkt_tol", "-rom_warm_start",
                 "-rom_ecsw_sum", "-rom_kacanov_rtol_primal", "-rom_qp_type"):

@@ -76,7 +76,9 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscCheck(m > 0, world, PETSC_ERR_ARG_SIZ, "offline: no snapshot to build the bases from");
   // --- primal: POD in the chosen inner product of the reference configuration
   PetscCall(PetscTime(&t0));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-pod_inner", inner, sizeof inner, NULL));
+  PetscOptionsBegin(world, "pod_", "Primal basis (offline)", "OfflineBases");
+  PetscCall(PetscOptionsString("-inner", "inner product of the POD: energy, h1 or l2", "", inner, inner, sizeof inner, NULL));
+  PetscOptionsEnd();
   b->inner = inner;
   Mat M = nullptr;
   if (!strcmp(inner, "energy")) {
@@ -120,7 +122,9 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     // weighted norm of the reported lambda error, ||x||_M^2 = sum_i int psi_i x_i^2 (reference
     // configuration): rows scaled by sqrt(int psi_i), the basis unscaled after (nonnegativity kept).
     PetscBool massWeighted = PETSC_FALSE;
-    PetscCall(PetscOptionsGetBool(NULL, NULL, "-dual_mass_weighted", &massWeighted, NULL));
+    PetscOptionsBegin(world, "dual_", "Dual basis (offline)", "OfflineBases");
+    PetscCall(PetscOptionsBool("-mass_weighted", "the dual greedy in the slave-mass weighted norm of the reported lambda error", "", massWeighted, &massWeighted, NULL));
+    PetscOptionsEnd();
     PetscCheck(!massWeighted || cmap, world, PETSC_ERR_ARG_INCOMP, "-dual_mass_weighted needs the scene's contact surfaces (-contact_slave, -contact_master)");
     std::vector<PetscReal> sw(R, 1.0);
     if (massWeighted) {
@@ -153,7 +157,10 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   SupremizerEnrichment &enr = b->enr;
   nsup                      = 0;
   enr                       = SupremizerEnrichment();
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-pod_supremizers", &supremizers, NULL));
+  // (a title of its own: PETSc prints the help of a (prefix, title) block once)
+  PetscOptionsBegin(world, "pod_", "Supremizer enrichment (offline)", "OfflineBases");
+  PetscCall(PetscOptionsBool("-supremizers", "enrich the POD with supremizers of the dual vectors (inf-sup of the reduced saddle point)", "", supremizers, &supremizers, NULL));
+  PetscOptionsEnd();
   PetscCall(SupremizerRatioFromOptions(world, &supRatio));
   if (supremizers && R > 0) {
     const PetscInt   r = dual.W.cols;

@@ -60,7 +60,9 @@ PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h)
   CubatureOptions co;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_hyper", buf, sizeof buf, NULL));
+  PetscOptionsBegin(comm, NULL, "Hyper-reduction of the contact terms (offline)", "HyperChoiceFromOptions");
+  PetscCall(PetscOptionsString("-rom_hyper", "methods to build: ecsw, eim, ecsw,eim or eim,ecsw (the first is the online default)", "", buf, buf, sizeof buf, NULL));
+  PetscOptionsEnd();
   const std::string s(buf);
   if (s == "ecsw") *h = {false, true, true};
   else if (s == "eim") *h = {true, false, false};
@@ -125,7 +127,9 @@ PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMa
   // --- the full contact patch on the support of the dual basis (Dirichlet values at the default mu)
   PetscInt &nsub = *nsubOut;
   nsub           = 4;
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &nsub, NULL));
+  PetscOptionsBegin(world, "eim_", "Contact quadrature of the hyper-reduction (offline)", "BuildExactReducedModel");
+  PetscCall(PetscOptionsInt("-quadrature_subdivisions", "pieces per slave facet of the candidate points (each with the contact Gauss rule)", "", nsub, &nsub, NULL));
+  PetscOptionsEnd();
   PetscCheck(nsub >= 1 && nsub <= 64, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
   std::vector<double> Wt((size_t)R * Rfom);
   for (PetscInt k = 0; k < R; ++k)
@@ -309,7 +313,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   }
   // --- the local data: slave facets of the points, master facets they projected onto (+ 2 rings)
   PetscInt rings = 2;
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_patch_rings", &rings, NULL));
+  PetscOptionsBegin(world, "eim_", "Local contact data (offline)", "OfflineReducedModel");
+  PetscCall(PetscOptionsInt("-patch_rings", "rings of master facets around those the points projected onto, kept online", "", rings, &rings, NULL));
+  PetscOptionsEnd();
   PetscCheck(rings >= 0 && rings <= 20, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", rings);
   std::vector<std::vector<PetscInt>> hitv(Q);
   for (PetscInt p = 0; p < Q; ++p) hitv[p].assign(hits[p].begin(), hits[p].end());
@@ -320,8 +326,11 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscReal    slack  = 0.1;
   EIMSelection esel;
   std::vector<std::vector<PetscReal>> held;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select", &select, NULL));
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+  PetscOptionsBegin(world, "eim_", "EIM sizes (offline)", "OfflineReducedModel");
+  PetscCall(PetscOptionsBool("-select", "choose the EIM sizes on held-out parameters", "", select, &select, NULL));
+  PetscCall(PetscOptionsReal("-select_slack", "the smallest sizes within this relative slack of the best held-out error", "", slack, &slack, NULL));
+  PetscCall(PetscOptionsBool("-select_keep_all", "keep every EIM term in the file (not only those in use)", "", keepAll, &keepAll, NULL));
+  PetscOptionsEnd();
   if (!eimKappa && !eimGap) select = PETSC_FALSE; // no EIM term to size
   if (select) {
     PetscBool heldSet = PETSC_FALSE;
@@ -338,7 +347,6 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     rm.warmStart      = PETSC_TRUE;
     rm.recordIterates = false;
     PetscCall(SelectEIMSizes(world, rm, held, slack, &esel));
-    PetscCall(PetscOptionsGetBool(NULL, NULL, "-eim_select_keep_all", &keepAll, NULL));
     if (!keepAll) { // keep only the terms in use, and the local data of their points
       std::vector<PetscInt> keep2, kP, gP;
       auto                  at = [&](PetscInt p) { return Intern(&keep2, p); };

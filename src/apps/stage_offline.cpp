@@ -65,32 +65,39 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscCall(PetscTime(&t0));
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   PetscCallMPI(MPI_Comm_size(world, &wsize));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, NULL));
+  char romPath[PETSC_MAX_PATH_LEN] = "", basisPath[PETSC_MAX_PATH_LEN] = "", trainType[64] = "grid";
+  // the stage's own options in one block: -help lists them with their defaults (the companion files'
+  // defaults follow -rom)
+  PetscOptionsBegin(world, NULL, "rbcontact offline: snapshots, bases and the reduced model", "rbcontact");
+  PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsString("-offline_stop", "last step: snapshots, bases or rom (every step)", "", stop, stop, sizeof stop, NULL));
+  PetscCall(PetscOptionsString("-rom", "the ROM file to write (with the bases and rom steps)", "", romPath, romPath, sizeof romPath, NULL));
+  {
+    // companion files of the ROM: <stem>.snapshots.h5 and <stem>.basis.h5 unless given
+    std::string stem = romPath;
+    if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
+    if (!strcmp(stop, "rom")) {
+      PetscCall(PetscStrncpy(snapPath, (stem + ".snapshots.h5").c_str(), sizeof snapPath));
+      PetscCall(PetscStrncpy(basisPath, (stem + ".basis.h5").c_str(), sizeof basisPath));
+    }
+  }
+  PetscCall(PetscOptionsString("-rom_basis", "the basis file (default: the ROM's stem + .basis.h5)", "", basisPath, basisPath, sizeof basisPath, NULL));
+  PetscCall(PetscOptionsString("-snapshots", "the snapshot file, checkpointed and resumable (default: the ROM's stem + .snapshots.h5)", "", snapPath, snapPath, sizeof snapPath, &set));
+  // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
+  restart = strcmp(stop, "snapshots") ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-snapshots_restart", "resume from an existing snapshot file of this problem", "", restart, &restart, NULL));
+  PetscCall(PetscOptionsBool("-snapshots_monitor", "print one line per solved snapshot", "", monitor, &monitor, NULL));
+  PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
+  PetscOptionsEnd();
   PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), world, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
   const PetscBool full  = strcmp(stop, "rom") ? PETSC_FALSE : PETSC_TRUE;
   const PetscBool bases = (PetscBool)(full || !strcmp(stop, "bases"));
-  char            romPath[PETSC_MAX_PATH_LEN] = "", basisPath[PETSC_MAX_PATH_LEN] = "";
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
   PetscCheck(!bases || romPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
-  // companion files of the ROM: <stem>.snapshots.h5 and <stem>.basis.h5 unless given
-  std::string stem = romPath;
-  if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
-  if (full) {
-    PetscCall(PetscStrncpy(snapPath, (stem + ".snapshots.h5").c_str(), sizeof snapPath));
-    PetscCall(PetscStrncpy(basisPath, (stem + ".basis.h5").c_str(), sizeof basisPath));
-    PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", basisPath, sizeof basisPath, NULL));
-  }
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", snapPath, sizeof snapPath, &set));
   PetscCheck(snapPath[0], world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
   PetscCall(CheckOutputPath(world, reportPath, "-report"));
   if (bases) PetscCall(CheckOutputPath(world, romPath, "-rom"));
   PetscCall(CheckOutputPath(world, snapPath, "-snapshots"));
   if (full) PetscCall(CheckOutputPath(world, basisPath, "-rom_basis"));
-  // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
-  restart = bases;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_restart", &restart, NULL));
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_monitor", &monitor, NULL));
   PetscCall(SceneSpecFromOptions(world, &scene));
   PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
   // -train_type greedy (docs/greedy_training.md): the snapshot file's training set is the pool (initial
@@ -98,8 +105,6 @@ PetscErrorCode StageOffline(MPI_Comm world)
   ParameterSet  train;
   GreedyOptions gopt;
   PetscInt      ninitial = 0;
-  char          trainType[64] = "grid";
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-train_type", trainType, sizeof trainType, NULL));
   const bool greedy = !strcmp(trainType, "greedy");
   if (greedy) {
     PetscCheck(scene.contact, world, PETSC_ERR_SUP, "-train_type greedy: the indicator is that of a contact scene (-contact_slave, -contact_master)");
@@ -135,7 +140,9 @@ PetscErrorCode StageOffline(MPI_Comm world)
   PetscInt           nnodes   = 0;
   PetscCall(MeshFacts(world, scene, &checksum, &nnodes));
   PetscInt k = (nnodes * 3 < 200000) ? wsize : 1;
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-snapshots_subcomm", &k, NULL));
+  PetscOptionsBegin(world, NULL, "rbcontact offline: groups of ranks", "rbcontact");
+  PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (default: one per rank below 200k dofs, else 1)", "", k, &k, NULL));
+  PetscOptionsEnd();
   PetscCheck(k >= 1 && k <= wsize, world, PETSC_ERR_ARG_OUTOFRANGE, "-snapshots_subcomm %" PetscInt_FMT " must lie in [1, %d] (the number of ranks)", k, (int)wsize);
   PetscSubcomm psub;
   PetscCall(PetscSubcommCreate(world, &psub));

@@ -35,7 +35,9 @@ PetscErrorCode SupremizerRatioFromOptions(MPI_Comm comm, PetscReal *ratio)
 {
   PetscFunctionBeginUser;
   *ratio = 1;
-  PetscCall(PetscOptionsGetReal(NULL, NULL, "-pod_supremizers_infsup", ratio, NULL));
+  PetscOptionsBegin(comm, "pod_", "Supremizers", "SupremizerRatioFromOptions");
+  PetscCall(PetscOptionsReal("-supremizers_infsup", "fraction of the full enrichment's reduced inf-sup constant to keep (1: every direction)", "", *ratio, ratio, NULL));
+  PetscOptionsEnd();
   PetscCheck(*ratio > 0 && *ratio <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-pod_supremizers_infsup %g out of range (0, 1]: the fraction of the full supremizer enrichment's inf-sup constant to keep (1: every supremizer direction)", (double)*ratio);
   PetscFunctionReturn(0);
 }
