@@ -1,9 +1,12 @@
 // python/module.cpp: the Python module rbcontact._rbcontact (pybind11): the online stage of a ROM file
-// (rbc::ReducedModel) from Python, with NumPy arrays in and out. PETSc/SLEPc are initialized on the first
+// (rbc::ReducedModel) from Python, with NumPy arrays in and out, and the offline and validate stages of
+// the library (RunOffline, RunValidation) with their options scoped to the call. PETSc/SLEPc are initialized on the first
 // use (rbcontact.initialize(options) to pass PETSc options first) and finalized at exit; every PETSc error
 // becomes a Python RuntimeError carrying PETSc's message (the file, option or value it names).
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
+#include "rbcontact/offline.hpp"
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/validation.hpp"
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -163,6 +166,70 @@ public:
   rbc::ReducedModel model_;
 };
 
+// The options database of one stage call: pushed as PETSc's default for the call, popped and destroyed
+// after it (also on an error), so one call's options never leak into the next or into the models.
+class ScopedOptions {
+public:
+  explicit ScopedOptions(const std::vector<std::string> &tokens)
+  {
+    std::string line;
+    for (const auto &t : tokens) {
+      if (t.find('"') != std::string::npos) throw std::runtime_error("rbcontact: an option value may not hold a double quote: " + t);
+      line += (t.find(' ') != std::string::npos ? "\"" + t + "\"" : t) + " ";
+    }
+    Check(PetscOptionsCreate(&opts_));
+    try {
+      Check(PetscOptionsInsertString(opts_, line.c_str())); // -options_file included
+      Check(PetscOptionsPush(opts_));
+    } catch (...) {
+      (void)PetscOptionsDestroy(&opts_);
+      throw;
+    }
+  }
+  ~ScopedOptions()
+  {
+    (void)PetscOptionsPop();
+    (void)PetscOptionsDestroy(&opts_);
+  }
+  ScopedOptions(const ScopedOptions &)            = delete;
+  ScopedOptions &operator=(const ScopedOptions &) = delete;
+
+private:
+  PetscOptions opts_ = nullptr;
+};
+
+// Runs the offline or validate stage of the library (RunOffline, RunValidation) with these command-line
+// options only (not those of initialize()); returns the stage's JSON report as text. -report is written too.
+std::string RunStage(const std::string &stage, const std::vector<std::string> &options)
+{
+  Initialize({});
+  if (stage != "offline" && stage != "validate") throw std::runtime_error("rbcontact: unknown stage '" + stage + "' (offline or validate; online: ReducedModel)");
+  ScopedOptions scope(options);
+  char          reportPath[PETSC_MAX_PATH_LEN] = "";
+  Check(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+  Check(rbc::CheckOutputPath(PETSC_COMM_WORLD, reportPath, "-report"));
+  rbc::SceneSpec scene;
+  rbc::Report    rep;
+  if (stage == "offline") {
+    rbc::OfflineSettings s;
+    Check(rbc::OfflineSettingsFromOptions(PETSC_COMM_WORLD, &s));
+    Check(rbc::SceneSpecFromOptions(PETSC_COMM_WORLD, &scene));
+    Check(rbc::RunOffline(PETSC_COMM_WORLD, scene, s, &rep));
+  } else {
+    char romPath[PETSC_MAX_PATH_LEN] = "";
+    Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
+    if (!romPath[0]) throw std::runtime_error("rbcontact.validate: give the ROM file (rom=... or -rom <file.h5>)");
+    rbc::ValidationSettings vs;
+    rbc::ParameterSet       test;
+    Check(rbc::ValidationSettingsFromOptions(PETSC_COMM_WORLD, reportPath, &vs));
+    Check(rbc::SceneSpecFromOptions(PETSC_COMM_WORLD, &scene));
+    Check(rbc::ParameterSetFromOptions(PETSC_COMM_WORLD, scene.params, "test_", &test));
+    Check(rbc::RunValidation(PETSC_COMM_WORLD, scene, romPath, test, vs, &rep));
+  }
+  Check(rep.Write(PETSC_COMM_WORLD, reportPath));
+  return rep.root.Dump();
+}
+
 } // namespace
 
 PYBIND11_MODULE(_rbcontact, m)
@@ -172,6 +239,8 @@ PYBIND11_MODULE(_rbcontact, m)
         "Initialize PETSc/SLEPc with these command-line options (e.g. ['-rom_kacanov_monitor']); optional, "
         "done with no options by the first ReducedModel");
   m.def("finalize", [] { if (liveModels == 0) Finalize(); else throw std::runtime_error("rbcontact.finalize: delete the ReducedModel objects first"); }, "Finalize PETSc/SLEPc (done at exit)");
+  m.def("_run_stage", &RunStage, py::arg("stage"), py::arg("options"),
+        "Run the offline or validate stage with these command-line options; the JSON report as text");
   py::class_<Solution>(m, "Solution", "One reduced solution")
     .def_readonly("v", &Solution::v, "reduced displacement coordinates (N)")
     .def_readonly("lambda_hat", &Solution::lambda_hat, "reduced multiplier coordinates (R)")

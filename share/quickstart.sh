@@ -92,7 +92,7 @@ main_job() {
   plot_pressure "$OUT/fom.h5" "$OUT/pressure.png" "$SCENE"
   # offline: resumes the snapshot file of an earlier (killed) run of the same problem
   # (both hyper-reductions: the ECSW cubature, the default online, and the EIM, for the comparison)
-  rbc offline "$OUT/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -rom_hyper ecsw,eim -snapshots_monitor
+  rbc offline "$OUT/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/rom.h5" -rom_hyper ecsw,eim -snapshots_monitor -offline_basis_output "$OUT/basis_view.h5"
   rbc online "$OUT/online.json" -rom "$OUT/rom.h5" -mu "$MU_ONLINE" -online_repeat 1000 -options_file "runs/$SCENE.opts" -rom_reconstruct "$OUT/online_fields.h5"
   plot "$OUT/online_fields.h5" "$OUT/deformed_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"
   plot_pressure "$OUT/online_fields.h5" "$OUT/pressure_rom.png" "$SCENE-ROM-radius-$MU_ONLINE"

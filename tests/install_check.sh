@@ -37,6 +37,8 @@ project(outside LANGUAGES C CXX)
 find_package(rbcontact 0.1 REQUIRED)
 add_executable(outside ${rbcontact_DATA_DIR}/examples/online_loop.cpp)
 target_link_libraries(outside PRIVATE rbcontact::rbcontact)
+add_executable(outside_pipeline ${rbcontact_DATA_DIR}/examples/offline_online.cpp)
+target_link_libraries(outside_pipeline PRIVATE rbcontact::rbcontact)
 CM
 cmake -S "$t/app" -B "$t/app/build" -DCMAKE_PREFIX_PATH="$t/prefix" -DCMAKE_BUILD_TYPE=Release > "$t/app/cmake.log" 2>&1 || { tail -30 "$t/app/cmake.log"; fail "configure with find_package(rbcontact)"; }
 cmake --build "$t/app/build" > "$t/app/build.log" 2>&1 || { tail -30 "$t/app/build.log"; fail "build with find_package(rbcontact)"; }
@@ -44,6 +46,19 @@ cmake --build "$t/app/build" > "$t/app/build.log" 2>&1 || { tail -30 "$t/app/bui
 [ "$(grep -c 'iterations' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: 11 solves expected"; }
 [ "$(grep -c 'force [0-9]' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: the online contact force of each solve expected"; }
 echo "ok: outside program with find_package(rbcontact): 11 online solves with their contact force"
+
+# an outside program running the whole pipeline through the library (RunOffline, RunValidation,
+# ReducedModel) for the installed scene, its mesh found through RBC_DATA_DIR = the installed share
+mkdir "$t/pipe" && cd "$t/pipe"
+RBC_DATA_DIR="$share" "$t/app/build/outside_pipeline" -options_file "$share/runs/ring_on_block.opts" -sizes 3,5 -test_size 4 -info > pipe.log 2>&1 \
+  || { tail -20 pipe.log; fail "the find_package pipeline program (offline, validate, online through the library)"; }
+grep -q "mesh file meshes/ring_on_block.geo -> $share/meshes/ring_on_block.geo" pipe.log || { grep "mesh file" pipe.log; fail "the pipeline program did not use the installed mesh"; }
+[ -f rom_train3.h5 ] && [ -f rom_train5.h5 ] || fail "the pipeline program wrote no ROM files"
+[ "$(grep -c '^train [35]: .* online force at the defaults [0-9]' pipe.log)" = 2 ] || { grep -v '^\[' pipe.log | tail; fail "the pipeline program: two trained models with their errors and online force expected"; }
+# the larger training set must not be worse (the u error of 5 radii below that of 3)
+awk '/^train 3:/{a=$12} /^train 5:/{b=$12} END{exit !(a+0 > 0 && b+0 > 0 && b+0 < a+0)}' pipe.log || { grep '^train' pipe.log; fail "the pipeline program: u error of 5 training radii not below that of 3"; }
+echo "ok: outside program with find_package(rbcontact): offline, validate and online through the library ($(grep -c '^train' pipe.log) models)"
+cd "$t/run"
 
 # the same with pkg-config
 export PKG_CONFIG_PATH="$t/prefix/lib/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"

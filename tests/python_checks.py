@@ -6,7 +6,10 @@
     radius to 1e-3 (an independent reference);
   - solve(): converged, reduced coordinates of the report's sizes, force vector whose norm is contact_force;
   - bad input raises RuntimeError naming the cause: a missing ROM file (its path), a radius outside the box
-    (the parameter), an array of the wrong shape; nan_on_failure keeps going past no failure here.
+    (the parameter), an array of the wrong shape; nan_on_failure keeps going past no failure here;
+  - the offline and validate stages from Python (rbcontact.offline / validate, the library's RunOffline and
+    RunValidation): the same ROM (forces to 1e-12) and the same validation errors as the command line with
+    the same options, the report returned and written, a bad option value raising with the option named.
 Usage: python_checks.py --exe build/bin/rbcontact --pythonpath build/python
 """
 import argparse
@@ -97,6 +100,25 @@ def main():
         check(p.returncode == 0 and "R 2 lambda_hat 2 converged True" in p.stdout and "ROM Kacanov" in p.stdout,
               "initialize(options) before the first model: -rom_R 2 and the Kacanov monitor take effect (exit %d)" % p.returncode)
         check(np.allclose(m.contact_forces(radii[:3], nan_on_failure=True), forces[:3], rtol=0, atol=0), "nan_on_failure: the same forces where every solve converges")
+
+        # the offline and validate stages from Python, against the command line with the same options
+        pyrom, clirom = d + "/py5.h5", d + "/cli5.h5"
+        rep = rbcontact.offline(options_file="runs/ring_on_block.opts", rom=pyrom, train_size=5, report=d + "/pyoff.json")
+        run(args.exe, 1, ["offline", "-options_file", "runs/ring_on_block.opts", "-rom", clirom, "-train_size", "5"])
+        written = json.load(open(d + "/pyoff.json"))
+        check(rep["stage"] == "offline" and rep["fom_solves"] == 5 and rep["rom"]["N"] == written["rom"]["N"] and os.path.exists(pyrom),
+              "rbcontact.offline: 5 FOM solves, the report returned and written, %s exists" % os.path.basename(pyrom))
+        fp = rbcontact.ReducedModel(pyrom).contact_forces(radii[::20])
+        fc = rbcontact.ReducedModel(clirom).contact_forces(radii[::20])
+        dmax = float(np.max(np.abs(fp - fc) / fc))
+        check(dmax <= 1e-12, "the Python-built ROM answers as the command line's (max rel diff %.1e <= 1e-12 at 5 radii)" % dmax)
+        val = rbcontact.validate("-options_file", "runs/ring_on_block.opts", rom=pyrom, test_size=3, validate_repeat=1)
+        run(args.exe, 1, ["validate", "-options_file", "runs/ring_on_block.opts", "-rom", pyrom, "-test_size", "3", "-validate_repeat", "1", "-report", d + "/cliv.json"])
+        cv = json.load(open(d + "/cliv.json"))
+        eu, ec = val["test"]["rel_err_u"], cv["test"]["rel_err_u"]
+        check(val["test"]["n"] == 3 and max(abs(a - b) for a, b in zip(eu, ec)) <= 1e-10 * max(ec) and max(eu) < 1e-3,
+              "rbcontact.validate: 3 test radii, u errors %s equal to the command line's" % ", ".join("%.2e" % x for x in eu))
+        raises(lambda: rbcontact.offline(options_file="runs/ring_on_block.opts", rom=d + "/bad.h5", offline_stop="bogus"), ["-offline_stop", "bogus"], "an unknown -offline_stop from Python")
         del m
     finally:
         shutil.rmtree(d, ignore_errors=True)

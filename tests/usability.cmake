@@ -5,7 +5,7 @@
 find_program(RBC_PYTHON3_U NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_UC ${RBC_PYTHON3_U} ${CMAKE_CURRENT_SOURCE_DIR}/usability_checks.py)
 foreach(np 1 2)
-  foreach(what provenance failure rename)
+  foreach(what provenance failure rename paraview)
     add_test(NAME usability_${what}_np${np} COMMAND ${RBC_UC} ${what} --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(usability_${what}_np${np} PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 PROCESSORS ${np} LABELS usability)
   endforeach()

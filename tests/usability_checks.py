@@ -11,6 +11,10 @@ Subcommands (exit 0 = pass; a failure prints what was seen):
               with one deprecation warning per option; both spellings at once are refused
   gamg        the README's iterative elastic solver (-fom_ksp_type cg -fom_pc_type gamg) on a contact
               scene: the direct solver's contact force to 1e-6
+  paraview    the XDMF files ParaView opens: every HDF dataset an .xmf names exists with the dimensions and
+              the number type / precision the .xmf says (the FOM output, the reconstructed ROM fields, the
+              offline basis view); the contact grid's points are the slave vertices; the basis view's POD
+              modes, supremizers and dual vectors are those of the basis file (the same norms and entries)
 """
 import argparse
 import atexit
@@ -186,15 +190,77 @@ def gamg(args):
     check(b["converged"] and rel <= 1e-6, "cg + gamg: contact force %.12g against the direct %.12g (rel %.1e <= 1e-6)" % (b["contact_force"], a["contact_force"], rel))
 
 
+def check_xdmf(xmf):
+    """Every HDF DataItem of xmf against its dataset: exists, dimensions, number type and precision."""
+    import xml.etree.ElementTree as ET
+    base = os.path.dirname(xmf)
+    bad, n = [], 0
+    for item in ET.parse(xmf).iter("DataItem"):
+        if item.get("Format") != "HDF":
+            continue
+        n += 1
+        fname, ds = item.text.strip().split(":", 1)
+        with h5py.File(os.path.join(base, fname), "r") as f:
+            if ds not in f:
+                bad.append("%s: no dataset %s" % (fname, ds))
+                continue
+            d = f[ds]
+            dims = tuple(int(x) for x in item.get("Dimensions").split())
+            kind = {"i": "Int", "u": "UInt", "f": "Float"}[d.dtype.kind]
+            if dims != d.shape or kind != item.get("NumberType") or str(d.dtype.itemsize) != item.get("Precision"):
+                bad.append("%s: .xmf says %s %s%s, the file holds %s %s%d" % (ds, dims, item.get("NumberType"), item.get("Precision"), d.shape, kind, d.dtype.itemsize))
+    check(n > 0 and not bad, "%s: %d HDF data items match their datasets%s" % (os.path.basename(xmf), n, (": " + "; ".join(bad[:4])) if bad else ""))
+    return ET.parse(xmf)
+
+
+def paraview(args):
+    import numpy as np
+    d = workdir()
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-fom_output", d + "/fom.h5"])
+    tree = check_xdmf(d + "/fom.xmf")
+    grids = [g.get("Name") for g in tree.iter("Grid")]
+    names = [a.get("Name") for g in tree.iter("Grid") if g.get("Name") == "contact" for a in g.iter("Attribute")]
+    check(grids == ["mesh", "contact"] and {"lambda", "weight", "normal"} <= set(names), "fom.xmf: grids %s, contact attributes %s" % (grids, names))
+    with h5py.File(d + "/fom.h5", "r") as f:
+        pts, x, y = f["/contact/points"][()], f["/contact/x"][()], f["/contact/y"][()]
+    check(pts.shape == (len(x), 3) and np.array_equal(pts[:, 0], x) and np.array_equal(pts[:, 1], y) and not pts[:, 2].any(),
+          "the contact grid's %d points are the slave vertices (x, y, 0)" % len(x))
+    rom = d + "/rom.h5"
+    run(args, args.np, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "7", "-rom", rom, "-offline_basis_output", d + "/basis_view.h5", "-report", d + "/off.json"])
+    off = load(d + "/off.json")
+    bv = off.get("basis_view", {})
+    check(bv.get("xdmf") == d + "/basis_view.xmf" and os.path.exists(bv.get("xdmf", "")), "offline -offline_basis_output: report key basis_view %s" % bv)
+    tree = check_xdmf(d + "/basis_view.xmf")
+    mesh_attrs = [a.get("Name") for g in tree.iter("Grid") if g.get("Name") == "mesh" for a in g.iter("Attribute")]
+    contact_attrs = [a.get("Name") for g in tree.iter("Grid") if g.get("Name") == "contact" for a in g.iter("Attribute")]
+    npod, nsup, r = bv.get("pod_modes", 0), bv.get("supremizers", 0), bv.get("dual", 0)
+    want_mesh = ["pod_mode_%d" % k for k in range(npod)] + ["supremizer_%d" % k for k in range(nsup)]
+    want_dual = ["dual_%d" % k for k in range(r)]
+    check(npod + nsup == off["rom"]["N"] and r == off["rom"]["R"] and set(want_mesh) <= set(mesh_attrs) and set(want_dual) <= set(contact_attrs),
+          "basis view: %d POD modes + %d supremizers (N %d) on the mesh, %d dual vectors (R %d) on the contact grid" % (npod, nsup, off["rom"]["N"], r, off["rom"]["R"]))
+    with h5py.File(d + "/basis_view.h5", "r") as v, h5py.File(d + "/rom.basis.h5", "r") as b:
+        modes, W = b["/pod/modes"][()], b["/dual/basis"][()]
+        # the view holds each mode on the mesh vertices (P1): the free dofs' entries in another order, and zero
+        # at the Dirichlet-constrained dofs (not the scene's boundary values: a mode is homogeneous)
+        def vs_mode(k, nm):
+            a = np.sort(np.ravel(v["/vertex_fields/%s_displacement" % nm][()]))
+            return abs(a - np.sort(np.concatenate([modes[k], np.zeros(a.size - modes[k].size)]))).max()
+        worst = max(vs_mode(k, nm) for k, nm in enumerate(want_mesh))
+        dworst = max(abs(np.sort(v["/contact/dual_%d" % k][()]) - np.sort(W[k])).max() for k in range(r))
+        dmin = min(v["/contact/dual_%d" % k][()].min() for k in range(r))
+    check(worst <= 1e-14 * abs(modes).max() and dworst <= 1e-14 * abs(W).max() and dmin >= 0,
+          "basis view entries = the basis file's (modes %.1e, dual %.1e), dual vectors nonnegative (min %.2g)" % (worst, dworst, dmin))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg"])
+    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg", "paraview"])
     ap.add_argument("--exe", default=os.path.join(ROOT, "build/bin/rbcontact"))
     ap.add_argument("--np", type=int, default=1)
     args = ap.parse_args()
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg}[args.what](args)
+    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg, "paraview": paraview}[args.what](args)
     if FAILED:
         print("%d check(s) failed" % len(FAILED))
         return 1

@@ -47,8 +47,11 @@ public:
   // Plain elastic solve u = A^{-1} f.
   PetscErrorCode SolveElastic();
   // Writes displacement (vertex field), von Mises (cell field) to HDF5 and an XDMF beside it; the
-  // named vectors of `contact` (multipliers, slave coordinates, ...) go to the group /contact.
-  PetscErrorCode WriteOutput(const std::string &h5file, const std::vector<Vec> &contact = {});
+  // named vectors of `contact` (multipliers, slave coordinates x, y(, z), normals normal_x, ...) go to the
+  // group /contact, and the XDMF gets a second grid "contact" (the slave vertices as points, every contact
+  // vector an attribute, the normal_* a vector) when the coordinates are among them. `fields`: more named
+  // global vectors of dm (POD modes, ...), written and described like the displacement.
+  PetscErrorCode WriteOutput(const std::string &h5file, const std::vector<Vec> &contact = {}, const std::vector<Vec> &fields = {});
   // Fills ndofs, nranks, energy, time_s.
   PetscErrorCode FillReport(Report *rep);
   PetscInt GlobalSize() const;
@@ -87,8 +90,9 @@ struct XdmfAttribute {
   PetscInt    ncomp = 1;
   bool        cell  = false;
 };
-// Writes <h5file without .h5>.xmf describing the mesh (/geometry/vertices, /viz/topology/cells)
-// and the attributes of an HDF5 file in PETSc's VIZ layout.
-PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs);
+// Writes <h5file without .h5>.xmf describing the mesh (/geometry/vertices, /viz/topology/cells: PetscInt,
+// its precision sizeof(PetscInt)) and the attributes of an HDF5 file in PETSc's VIZ layout; with npoints > 0
+// also the grid "contact": npoints points at /contact/points (npoints x 3) with the attributes pattrs.
+PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs, PetscInt npoints = 0, const std::vector<XdmfAttribute> &pattrs = {});
 
 } // namespace rbc

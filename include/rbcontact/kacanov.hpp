@@ -96,4 +96,9 @@ PetscErrorCode GatherVec(Vec v, std::vector<PetscReal> *full);
 
 PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt dim, ContactSummary *s);
 
+// Hertz's line contact of a cylinder of radius Rc on a half-space, plane strain, per unit thickness, pressed
+// by the force P: the contact half-width a = sqrt(4 P Rc / (pi E*)) and the peak pressure p0 = 2 P / (pi a),
+// with 1/E* = sum over the scene's first two bodies of (1 - nu^2) / E (`rbcontact fom -hertz_radius`).
+void HertzLineContact(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0);
+
 } // namespace rbc

@@ -8,10 +8,46 @@ A ROM file written by ``rbcontact offline`` answers new parameters in microsecon
     radii = np.linspace(0.95, 1.15, 100)
     forces = rom.contact_forces(radii)                # the contact force at 100 radii, one NumPy array
 
+The offline and validate stages run from Python too, with their options given as keywords (or a list of
+command-line words) and their JSON report returned as a dict::
+
+    rep = rbcontact.offline(options_file="runs/ring_on_block.opts", rom="rom.h5", train_size=5)
+    val = rbcontact.validate(options_file="runs/ring_on_block.opts", rom="rom.h5", test_size=5)
+    val["test"]["max_rel_err_u"]
+
 PETSc options (``-rom_*``, docs/online.md) go through ``rbcontact.initialize([...])`` before the first model.
 Errors (a missing or mismatched file, a parameter outside its box, a solve that does not converge) raise
 RuntimeError with the message of the command-line stages. docs/python.md.
 """
-from ._rbcontact import ReducedModel, Solution, initialize, finalize
+import json as _json
 
-__all__ = ["ReducedModel", "Solution", "initialize", "finalize"]
+from ._rbcontact import ReducedModel, Solution, initialize, finalize, _run_stage
+
+
+def _words(args, kw):
+    words = [str(a) for a in args]
+    for k, v in kw.items():
+        if v is None or v is False:
+            continue
+        words.append("-" + k)
+        if v is not True:
+            words.append(",".join(str(x) for x in v) if isinstance(v, (list, tuple)) else str(v))
+    return words
+
+
+def offline(*args, **options):
+    """Run the offline stage (snapshots, bases, ROM file) with these options; returns its report (dict).
+
+    ``offline(options_file="runs/ring_on_block.opts", rom="rom.h5", train_size=5)`` is
+    ``rbcontact offline -options_file runs/ring_on_block.opts -rom rom.h5 -train_size 5``; positional
+    arguments are command-line words as they are. Only these options apply (not initialize()'s).
+    """
+    return _json.loads(_run_stage("offline", _words(args, options)))
+
+
+def validate(*args, **options):
+    """Run the validate stage (the ROM against the FOM on a test set); returns its report (dict)."""
+    return _json.loads(_run_stage("validate", _words(args, options)))
+
+
+__all__ = ["ReducedModel", "Solution", "initialize", "finalize", "offline", "validate"]

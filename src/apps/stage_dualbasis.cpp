@@ -2,7 +2,7 @@
 // snapshot matrix from any source: "file.h5:/dataset" or a PETSc binary matrix from another code
 // (rows = multipliers, columns = snapshots), or a snapshot file of the offline stage.
 #include "stages.hpp"
-#include "offline_bases.hpp"
+#include "rbcontact/offline_bases.hpp"
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/rom_file.hpp"

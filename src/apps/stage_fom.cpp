@@ -7,16 +7,6 @@
 
 namespace rbc {
 
-// Hertz line contact of a cylinder (radius Rc) on a half-space, plane strain, per unit thickness.
-static void HertzReference(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0)
-{
-  PetscReal inv = 0;
-  for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
-  const PetscReal Estar = 1.0 / inv;
-  *a                    = std::sqrt(4 * P * Rc / (PETSC_PI * Estar));
-  *p0                   = 2 * P / (PETSC_PI * *a);
-}
-
 PetscErrorCode StageFom(MPI_Comm comm)
 {
   SceneSpec      scene;
@@ -98,7 +88,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     if (!kacanov.history.dualCG.empty()) h["dual_cg"] = std::vector<double>(kacanov.history.dualCG.begin(), kacanov.history.dualCG.end());
     if (hertz) {
       PetscReal a, p0;
-      HertzReference(scene, hertzRadius, cs.force, &a, &p0);
+      HertzLineContact(scene, hertzRadius, cs.force, &a, &p0);
       JsonValue &hz  = rep.root["hertz"];
       hz["a"]        = (double)cs.halfwidthMoment; // from the pressure's second moment (docs/contact.md)
       hz["a_nodes"]  = (double)cs.halfwidth;       // half the extent of the active nodes

@@ -2,9 +2,9 @@
 // file, solves the reduced contact problem at mu (ReducedModel, the C++ API), reports the reduced
 // solution, its KKT residuals and timings (-online_repeat n: median of n timed solves after one
 // warm-up). -rom_reconstruct out.h5 (with the scene, -options_file runs/<scene>.opts) writes the full
-// fields: displacement and contact pressure, with XDMF (src/apps/rom_fields.cpp).
+// fields: displacement and contact pressure, with XDMF (src/offline/rom_fields.cpp).
 #include "stages.hpp"
-#include "rom_fields.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
 #include <algorithm>

@@ -636,4 +636,13 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
   PetscFunctionReturn(0);
 }
 
+void HertzLineContact(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0)
+{
+  PetscReal inv = 0;
+  for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
+  const PetscReal Estar = 1.0 / inv;
+  *a                    = std::sqrt(4 * P * Rc / (PETSC_PI * Estar));
+  *p0                   = 2 * P / (PETSC_PI * *a);
+}
+
 } // namespace rbc

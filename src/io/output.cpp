@@ -10,7 +10,37 @@
 
 namespace rbc {
 
-PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs)
+// One attribute over n points (or cells) of the file base: 2-component vectors padded with a zero z
+// (ParaView wants 3), a "JOIN" of the datasets when the components are stored apart (dataset "a|b|c").
+static void XdmfAttributeText(std::ostringstream &x, const std::string &base, const XdmfAttribute &at, PetscInt n)
+{
+  const bool split = at.dataset.find('|') != std::string::npos;
+  x << "   <Attribute Name=\"" << at.name << "\" AttributeType=\"" << (at.ncomp == 1 ? "Scalar" : "Vector") << "\" Center=\"" << (at.cell ? "Cell" : "Node") << "\">\n";
+  auto item = [&](const std::string &ds, PetscInt ncomp) { x << "      <DataItem Dimensions=\"" << n << (ncomp > 1 ? " " + std::to_string((long long)ncomp) : std::string()) << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base << ":" << ds << "</DataItem>\n"; };
+  if (split) {
+    std::vector<std::string> parts;
+    for (size_t a = 0, b; a <= at.dataset.size(); a = b + 1) {
+      b = at.dataset.find('|', a);
+      if (b == std::string::npos) b = at.dataset.size();
+      parts.push_back(at.dataset.substr(a, b - a));
+    }
+    x << "    <DataItem ItemType=\"Function\" Function=\"JOIN($0, $1, " << (parts.size() > 2 ? "$2" : "0*$0") << ")\" Dimensions=\"" << n << " 3\">\n";
+    for (const auto &p : parts) item(p, 1);
+    x << "    </DataItem>\n";
+  } else if (at.ncomp == 2) {
+    x << "    <DataItem ItemType=\"Function\" Function=\"JOIN($0, $1, 0*$0)\" Dimensions=\"" << n << " 3\">\n";
+    for (int c = 0; c < 2; ++c) {
+      x << "     <DataItem ItemType=\"HyperSlab\" Dimensions=\"" << n << " 1\" Type=\"HyperSlab\">\n";
+      x << "      <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " << c << " 1 1 " << n << " 1</DataItem>\n";
+      item(at.dataset, 2);
+      x << "     </DataItem>\n";
+    }
+    x << "    </DataItem>\n";
+  } else item(at.dataset, at.ncomp);
+  x << "   </Attribute>\n";
+}
+
+PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs, PetscInt npoints, const std::vector<XdmfAttribute> &pattrs)
 {
   std::ostringstream x;
   const std::string  base = h5file.substr(h5file.find_last_of('/') == std::string::npos ? 0 : h5file.find_last_of('/') + 1);
@@ -19,34 +49,28 @@ PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim,
   PetscFunctionBeginUser;
   x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n";
   x << "   <Topology TopologyType=\"" << topo << "\" NumberOfElements=\"" << ncells << "\">\n";
-  x << "    <DataItem Dimensions=\"" << ncells << " " << nvpc << "\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">" << base << ":/viz/topology/cells</DataItem>\n   </Topology>\n";
+  // the cells are PetscInt (int32 unless PETSc uses 64-bit indices): the precision says which
+  x << "    <DataItem Dimensions=\"" << ncells << " " << nvpc << "\" NumberType=\"Int\" Precision=\"" << sizeof(PetscInt) << "\" Format=\"HDF\">" << base << ":/viz/topology/cells</DataItem>\n   </Topology>\n";
   x << "   <Geometry GeometryType=\"" << (dim == 2 ? "XY" : "XYZ") << "\">\n";
   x << "    <DataItem Dimensions=\"" << nverts << " " << dim << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base << ":/geometry/vertices</DataItem>\n   </Geometry>\n";
-  for (const auto &at : attrs) {
-    const PetscInt n = at.cell ? ncells : nverts;
-    x << "   <Attribute Name=\"" << at.name << "\" AttributeType=\"" << (at.ncomp == 1 ? "Scalar" : "Vector") << "\" Center=\"" << (at.cell ? "Cell" : "Node") << "\">\n";
-    if (at.ncomp == 2) {
-      // ParaView wants 3-component vectors: pad with a zero z
-      x << "    <DataItem ItemType=\"Function\" Function=\"JOIN($0, $1, 0*$0)\" Dimensions=\"" << n << " 3\">\n";
-      for (int c = 0; c < 2; ++c) {
-        x << "     <DataItem ItemType=\"HyperSlab\" Dimensions=\"" << n << " 1\" Type=\"HyperSlab\">\n";
-        x << "      <DataItem Dimensions=\"3 2\" Format=\"XML\">0 " << c << " 1 1 " << n << " 1</DataItem>\n";
-        x << "      <DataItem Dimensions=\"" << n << " 2\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base << ":" << at.dataset << "</DataItem>\n     </DataItem>\n";
-      }
-      x << "    </DataItem>\n";
-    } else {
-      x << "    <DataItem Dimensions=\"" << n << (at.ncomp > 1 ? " " + std::to_string((long long)at.ncomp) : std::string()) << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base << ":" << at.dataset << "</DataItem>\n";
-    }
-    x << "   </Attribute>\n";
+  for (const auto &at : attrs) XdmfAttributeText(x, base, at, at.cell ? ncells : nverts);
+  x << "  </Grid>\n";
+  if (npoints > 0) {
+    x << "  <Grid Name=\"contact\" GridType=\"Uniform\">\n";
+    x << "   <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << npoints << "\" NodesPerElement=\"1\"/>\n";
+    x << "   <Geometry GeometryType=\"XYZ\">\n";
+    x << "    <DataItem Dimensions=\"" << npoints << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << base << ":/contact/points</DataItem>\n   </Geometry>\n";
+    for (const auto &at : pattrs) XdmfAttributeText(x, base, at, npoints);
+    x << "  </Grid>\n";
   }
-  x << "  </Grid>\n </Domain>\n</Xdmf>\n";
+  x << " </Domain>\n</Xdmf>\n";
   std::string xdmf = h5file;
   if (xdmf.size() > 3 && xdmf.substr(xdmf.size() - 3) == ".h5") xdmf = xdmf.substr(0, xdmf.size() - 3);
   PetscCall(WriteFileAtomic(comm, xdmf + ".xmf", x.str()));
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vector<Vec> &contact)
+PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vector<Vec> &contact, const std::vector<Vec> &fields)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   PetscViewer v;
@@ -106,10 +130,71 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   }
   PetscCall(VecView(u, v));
   PetscCall(VecView(vm, v));
+  // the extra fields through a clone of the DM with the same discretization and no boundary conditions:
+  // PETSc's VIZ viewer inserts the DM's Dirichlet values (right for the displacement, wrong for a POD mode,
+  // which is zero there); the clone has the same local layout
+  if (!fields.empty()) {
+    DM          dmv;
+    PetscObject fe;
+    PetscCall(DMClone(dm, &dmv));
+    PetscCall(DMGetField(dm, 0, NULL, &fe));
+    PetscCall(DMSetField(dmv, 0, NULL, fe));
+    PetscCall(DMCreateDS(dmv));
+    for (Vec f : fields) {
+      Vec         loc, lv;
+      const char *name;
+      PetscCall(DMGetLocalVector(dm, &loc));
+      PetscCall(VecZeroEntries(loc));
+      PetscCall(DMGlobalToLocal(dm, f, INSERT_VALUES, loc));
+      PetscCall(DMGetLocalVector(dmv, &lv));
+      PetscCall(VecCopy(loc, lv));
+      PetscCall(PetscObjectGetName((PetscObject)f, &name));
+      PetscCall(PetscObjectSetName((PetscObject)lv, name));
+      PetscCall(VecView(lv, v));
+      PetscCall(DMRestoreLocalVector(dmv, &lv));
+      PetscCall(DMRestoreLocalVector(dm, &loc));
+    }
+    PetscCall(DMDestroy(&dmv));
+  }
   PetscCall(PetscViewerPopFormat(v));
+  // the contact vectors, and the slave points (x, y(, z) joined, z = 0 in 2D) for the XDMF's contact grid
+  PetscInt                   npoints = 0;
+  std::vector<XdmfAttribute> pattrs;
   if (!contact.empty()) {
     PetscCall(PetscViewerHDF5PushGroup(v, "/contact"));
-    for (Vec c : contact) PetscCall(VecView(c, v));
+    Vec         xyz[3] = {nullptr, nullptr, nullptr};
+    std::string nx[3];
+    for (Vec c : contact) {
+      const char *name;
+      PetscCall(VecView(c, v));
+      PetscCall(PetscObjectGetName((PetscObject)c, &name));
+      const std::string n = name;
+      if (n == "x" || n == "y" || n == "z") xyz[n[0] - 'x'] = c;
+      else if (n.compare(0, 7, "normal_") == 0) nx[n[7] - 'x'] = "/contact/" + n;
+      else pattrs.push_back({n, "/contact/" + n, 1, false});
+    }
+    if (xyz[0] && xyz[1]) {
+      Vec                pts;
+      PetscInt           nloc;
+      PetscScalar       *p;
+      const PetscScalar *c[3] = {nullptr, nullptr, nullptr};
+      PetscCall(VecGetLocalSize(xyz[0], &nloc));
+      PetscCall(VecGetSize(xyz[0], &npoints));
+      PetscCall(VecCreateMPI(comm, 3 * nloc, PETSC_DETERMINE, &pts));
+      PetscCall(VecSetBlockSize(pts, 3));
+      PetscCall(PetscObjectSetName((PetscObject)pts, "points"));
+      PetscCall(VecGetArray(pts, &p));
+      for (int d = 0; d < 3; ++d)
+        if (xyz[d]) PetscCall(VecGetArrayRead(xyz[d], &c[d]));
+      for (PetscInt i = 0; i < nloc; ++i)
+        for (int d = 0; d < 3; ++d) p[3 * i + d] = c[d] ? c[d][i] : 0.0;
+      for (int d = 0; d < 3; ++d)
+        if (xyz[d]) PetscCall(VecRestoreArrayRead(xyz[d], &c[d]));
+      PetscCall(VecRestoreArray(pts, &p));
+      PetscCall(VecView(pts, v));
+      PetscCall(VecDestroy(&pts));
+      if (!nx[0].empty() && !nx[1].empty()) pattrs.push_back({"normal", nx[0] + "|" + nx[1] + (nx[2].empty() ? "" : "|" + nx[2]), 3, false});
+    }
     PetscCall(PetscViewerHDF5PopGroup(v));
   }
   {
@@ -127,7 +212,12 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   PetscCall(GlobalPointCount(dm, true, &ncells));
   // PETSc's VIZ layout names datasets <vector name>_<field name>.
   std::vector<XdmfAttribute> attrs = {{"displacement", "/vertex_fields/displacement_displacement", elas.dim, false}, {"von_mises", "/cell_fields/von_mises_von_mises", 1, true}};
-  PetscCall(WriteXdmf(comm, h5file, elas.dim, nverts, ncells, elas.dim + 1, attrs));
+  for (Vec f : fields) {
+    const char *name;
+    PetscCall(PetscObjectGetName((PetscObject)f, &name));
+    attrs.push_back({name, std::string("/vertex_fields/") + name + "_displacement", elas.dim, false});
+  }
+  PetscCall(WriteXdmf(comm, h5file, elas.dim, nverts, ncells, elas.dim + 1, attrs, npoints, pattrs));
   PetscFunctionReturn(0);
 }
 

@@ -1,8 +1,8 @@
-// src/apps/offline_greedy.cpp: the greedy training's options, candidate pool, error indicator and picks
+// src/offline/offline_greedy.cpp: the greedy training's options, candidate pool, error indicator and picks
 // (offline_greedy.hpp, docs/greedy_training.md).
-#include "offline_greedy.hpp"
-#include "offline_bases.hpp"
-#include "offline_rom.hpp"
+#include "rbcontact/offline_greedy.hpp"
+#include "rbcontact/offline_bases.hpp"
+#include "rbcontact/offline_rom.hpp"
 #include <algorithm>
 #include <cmath>
 #include <numeric>

@@ -1,12 +1,12 @@
-// src/apps/offline_rom.cpp: the last offline step: from the snapshots and the bases, the online data
+// src/offline/offline_rom.cpp: the last offline step: from the snapshots and the bases, the online data
 // of the ROM file (docs/eim.md, docs/rom_file.md): reduced affine terms A^_q = V'A_qV, f^_q = V'f_q;
 // the full contact patch on the support of the dual basis and P = W' Psi; snapshots of the contact map
 // kappa and the gap gamma at the training solutions and at the iterates of the reduced Kacanov loop
 // with exact contact terms; their EIM (or their exact constant form when they do not vary); the patch
 // restricted to the facets around the EIM points; warm starts. Every rank of the group computes the
 // same (deterministic) data; world rank 0 writes it.
-#include "offline_rom.hpp"
-#include "rom_fields.hpp"
+#include "rbcontact/offline_rom.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/empirical_cubature.hpp"
 #include "rbcontact/eim_selection.hpp"

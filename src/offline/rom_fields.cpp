@@ -1,5 +1,5 @@
-// src/apps/rom_fields.cpp: full-order fields of reduced solutions (validation, -rom_reconstruct).
-#include "rom_fields.hpp"
+// src/offline/rom_fields.cpp: full-order fields of reduced solutions (validation, -rom_reconstruct).
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_file.hpp"
 #include <filesystem>
@@ -181,6 +181,61 @@ PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::ve
   PetscFunctionReturn(0);
 }
 
+// The scene's FOM at mu for the ROM at romPath (checked to be the ROM's scene), the canonical order, the
+// bases, and the contact system at displacement fom.u (the multiplier layout, weights, normals, points).
+static PetscErrorCode SceneOfRom(MPI_Comm comm, const SceneSpec &scene, const ReducedModel &model, const std::vector<PetscReal> &mu, const char *what, ElasticFOM *fom, CanonicalOrder *order, RomBases *bases, ContactMap *cmap)
+{
+  std::string romScene;
+
+  PetscFunctionBeginUser;
+  PetscCall(RomReadAttr(model.file, "scene", &romScene));
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "%s: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", what, scene.name.c_str(), model.file.c_str(), romScene.c_str(), romScene.c_str());
+  PetscCall(fom->Create(comm, scene));
+  PetscCall(CheckRomScene(comm, model.file, scene, fom->map));
+  PetscCall(fom->SetupAffine());
+  PetscCall(fom->SetMu(mu));
+  PetscCall(order->BuildDofs(fom->elas));
+  PetscCall(bases->Read(comm, model, model.file, order->NumDofs()));
+  if (!fom->u) {
+    PetscCall(DMCreateGlobalVector(fom->dm, &fom->u));
+    PetscCall(PetscObjectSetName((PetscObject)fom->u, "displacement"));
+  }
+  PetscCheck(scene.contact, comm, PETSC_ERR_SUP, "%s: the scene has no contact pair (-contact_slave, -contact_master)", what);
+  PetscCall(cmap->Setup(fom->elas, scene.slave, scene.master));
+  cmap->SetGeometry(&fom->map, mu);
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ContactAt(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys)
+{
+  Vec uloc;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalVector(fom.dm, &uloc));
+  PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+  PetscCall(cmap.Assemble(fom.elas, uloc, sys));
+  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+  PetscCall(order.BuildMultipliers(sys->coordRef, fom.elas.dim));
+  PetscFunctionReturn(0);
+}
+
+// The contact vectors of the output: the named ones first, then weight, slave points and normals.
+static PetscErrorCode ContactOutputs(const ContactSystem &sys, PetscInt dim, std::vector<Vec> *cv)
+{
+  const char *names[] = {"x", "y", "z"}, *nn[] = {"normal_x", "normal_y", "normal_z"};
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectSetName((PetscObject)sys.weight, "weight"));
+  cv->push_back(sys.weight);
+  for (PetscInt d = 0; d < dim; ++d) {
+    PetscCall(PetscObjectSetName((PetscObject)sys.coord[d], names[d]));
+    PetscCall(PetscObjectSetName((PetscObject)sys.normal[d], nn[d]));
+    cv->push_back(sys.coord[d]);
+    cv->push_back(sys.normal[d]);
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep)
 {
   SceneSpec      scene;
@@ -189,34 +244,12 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   CanonicalOrder order;
   RomBases       bases;
   ContactSystem  sys;
-  std::string    romScene;
 
   PetscFunctionBeginUser;
   PetscCall(SceneSpecFromOptions(comm, &scene));
-  PetscCall(RomReadAttr(model.file, "scene", &romScene));
-  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "-rom_reconstruct: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), model.file.c_str(), romScene.c_str(), romScene.c_str());
-  PetscCall(fom.Create(comm, scene));
-  PetscCall(CheckRomScene(comm, model.file, scene, fom.map));
-  PetscCall(fom.SetupAffine());
-  PetscCall(fom.SetMu(mu));
-  PetscCall(order.BuildDofs(fom.elas));
-  PetscCall(bases.Read(comm, model, model.file, order.NumDofs()));
-  if (!fom.u) {
-    PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
-    PetscCall(PetscObjectSetName((PetscObject)fom.u, "displacement"));
-  }
+  PetscCall(SceneOfRom(comm, scene, model, mu, "-rom_reconstruct", &fom, &order, &bases, &cmap));
   PetscCall(bases.Displacement(model, order, sol.v, fom.u));
-  // the contact system at the reconstructed displacement: multiplier layout, weights, normals
-  PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
-  cmap.SetGeometry(&fom.map, mu);
-  {
-    Vec uloc;
-    PetscCall(DMGetLocalVector(fom.dm, &uloc));
-    PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
-    PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
-    PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-  }
-  PetscCall(order.BuildMultipliers(sys.coordRef, fom.elas.dim));
+  PetscCall(ContactAt(fom, cmap, order, &sys)); // at the reconstructed displacement
   std::vector<PetscReal> lam;
   bases.Multipliers(model, sol.lambda, &lam);
   Vec lambda;
@@ -230,18 +263,64 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   PetscReal energy;
   PetscCall(fom.elas.Energy(fom.u, &energy));
   rep->root["energy"] = (double)energy;
-  const char      *names[] = {"x", "y", "z"}, *nn[] = {"normal_x", "normal_y", "normal_z"};
-  std::vector<Vec> cv      = {lambda, sys.weight};
   PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
-  PetscCall(PetscObjectSetName((PetscObject)sys.weight, "weight"));
-  for (PetscInt d = 0; d < fom.elas.dim; ++d) {
-    PetscCall(PetscObjectSetName((PetscObject)sys.coord[d], names[d]));
-    PetscCall(PetscObjectSetName((PetscObject)sys.normal[d], nn[d]));
-    cv.push_back(sys.coord[d]);
-    cv.push_back(sys.normal[d]);
-  }
+  std::vector<Vec> cv = {lambda};
+  PetscCall(ContactOutputs(sys, fom.elas.dim, &cv));
   PetscCall(fom.WriteOutput(path, cv));
   PetscCall(VecDestroy(&lambda));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode WriteBasisView(MPI_Comm comm, const SceneSpec &scene, const std::string &romPath, const std::string &path, Report *rep)
+{
+  ReducedModel   model;
+  ElasticFOM     fom;
+  ContactMap     cmap;
+  CanonicalOrder order;
+  RomBases       bases;
+  ContactSystem  sys;
+  std::vector<Vec> fields, dual;
+
+  PetscFunctionBeginUser;
+  PetscCall(CheckOutputPath(comm, path, "-offline_basis_output"));
+  PetscCall(model.Open(romPath));
+  std::vector<PetscReal> mu;
+  for (const auto &p : model.par.params) mu.push_back(p.def);
+  PetscCall(SceneOfRom(comm, scene, model, mu, "-offline_basis_output", &fom, &order, &bases, &cmap));
+  PetscCall(VecZeroEntries(fom.u));
+  PetscCall(ContactAt(fom, cmap, order, &sys)); // the reference configuration at the default parameters
+  PetscInt lo, hi;
+  PetscCall(VecGetOwnershipRange(fom.u, &lo, &hi));
+  for (PetscInt n = 0; n < bases.N; ++n) { // POD modes, then supremizers (unit energy norm)
+    Vec          f;
+    PetscScalar *a;
+    PetscCall(VecDuplicate(fom.u, &f));
+    PetscCall(VecGetArray(f, &a));
+    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = bases.modes[(size_t)n * bases.ndofs + order.CanonicalDof(i)];
+    PetscCall(VecRestoreArray(f, &a));
+    const std::string name = n < model.Npod ? "pod_mode_" + std::to_string((long long)n) : "supremizer_" + std::to_string((long long)(n - model.Npod));
+    PetscCall(PetscObjectSetName((PetscObject)f, name.c_str()));
+    fields.push_back(f);
+  }
+  for (PetscInt k = 0; k < bases.r; ++k) { // the nonnegative dual basis: nodal multiplier coefficients
+    Vec l;
+    PetscCall(VecDuplicate(sys.g, &l));
+    PetscCall(CanonicalToMultipliers(order, std::vector<PetscReal>(bases.W.begin() + (size_t)k * bases.R, bases.W.begin() + (size_t)(k + 1) * bases.R), l));
+    PetscCall(PetscObjectSetName((PetscObject)l, ("dual_" + std::to_string((long long)k)).c_str()));
+    dual.push_back(l);
+  }
+  std::vector<Vec> cv = dual;
+  PetscCall(ContactOutputs(sys, fom.elas.dim, &cv));
+  PetscCall(fom.WriteOutput(path, cv, fields));
+  for (Vec &f : fields) PetscCall(VecDestroy(&f));
+  for (Vec &l : dual) PetscCall(VecDestroy(&l));
+  std::string xmf = path;
+  if (xmf.size() > 3 && xmf.compare(xmf.size() - 3, 3, ".h5") == 0) xmf.resize(xmf.size() - 3);
+  rep->root["basis_view"]["file"]        = path;
+  rep->root["basis_view"]["xdmf"]        = xmf + ".xmf";
+  rep->root["basis_view"]["pod_modes"]   = (long long)model.Npod;
+  rep->root["basis_view"]["supremizers"] = (long long)(bases.N - model.Npod);
+  rep->root["basis_view"]["dual"]        = (long long)bases.r;
   PetscFunctionReturn(0);
 }
 

@@ -1,4 +1,4 @@
-// src/apps/rom_fields.hpp: full-order fields of a reduced solution on the scene's mesh: the primal and
+// include/rbcontact/rom_fields.hpp: full-order fields of a reduced solution on the scene's mesh: the primal and
 // dual bases read from the ROM's basis file, the displacement u = sum_n v_n theta_n and the
 // multipliers lambda = sum_r lambda_r xi_r (canonical order), and -rom_reconstruct's output file.
 #pragma once
@@ -45,5 +45,11 @@ PetscErrorCode CanonicalToMultipliers(const CanonicalOrder &order, const std::ve
 
 // -rom_reconstruct: the scene from the options (must match the ROM's), fields at mu written to path.
 PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const ReducedSolution &sol, const std::vector<PetscReal> &mu, const std::string &path, Report *rep);
+
+// -offline_basis_output: the bases of the ROM at romPath on the scene's mesh for ParaView (path + its .xmf): the
+// POD modes and supremizers as vertex fields pod_mode_k, supremizer_k (the displacement is zero), and the dual
+// basis vectors dual_k with the slave weights and normals on the grid "contact" (the slave vertices at the
+// default parameters). Report key basis_view {file, xdmf, pod_modes, supremizers, dual}.
+PetscErrorCode WriteBasisView(MPI_Comm comm, const SceneSpec &scene, const std::string &romPath, const std::string &path, Report *rep);
 
 } // namespace rbc

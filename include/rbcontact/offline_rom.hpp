@@ -1,4 +1,4 @@
-// src/apps/offline_rom.hpp: the online data step of the offline stage (reduced affine terms, EIM of
+// include/rbcontact/offline_rom.hpp: the online data step of the offline stage (reduced affine terms, EIM of
 // the contact map and gap, local contact data, warm starts), written into the ROM file.
 #pragma once
 #include <slepcbv.h>

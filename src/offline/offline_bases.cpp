@@ -1,12 +1,12 @@
-// src/apps/offline_bases.cpp: POD of the displacement snapshots (energy, H1 or l2 inner product of the
+// src/offline/offline_bases.cpp: POD of the displacement snapshots (energy, H1 or l2 inner product of the
 // reference configuration) and the nonnegative dual basis of the multiplier snapshots; ROM file.
-#include "offline_bases.hpp"
+#include "rbcontact/offline_bases.hpp"
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/supremizers.hpp"
-#include "offline_rom.hpp"
-#include "rom_fields.hpp"
+#include "rbcontact/offline_rom.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
 #include <cmath>

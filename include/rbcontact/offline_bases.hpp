@@ -1,4 +1,4 @@
-// src/apps/offline_bases.hpp: the bases step of the offline stage (-offline_stop bases): primal POD
+// include/rbcontact/offline_bases.hpp: the bases step of the offline stage (-offline_stop bases): primal POD
 // and nonnegative dual basis from a snapshot file (or snapshots in memory), written to the ROM file.
 #pragma once
 #include "rbcontact/canonical_order.hpp"
@@ -16,7 +16,7 @@ namespace rbc {
 // group: the ranks of fom (a subcommunicator of world); world rank 0 writes romPath.
 // cmap: the scene's contact surfaces (null without contact; -dual_mass_weighted and the online ROM need
 // them). onlineRom false: bases only (-offline_stop bases), written to romPath (format_version 1);
-// true: the bases go to basisPath and the online ROM (format_version 2, src/apps/offline_rom.cpp) to romPath.
+// true: the bases go to basisPath and the online ROM (format_version 2, src/offline/offline_rom.cpp) to romPath.
 // partial: the training set is the done snapshots of the file (a greedy run declares its candidate pool);
 // otherwise every training point must be done.
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "", bool partial = false);

@@ -1,4 +1,4 @@
-// src/apps/offline_greedy.hpp: greedy training (offline -train_type greedy, docs/greedy_training.md):
+// include/rbcontact/offline_greedy.hpp: greedy training (offline -train_type greedy, docs/greedy_training.md):
 // the candidate pool, the error indicator of a reduced solution computed with the reduced model with
 // exact contact terms, the choice of the next FOM parameters, and the rounds (bases, indicator, picks);
 // the snapshot solves and their checkpoints are the snapshot stage's (stage_offline.cpp).

@@ -1,0 +1,32 @@
+// include/rbcontact/validation.hpp: the ROM against the FOM on a test set as library API
+// (src/offline/validation.cpp; `rbcontact validate` is a thin wrapper): errors of the ROM and of the ROM
+// with exact contact terms (u in the energy norm of A(mu), lambda in the slave-mass weighted l2 norm, the
+// contact force on the mesh and online), online and FOM timings, and the speed-against-error sweep.
+#pragma once
+#include <string>
+#include <vector>
+#include "rbcontact/report.hpp"
+#include "rbcontact/scene.hpp"
+#include "rbcontact/training_set.hpp"
+
+namespace rbc {
+
+struct ValidationSettings {
+  PetscInt               repeat = 100;                        // -validate_repeat: timed online solves per parameter
+  bool                   sweep  = false;                      // -validate_sweep: the speed-against-error table
+  std::vector<PetscReal> fractions{0.2, 0.4, 0.6, 0.8, 1.0};  // -validate_sweep_fractions of N, R (and the EIM sizes)
+  std::string            sweepOutput;                         // -validate_sweep_output stem (default: the report's + _sweep)
+};
+
+// Reads and checks the settings (one PetscOptionsBegin block); reportPath gives the sweep's default stem.
+PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &reportPath, ValidationSettings *s);
+
+// The ROM at romPath (built for scene as configured now: checked) against the FOM at every point of test.
+// Report keys: stage, scene, rom_file, nranks, test and test_exact (= test_no_eim) {n, max_rel_err_u,
+// mean_rel_err_u, max_rel_err_lambda, mean_rel_err_lambda, max_rel_err_force, rel_err_*, max_rel_err_force_online,
+// failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat}, fom_time_s {median, all},
+// speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}; with the sweep
+// also sweep [rows] and sweep_files. An error if the ROM fails on a test parameter. Collective on comm.
+PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::string &romPath, const ParameterSet &test, const ValidationSettings &s, Report *rep);
+
+} // namespace rbc

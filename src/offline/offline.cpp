@@ -1,0 +1,399 @@
+// src/offline/offline.cpp: the offline stage as library API (include/rbcontact/offline.hpp): its settings,
+// the checks of the later steps' options, the snapshot solves (groups of ranks over the parameters, every
+// finished round written to the snapshot file before the next starts: a killed job resumes) and the
+// bases and ROM steps (offline_bases.cpp, offline_greedy.cpp, offline_rom.cpp).
+#include "rbcontact/offline.hpp"
+#include "rbcontact/offline_bases.hpp"
+#include "rbcontact/offline_greedy.hpp"
+#include "rbcontact/offline_rom.hpp"
+#include "rbcontact/rom_fields.hpp"
+#include "rbcontact/provenance.hpp"
+#include "rbcontact/supremizers.hpp"
+#include "rbcontact/eim.hpp"
+#include "rbcontact/canonical_order.hpp"
+#include "rbcontact/fom.hpp"
+#include "rbcontact/kacanov.hpp"
+#include "rbcontact/mesh.hpp"
+#include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/training_set.hpp"
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace rbc {
+
+static PetscLogEvent OFF_Snapshots = 0;
+
+PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
+{
+  char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64];
+  PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(romPath, s->rom.c_str(), sizeof romPath));
+  PetscCall(PetscStrncpy(trainType, s->trainType.c_str(), sizeof trainType));
+  PetscCall(PetscStrncpy(viewPath, s->basisView.c_str(), sizeof viewPath));
+  if (s->stop == OfflineStop::Snapshots) PetscCall(PetscStrncpy(stop, "snapshots", sizeof stop));
+  if (s->stop == OfflineStop::Bases) PetscCall(PetscStrncpy(stop, "bases", sizeof stop));
+  // the companion files' defaults follow -rom, so -help lists them after it
+  PetscOptionsBegin(comm, NULL, "rbcontact offline: snapshots, bases and the reduced model", "rbcontact");
+  PetscCall(PetscOptionsString("-offline_stop", "last step: snapshots, bases or rom (every step)", "", stop, stop, sizeof stop, NULL));
+  PetscCall(PetscOptionsString("-rom", "the ROM file to write (with the bases and rom steps)", "", romPath, romPath, sizeof romPath, NULL));
+  {
+    // companion files of the ROM: <stem>.snapshots.h5 and <stem>.basis.h5 unless given
+    std::string stem = romPath;
+    if (stem.size() > 3 && stem.compare(stem.size() - 3, 3, ".h5") == 0) stem.resize(stem.size() - 3);
+    if (!strcmp(stop, "rom")) {
+      PetscCall(PetscStrncpy(snapPath, (stem + ".snapshots.h5").c_str(), sizeof snapPath));
+      PetscCall(PetscStrncpy(basisPath, (stem + ".basis.h5").c_str(), sizeof basisPath));
+    }
+    if (!s->snapshots.empty()) PetscCall(PetscStrncpy(snapPath, s->snapshots.c_str(), sizeof snapPath));
+    if (!s->basis.empty()) PetscCall(PetscStrncpy(basisPath, s->basis.c_str(), sizeof basisPath));
+  }
+  PetscCall(PetscOptionsString("-rom_basis", "the basis file (default: the ROM's stem + .basis.h5)", "", basisPath, basisPath, sizeof basisPath, NULL));
+  PetscCall(PetscOptionsString("-snapshots", "the snapshot file, checkpointed and resumable (default: the ROM's stem + .snapshots.h5)", "", snapPath, snapPath, sizeof snapPath, NULL));
+  // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
+  restart = strcmp(stop, "snapshots") ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-snapshots_restart", "resume from an existing snapshot file of this problem", "", restart, &restart, NULL));
+  PetscCall(PetscOptionsBool("-snapshots_monitor", "print one line per solved snapshot", "", monitor, &monitor, NULL));
+  PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
+  PetscCall(PetscOptionsString("-offline_basis_output", "write the POD modes, supremizers and dual basis on the mesh to this HDF5 file (+ .xmf for ParaView)", "", viewPath, viewPath, sizeof viewPath, NULL));
+  PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));
+  PetscOptionsEnd();
+  PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
+  s->stop      = !strcmp(stop, "rom") ? OfflineStop::Rom : !strcmp(stop, "bases") ? OfflineStop::Bases : OfflineStop::Snapshots;
+  s->rom       = romPath;
+  s->basis     = basisPath;
+  s->snapshots = snapPath;
+  s->restart   = restart;
+  s->monitor   = monitor;
+  s->trainType = trainType;
+  s->basisView = viewPath;
+  PetscCheck(s->basisView.empty() || s->stop == OfflineStop::Rom, comm, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", stop);
+  if (!s->basisView.empty()) PetscCall(CheckOutputPath(comm, s->basisView, "-offline_basis_output"));
+  const bool bases = s->stop != OfflineStop::Snapshots;
+  PetscCheck(!bases || !s->rom.empty(), comm, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
+  PetscCheck(!s->snapshots.empty(), comm, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  if (bases) PetscCall(CheckOutputPath(comm, s->rom, "-rom"));
+  PetscCall(CheckOutputPath(comm, s->snapshots, "-snapshots"));
+  if (s->stop == OfflineStop::Rom) PetscCall(CheckOutputPath(comm, s->basis, "-rom_basis"));
+  PetscFunctionReturn(0);
+}
+
+// Rank 0 reads the mesh file: its checksum and node count (msh22: the line after $Nodes).
+static PetscErrorCode MeshFacts(MPI_Comm comm, const SceneSpec &scene, unsigned long long *checksum, PetscInt *nnodes)
+{
+  std::string path;
+  PetscMPIInt rank;
+  long long   buf[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshGenerate(comm, scene.mesh, &path));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    std::ifstream     f(path, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    const std::string text = ss.str();
+    buf[0]                 = (long long)Fnv1a(text);
+    const auto pos         = text.find("$Nodes");
+    if (pos != std::string::npos) buf[1] = std::atoll(text.c_str() + text.find('\n', pos) + 1);
+  }
+  PetscCallMPI(MPI_Bcast(buf, 2, MPI_LONG_LONG, 0, comm));
+  *checksum = (unsigned long long)buf[0];
+  *nnodes   = (PetscInt)buf[1];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineSettings &s, Report *report)
+{
+  Report        &rep = *report;
+  const bool      full = s.stop == OfflineStop::Rom, bases = full || s.stop == OfflineStop::Bases;
+  const bool      greedy = s.trainType == "greedy";
+  const char     *snapPath = s.snapshots.c_str(), *romPath = s.rom.c_str(), *trainType = s.trainType.c_str();
+  const PetscBool restart = s.restart ? PETSC_TRUE : PETSC_FALSE, monitor = s.monitor ? PETSC_TRUE : PETSC_FALSE;
+  PetscMPIInt     wrank, wsize;
+  PetscLogDouble  t0, t1, tSnap0;
+
+  PetscFunctionBeginUser;
+  if (!OFF_Snapshots) PetscCall(PetscLogEventRegister("RBCSnapshots", DM_CLASSID, &OFF_Snapshots));
+  PetscCall(PetscTime(&t0));
+  PetscCallMPI(MPI_Comm_rank(world, &wrank));
+  PetscCallMPI(MPI_Comm_size(world, &wsize));
+  PetscCheck(!bases || !s.rom.empty(), world, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
+  PetscCheck(!s.snapshots.empty(), world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  if (bases) PetscCall(CheckOutputPath(world, s.rom, "-rom"));
+  PetscCall(CheckOutputPath(world, s.snapshots, "-snapshots"));
+  if (full) PetscCall(CheckOutputPath(world, s.basis, "-rom_basis"));
+  PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
+  // -train_type greedy (docs/greedy_training.md): the snapshot file's training set is the pool (initial
+  // set, then the candidates); the FOM solves the initial set, then the parameters the indicator picks
+  ParameterSet  train;
+  GreedyOptions gopt;
+  PetscInt      ninitial = 0;
+  if (greedy) {
+    PetscCheck(scene.contact, world, PETSC_ERR_SUP, "-train_type greedy: the indicator is that of a contact scene (-contact_slave, -contact_master)");
+    PetscCheck(full, world, PETSC_ERR_ARG_INCOMP, "-train_type greedy builds the reduced model while it trains: it runs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
+    PetscCall(GreedyOptionsFromOptions(world, &gopt));
+    PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
+  } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
+  const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
+  { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
+    PetscReal supRatio;
+    PetscCall(SupremizerRatioFromOptions(world, &supRatio));
+  }
+  if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
+    EIMOptions  eo;
+    PetscReal   slack = 0;
+    HyperChoice hc;
+    PetscCall(HyperChoiceFromOptions(world, &hc));
+    PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
+    PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+    PetscCheck(slack >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_select_slack %g must be >= 0", (double)slack);
+    PetscBool held = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &held));
+    if (held) {
+      ParameterSet hs;
+      PetscCall(ParameterSetFromOptions(world, scene.params, "eim_heldout_", &hs));
+    }
+  }
+
+  // Groups of ranks, each solving its share of the parameters. Default: one group per rank for a
+  // small mesh (< 200k dofs, where one rank per solve is efficient), one group otherwise.
+  unsigned long long checksum = 0;
+  PetscInt           nnodes   = 0;
+  PetscCall(MeshFacts(world, scene, &checksum, &nnodes));
+  PetscInt k = s.subcomms > 0 ? s.subcomms : (nnodes * 3 < 200000) ? wsize : 1;
+  PetscCheck(k >= 1 && k <= wsize, world, PETSC_ERR_ARG_OUTOFRANGE, "-snapshots_subcomm %" PetscInt_FMT " must lie in [1, %d] (the number of ranks)", k, (int)wsize);
+  PetscSubcomm psub;
+  PetscCall(PetscSubcommCreate(world, &psub));
+  PetscCall(PetscSubcommSetNumber(psub, (PetscInt)k));
+  PetscCall(PetscSubcommSetType(psub, PETSC_SUBCOMM_CONTIGUOUS));
+  MPI_Comm    group = PetscSubcommChild(psub);
+  PetscMPIInt grank;
+  PetscCallMPI(MPI_Comm_rank(group, &grank));
+  const PetscInt color = psub->color;
+
+  {
+    // Every group: the reference-configuration FOM with its affine decomposition and contact map.
+    ElasticFOM     fom;
+    ContactMap     cmap;
+    KacanovSolver  kac;
+    CanonicalOrder order;
+    PetscCall(fom.Create(group, scene));
+    PetscCall(fom.SetupAffine());
+    PetscInt ndofs;
+    {
+      Vec g;
+      PetscCall(DMGetGlobalVector(fom.dm, &g));
+      PetscCall(VecGetSize(g, &ndofs));
+      PetscCall(DMRestoreGlobalVector(fom.dm, &g));
+    }
+    PetscCall(order.BuildDofs(fom.elas));
+    PetscInt               R = 0;
+    std::vector<PetscInt>  D, Dc, Dperm;
+    if (scene.contact) {
+      PetscCall(kac.SetFromOptions(group));
+      PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+      PetscCall(kac.ShareFactor(fom, cmap));
+      R = cmap.NumMultipliers();
+      PetscCall(cmap.SurfaceDofs(group, &D));
+      // contact dofs in canonical numbering, sorted; Dperm[j] = position in D of the j-th canonical one
+      std::vector<std::pair<PetscInt, PetscInt>> cd;
+      for (size_t j = 0; j < D.size(); ++j) cd.emplace_back(order.CanonicalDof(D[j]), (PetscInt)j);
+      std::sort(cd.begin(), cd.end());
+      for (const auto &p : cd) { Dc.push_back(p.first); Dperm.push_back(p.second); }
+    }
+    const PetscInt nD = (PetscInt)D.size();
+
+    SnapshotHeader h;
+    h.scene          = scene.name;
+    h.sceneHash      = Fnv1a(SceneFingerprint(scene, fom.map));
+    h.meshChecksum   = checksum;
+    h.codeVersion    = CodeVersion();
+    h.paramNames     = train.names;
+    for (const auto &p : scene.params) { h.paramMin.push_back(p.min); h.paramMax.push_back(p.max); }
+    h.trainingPoints = train.points;
+    h.ndofs          = ndofs;
+    h.nmult          = R;
+    {
+      char *all = NULL;
+      PetscCall(PetscOptionsGetAll(NULL, &all));
+      h.optionsText = all ? all : "";
+      PetscCall(PetscFree(all));
+    }
+    SnapshotFile file;
+    PetscCall(file.Open(world, snapPath, h, restart));
+    std::vector<PetscInt> done, todo;
+    PetscCall(file.DoneIndices(&done));
+    for (PetscInt i = 0; i < ntrain; ++i)
+      if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
+    if (!restart) PetscCheck(done.empty(), world, PETSC_ERR_PLIB, "new snapshot file with done entries");
+
+    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], K_D[R*nD]
+    const size_t           L = 7 + np + ndofs + 2 * R + (size_t)R * nD;
+    std::vector<PetscReal> pack(L), gathered(wrank == 0 ? L * wsize : 0);
+    std::vector<PetscInt>  itsSolved;
+    bool                   multOrderBuilt = false;
+    // Solves the training points list (indices into train.points) in rounds of k, one per group of ranks;
+    // every finished round is written before the next starts.
+    PetscInt solvedNow = 0;
+    auto solveList = [&](const std::vector<PetscInt> &list) -> PetscErrorCode {
+      const PetscInt rounds = ((PetscInt)list.size() + k - 1) / k;
+      for (PetscInt r = 0; r < rounds; ++r) {
+        const PetscInt slot = r * k + color;
+        const PetscInt idx  = slot < (PetscInt)list.size() ? list[slot] : -1;
+        std::fill(pack.begin(), pack.end(), 0.0);
+        pack[0] = idx;
+        if (idx >= 0) {
+          PetscLogDouble s0, s1;
+          PetscCall(PetscTime(&s0));
+          const std::vector<PetscReal> &mu = train.points[idx];
+          PetscCall(fom.SetMu(mu));
+          PetscCall(fom.AssembleAndFactor());
+          std::vector<PetscReal> u, lam, gap, KDg;
+          if (scene.contact) {
+            cmap.SetGeometry(&fom.map, mu);
+            PetscCall(kac.Solve(fom, cmap));
+            if (!multOrderBuilt) {
+              PetscCall(order.BuildMultipliers(kac.sys.coordRef, fom.elas.dim));
+              multOrderBuilt = true;
+            }
+            PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));
+            PetscCall(order.MultipliersToCanonical(kac.sys.g, &gap));
+            PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KDg));
+          } else PetscCall(fom.SolveElastic());
+          PetscCall(order.DofsToCanonical(fom.u, &u));
+          PetscCall(PetscTime(&s1));
+          if (grank == 0) {
+            size_t o = 1;
+            pack[o++] = kac.iterations;
+            pack[o++] = s1 - s0;
+            pack[o++] = kac.kkt.primal;
+            pack[o++] = kac.kkt.dual;
+            pack[o++] = kac.kkt.complementarity;
+            pack[o++] = kac.kkt.stationarity;
+            for (PetscInt j = 0; j < np; ++j) pack[o++] = mu[j];
+            for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = u[j];
+            for (PetscInt j = 0; j < R; ++j) pack[o++] = lam[j];
+            for (PetscInt j = 0; j < R; ++j) pack[o++] = gap[j];
+            // K_D: rows in canonical multiplier order, columns in canonical dof order (row-major)
+            for (PetscInt g = 0; g < R; ++g) {
+              const PetscInt c = order.CanonicalMultiplier(g);
+              for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
+            }
+          }
+          itsSolved.push_back(kac.iterations);
+        }
+        // group roots -> world rank 0 (other ranks send an empty slot)
+        if (grank != 0) pack[0] = -1;
+        PetscCallMPI(MPI_Gather(pack.data(), (int)L, MPIU_REAL, gathered.data(), (int)L, MPIU_REAL, 0, world));
+        std::vector<Snapshot> snaps;
+        if (wrank == 0)
+          for (PetscMPIInt q = 0; q < wsize; ++q) {
+            const PetscReal *p = &gathered[(size_t)q * L];
+            if (p[0] < 0) continue;
+            Snapshot s;
+            size_t   o = 0;
+            s.index             = (PetscInt)p[o++];
+            s.kacanovIterations = (PetscInt)p[o++];
+            s.seconds           = p[o++];
+            s.kkt.assign(p + o, p + o + 4);
+            o += 4;
+            s.mu.assign(p + o, p + o + np);
+            o += np;
+            s.u.assign(p + o, p + o + ndofs);
+            o += ndofs;
+            s.lambda.assign(p + o, p + o + R);
+            o += R;
+            if (scene.contact) {
+              s.extra["contact_gap"].assign(p + o, p + o + R);
+              o += R;
+              s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
+              s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
+            }
+            snaps.push_back(s);
+          }
+        PetscInt nsnap = (PetscInt)snaps.size();
+        PetscCallMPI(MPI_Bcast(&nsnap, 1, MPIU_INT, 0, world));
+        for (PetscInt i = 0; i < nsnap; ++i) PetscCall(file.Write(wrank == 0 ? snaps[i] : Snapshot()));
+        if (monitor && wrank == 0) {
+          PetscLogDouble now;
+          PetscCall(PetscTime(&now));
+          const PetscInt  finished = solvedNow + std::min<PetscInt>((r + 1) * k, (PetscInt)list.size());
+          const PetscReal eta      = (now - tSnap0) / finished * (solvedNow + (PetscInt)list.size() - finished);
+          for (const auto &s : snaps) {
+            std::ostringstream m;
+            for (auto v : s.mu) m << " " << v;
+            PetscCall(PetscPrintf(PETSC_COMM_SELF, "  snapshot %3" PetscInt_FMT "/%" PetscInt_FMT "  mu =%s  Kacanov its %2" PetscInt_FMT "  %.2f s  [%" PetscInt_FMT "/%" PetscInt_FMT " done, ETA %.1f s]\n", s.index + 1, ntrain, m.str().c_str(), s.kacanovIterations, (double)s.seconds, finished, solvedNow + (PetscInt)list.size(), (double)eta));
+          }
+        }
+      }
+      solvedNow += (PetscInt)list.size();
+      return 0;
+    };
+    PetscCall(PetscTime(&tSnap0));
+    PetscCall(PetscLogEventBegin(OFF_Snapshots, 0, 0, 0, 0));
+    if (!greedy) PetscCall(solveList(todo));
+    else {
+      std::vector<PetscInt> init;
+      for (PetscInt i : todo)
+        if (i < ninitial) init.push_back(i);
+      PetscCall(solveList(init));
+      PetscCall(GreedyRounds(world, gopt, k, color, fom, cmap, order, train, ninitial, file, h, solveList, &rep));
+    }
+    PetscCall(PetscLogEventEnd(OFF_Snapshots, 0, 0, 0, 0));
+    PetscCall(file.Close());
+    PetscCall(PetscTime(&t1));
+
+    // statistics over every snapshot solved in this run
+    std::vector<int> myIts(itsSolved.begin(), itsSolved.end());
+    if (grank != 0) myIts.clear();
+    int              cnt = (int)myIts.size();
+    std::vector<int> counts(wsize), displs(wsize, 0);
+    PetscCallMPI(MPI_Allgather(&cnt, 1, MPI_INT, counts.data(), 1, MPI_INT, world));
+    for (int q = 1; q < wsize; ++q) displs[q] = displs[q - 1] + counts[q - 1];
+    std::vector<int> allIts(displs[wsize - 1] + counts[wsize - 1]);
+    PetscCallMPI(MPI_Allgatherv(myIts.data(), cnt, MPI_INT, allIts.data(), counts.data(), displs.data(), MPI_INT, world));
+
+    rep.root["stage"]       = "offline";
+    rep.root["scene"]       = scene.name;
+    rep.root["ntrain"]      = (long long)ntrain; // greedy: the pool (greedy.training_set_size: the points solved)
+    rep.root["train_type"]  = trainType;
+    rep.root["nparams"]     = (long long)np;
+    rep.root["fom_solves"]  = (long long)allIts.size();
+    rep.root["resumed"]     = (long long)done.size();
+    rep.root["ndofs"]       = (long long)ndofs;
+    rep.root["ncontact"]    = (long long)R;
+    JsonValue &ki           = rep.root["kacanov_iterations"];
+    if (!allIts.empty()) {
+      ki["min"]  = (long long)*std::min_element(allIts.begin(), allIts.end());
+      ki["max"]  = (long long)*std::max_element(allIts.begin(), allIts.end());
+      double sum = 0;
+      for (int v : allIts) sum += v;
+      ki["mean"] = sum / allIts.size();
+    }
+    JsonValue at;
+    fom.affine.Describe(&at);
+    rep.root["affine_terms"]          = at;
+    rep.root["time_s"]["snapshots"]   = (double)(t1 - tSnap0);
+    rep.root["time_s"]["total"]       = (double)(t1 - t0);
+    rep.root["nranks"]                = (int)wsize;
+    rep.root["subcomms"]              = (long long)k;
+    rep.root["snapshots"]             = snapPath;
+    if (bases) {
+      // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
+      PetscCall(OfflineBases(world, fom, order, s.snapshots, s.rom, h, &rep, scene.contact ? &cmap : nullptr, full, s.basis, greedy));
+      if (full && !s.basisView.empty()) PetscCall(WriteBasisView(world, scene, s.rom, s.basisView, &rep));
+      PetscCall(PetscTime(&t1));
+      rep.root["time_s"]["total"] = (double)(t1 - t0);
+    }
+    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), bases ? romPath : snapPath));
+  }
+  PetscCall(PetscSubcommDestroy(&psub));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

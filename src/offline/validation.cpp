@@ -1,0 +1,394 @@
+// src/offline/validation.cpp: the ROM against the FOM on a test set (include/rbcontact/validation.hpp).
+// For each test parameter: the FOM solve (timed), the ROM solve (median of -validate_repeat timed solves
+// after a warm-up; operators + EIM + Kacanov + QP, no I/O) and the ROM with exact reduced contact terms
+// (no EIM: the full contact patch, same quadrature), and their errors: u in the energy norm of A(mu),
+// lambda in the l2 norm weighted by the slave mass (int psi_i), the resultant contact force.
+// Sweep: the same for a series of truncations (N, R, Mk, Mg) of the ROM, a table of online median time
+// against max error (CSV and JSON); share/plot_speed_error.py draws it. The FOM is distributed over the
+// ranks, the ROM runs redundantly on every rank (identical data, identical answers).
+#include "rbcontact/validation.hpp"
+#include "rbcontact/rom_fields.hpp"
+#include "rbcontact/kacanov.hpp"
+#include "rbcontact/reduced_model.hpp"
+#include "rbcontact/rom_file.hpp"
+#include <algorithm>
+#include <numeric>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace rbc {
+
+PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &reportPath, ValidationSettings *s)
+{
+  PetscInt  nf = 32;
+  PetscReal fbuf[32];
+  PetscBool fset = PETSC_FALSE, sweep = s->sweep ? PETSC_TRUE : PETSC_FALSE;
+  char      sweepOut[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  {
+    std::string stem = reportPath.empty() ? "validate.json" : reportPath;
+    if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
+    PetscCall(PetscStrncpy(sweepOut, s->sweepOutput.empty() ? (stem + "_sweep").c_str() : s->sweepOutput.c_str(), sizeof sweepOut));
+  }
+  PetscOptionsBegin(comm, NULL, "rbcontact validate: the ROM against the FOM on a test set", "rbcontact");
+  PetscCall(PetscOptionsInt("-validate_repeat", "online solves per test parameter (the median is reported)", "", s->repeat, &s->repeat, NULL));
+  PetscCall(PetscOptionsBool("-validate_sweep", "also the speed-against-error sweep over truncated sizes", "", sweep, &sweep, NULL));
+  PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
+  PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
+  PetscOptionsEnd();
+  PetscCheck(s->repeat >= 1 && s->repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", s->repeat);
+  if (fset) s->fractions.assign(fbuf, fbuf + nf);
+  for (PetscReal f : s->fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
+  s->sweep       = sweep;
+  s->sweepOutput = sweepOut;
+  if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".json", "-validate_sweep_output"));
+  PetscFunctionReturn(0);
+}
+
+static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
+
+namespace {
+struct Errors {
+  std::vector<double> u, lambda, force;
+  std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
+  PetscInt            failed = 0;
+  std::string         firstFailure;
+  void Fill(JsonValue *j) const
+  {
+    auto mx   = [](const std::vector<double> &v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+    auto mean = [](const std::vector<double> &v) {
+      double s = 0;
+      for (double x : v) s += x;
+      return v.empty() ? 0.0 : s / v.size();
+    };
+    (*j)["n"]                   = (long long)u.size();
+    (*j)["max_rel_err_u"]       = mx(u);
+    (*j)["mean_rel_err_u"]      = mean(u);
+    (*j)["max_rel_err_lambda"]  = mx(lambda);
+    (*j)["mean_rel_err_lambda"] = mean(lambda);
+    (*j)["max_rel_err_force"]   = mx(force);
+    (*j)["rel_err_u"]           = u;
+    (*j)["rel_err_lambda"]      = lambda;
+    (*j)["rel_err_force"]       = force;
+    // the force computed online from the reduced solution (docs/online.md, "Outputs of interest"); null with the EIM
+    if (!forceOnline.empty() && forceOnline.size() == u.size()) {
+      (*j)["max_rel_err_force_online"] = mx(forceOnline);
+      (*j)["rel_err_force_online"]     = forceOnline;
+    } else {
+      (*j)["max_rel_err_force_online"] = JsonValue();
+      (*j)["rel_err_force_online"]     = JsonValue();
+    }
+    (*j)["failed"]              = (long long)failed;
+    if (failed) (*j)["first_failure"] = firstFailure;
+  }
+};
+
+// One test parameter's FOM solution.
+struct FomSolution {
+  std::vector<PetscReal> mu;
+  Vec                    u = nullptr, lambda = nullptr;
+  PetscReal              energyNorm = 0, lambdaNorm = 0, force[3] = {0, 0, 0};
+};
+
+double Median(std::vector<double> v)
+{
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+} // namespace
+
+// Relative errors of a reduced solution against the FOM solution F (A: the FOM matrix at F.mu).
+// ||e||_A(mu)^2 = sum_q thetaA_q(mu) e'A_q e (the affine terms: no copy of A(mu) per test parameter).
+static PetscErrorCode EnergyNorm2(const AffineDecomposition &aff, const std::vector<PetscReal> &mu, Vec e, Vec work, PetscReal *n2)
+{
+  PetscFunctionBeginUser;
+  const std::vector<PetscReal> th = aff.ThetaA(mu);
+  *n2                             = 0;
+  for (size_t q = 0; q < aff.Aq.size(); ++q) {
+    PetscScalar d;
+    PetscCall(MatMult(aff.Aq[q], e, work));
+    PetscCall(VecDot(e, work, &d));
+    *n2 += th[q] * PetscRealPart(d);
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode Compare(const ReducedModel &model, const RomBases &bases, const CanonicalOrder &order, const ContactSystem &sys, PetscInt dim, const AffineDecomposition &aff, const FomSolution &F, const ReducedSolution &sol, Vec work, Vec work2, Vec lwork, double *eu, double *el, double *ef)
+{
+  PetscFunctionBeginUser;
+  PetscCall(bases.Displacement(model, order, sol.v, work));
+  PetscCall(VecAYPX(work, -1.0, F.u)); // u_fom - u_rom
+  PetscReal e2;
+  PetscCall(EnergyNorm2(aff, F.mu, work, work2, &e2));
+  *eu = std::sqrt(std::max<PetscReal>(e2, 0)) / F.energyNorm;
+  std::vector<PetscReal> lam;
+  bases.Multipliers(model, sol.lambda, &lam);
+  PetscCall(CanonicalToMultipliers(order, lam, lwork));
+  ContactSummary cs;
+  PetscCall(SummarizeContact(sys, lwork, dim, &cs));
+  PetscReal df = 0, nf = 0;
+  for (PetscInt d = 0; d < dim; ++d) {
+    df += PetscSqr(cs.forceVec[d] - F.force[d]);
+    nf += PetscSqr(F.force[d]);
+  }
+  *ef = nf > 0 ? std::sqrt(df / nf) : std::sqrt(df);
+  // weighted l2: sum_i w_i (lambda_i - lambda_rom_i)^2
+  PetscCall(VecAYPX(lwork, -1.0, F.lambda));
+  PetscCall(VecPointwiseMult(lwork, lwork, lwork));
+  PetscScalar wl;
+  PetscCall(VecDot(lwork, sys.weight, &wl));
+  *el = F.lambdaNorm > 0 ? std::sqrt(std::max<PetscReal>(PetscRealPart(wl), 0)) / F.lambdaNorm : std::sqrt(std::max<PetscReal>(PetscRealPart(wl), 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::string &romPathIn, const ParameterSet &test, const ValidationSettings &settings, Report *report)
+{
+  Report        &rep = *report;
+  const char    *romPath = romPathIn.c_str(), *sweepOut = settings.sweepOutput.c_str();
+  const PetscInt repeat = settings.repeat;
+  const bool     sweep  = settings.sweep;
+  const auto    &fractions = settings.fractions;
+  ReducedModel   model, exact;
+  ElasticFOM     fom;
+  ContactMap     cmap;
+  KacanovSolver  kac;
+  CanonicalOrder order;
+  RomBases       bases;
+  std::string    romScene;
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  if (!VAL_FOM) {
+    PetscCall(PetscLogEventRegister("RBCValidateFOM", DM_CLASSID, &VAL_FOM));
+    PetscCall(PetscLogEventRegister("RBCValidateROM", DM_CLASSID, &VAL_ROM));
+  }
+  PetscCall(model.Open(romPath));
+  PetscCall(model.SetFromOptions());
+  PetscCall(RomReadAttr(romPath, "scene", &romScene));
+  PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), romPath, romScene.c_str(), romScene.c_str());
+  for (const auto &mu : test.points) PetscCall(model.par.CheckBox(comm, mu));
+
+  // the FOM of the scene (reference configuration, affine terms) and the bases
+  PetscCall(fom.Create(comm, scene));
+  PetscCall(CheckRomScene(comm, romPath, scene, fom.map)); // the same materials, loads, maps, mesh as offline
+  PetscCall(fom.SetupAffine());
+  PetscCall(order.BuildDofs(fom.elas));
+  PetscCall(bases.Read(comm, model, romPath, order.NumDofs()));
+  PetscCall(kac.SetFromOptions(comm));
+  PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+  PetscCall(kac.ShareFactor(fom, cmap));
+  const PetscInt dim = fom.elas.dim;
+
+  // the ROM without EIM: exact reduced contact terms on the full patch (the ROM's contact quadrature)
+  {
+    std::vector<unsigned long long> dims;
+    std::vector<double>             q;
+    PetscCall(RomReadDataset(romPath, "/online/eim_quadrature", &dims, &q));
+    std::shared_ptr<ContactPatch> full;
+    std::vector<PetscReal>        P;
+    PetscCall(BuildFullContact(fom, cmap, order, bases.modes, bases.N, bases.W, bases.r, (PetscInt)q[0], &full, &P));
+    PetscCall(exact.Open(romPath));
+    PetscCall(exact.SetFromOptions());
+    exact.SetExactContact(full, P);
+    exact.SetContactMode(ReducedModel::ContactMode::Exact);
+    PetscCall(exact.Truncate((PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; }), model.R(), -1, -1));
+  }
+
+  // FOM solutions of the test set (kept for the sweep)
+  const PetscInt           nt = (PetscInt)test.points.size();
+  std::vector<FomSolution> F(nt);
+  std::vector<double>      fomTimes;
+  std::vector<std::shared_ptr<ContactSystem>> sysAt(nt);
+  for (PetscInt j = 0; j < nt; ++j) {
+    F[j].mu = test.points[j];
+    PetscCall(PetscLogEventBegin(VAL_FOM, 0, 0, 0, 0));
+    PetscCall(PetscTime(&t0));
+    PetscCall(fom.SetMu(F[j].mu));
+    PetscCall(fom.AssembleAndFactor());
+    cmap.SetGeometry(&fom.map, F[j].mu);
+    PetscCall(kac.Solve(fom, cmap));
+    PetscCall(PetscTime(&t1));
+    PetscCall(PetscLogEventEnd(VAL_FOM, 0, 0, 0, 0));
+    fomTimes.push_back(t1 - t0);
+    PetscCall(VecDuplicate(fom.u, &F[j].u));
+    PetscCall(VecCopy(fom.u, F[j].u));
+    PetscCall(VecDuplicate(kac.lambda, &F[j].lambda));
+    PetscCall(VecCopy(kac.lambda, F[j].lambda));
+    Vec       Au;
+    PetscReal uAu;
+    PetscCall(VecDuplicate(fom.u, &Au));
+    PetscCall(EnergyNorm2(fom.affine, F[j].mu, fom.u, Au, &uAu));
+    PetscCall(VecDestroy(&Au));
+    F[j].energyNorm = std::sqrt(uAu);
+    Vec l2;
+    PetscCall(VecDuplicate(kac.lambda, &l2));
+    PetscCall(VecPointwiseMult(l2, kac.lambda, kac.lambda));
+    PetscScalar wl;
+    PetscCall(VecDot(l2, kac.sys.weight, &wl));
+    PetscCall(VecDestroy(&l2));
+    F[j].lambdaNorm = std::sqrt(PetscRealPart(wl));
+    ContactSummary cs;
+    PetscCall(SummarizeContact(kac.sys, kac.lambda, dim, &cs));
+    for (PetscInt d = 0; d < 3; ++d) F[j].force[d] = cs.forceVec[d];
+    // keep the contact system (weights, normals) of this solution
+    auto s = std::make_shared<ContactSystem>();
+    PetscCall(VecDuplicate(kac.sys.weight, &s->weight));
+    PetscCall(VecCopy(kac.sys.weight, s->weight));
+    for (PetscInt d = 0; d < dim; ++d) {
+      PetscCall(VecDuplicate(kac.sys.normal[d], &s->normal[d]));
+      PetscCall(VecCopy(kac.sys.normal[d], s->normal[d]));
+      PetscCall(VecDuplicate(kac.sys.coord[d], &s->coord[d]));
+      PetscCall(VecCopy(kac.sys.coord[d], s->coord[d]));
+    }
+    PetscCall(VecDuplicate(kac.sys.g, &s->g));
+    s->R   = kac.sys.R;
+    sysAt[j] = s;
+  }
+  Vec work, work2, lwork;
+  PetscCall(VecDuplicate(fom.u, &work));
+  PetscCall(VecDuplicate(fom.u, &work2));
+  PetscCall(VecDuplicate(kac.lambda, &lwork));
+
+  // ROM (timed) and ROM without EIM on the test set, for one truncation of the model
+  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    for (PetscInt j = 0; j < nt; ++j) {
+      ReducedSolution sol;
+      PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
+      PetscCall(m.Solve(F[j].mu, &sol)); // warm-up
+      if (timed) {
+        std::vector<double> ts;
+        for (PetscInt k = 0; k < repeat; ++k) {
+          PetscLogDouble a, b;
+          PetscCall(PetscTime(&a));
+          PetscCall(m.Solve(F[j].mu, &sol));
+          PetscCall(PetscTime(&b));
+          ts.push_back(b - a);
+        }
+        medians->push_back(Median(ts));
+      }
+      PetscCall(PetscLogEventEnd(VAL_ROM, 0, 0, 0, 0));
+      if (!sol.converged) {
+        if (!E->failed) E->firstFailure = sol.message;
+        ++E->failed;
+        continue;
+      }
+      if (its) its->push_back(sol.iterations);
+      double eu, el, ef;
+      PetscCall(Compare(m, bases, order, *sysAt[j], dim, fom.affine, F[j], sol, work, work2, lwork, &eu, &el, &ef));
+      E->u.push_back(eu);
+      E->lambda.push_back(el);
+      E->force.push_back(ef);
+      if ((PetscInt)sol.force.size() == dim) {
+        PetscReal df = 0, nf = 0;
+        for (PetscInt d = 0; d < dim; ++d) {
+          df += PetscSqr(sol.force[d] - F[j].force[d]);
+          nf += PetscSqr(F[j].force[d]);
+        }
+        E->forceOnline.push_back(nf > 0 ? std::sqrt(df / nf) : std::sqrt(df));
+      }
+    }
+    PetscFunctionReturn(0);
+  };
+  Errors                E, E0;
+  std::vector<double>   medians;
+  std::vector<PetscInt> romIts;
+  PetscCall(evaluate(model, true, &E, &medians, &romIts));
+  PetscCall(evaluate(exact, false, &E0, nullptr, nullptr));
+  PetscCheck(!E.failed, comm, PETSC_ERR_NOT_CONVERGED, "validate: the ROM failed on %" PetscInt_FMT " of %" PetscInt_FMT " test parameters; first: %s", E.failed, nt, E.firstFailure.c_str());
+
+  rep.root["stage"] = "validate";
+  rep.root["scene"] = scene.name;
+  rep.root["rom_file"] = romPath;
+  rep.root["nranks"] = [&] { PetscMPIInt s; MPI_Comm_size(comm, &s); return (long long)s; }();
+  E.Fill(&rep.root["test"]);
+  E0.Fill(&rep.root["test_no_eim"]); // the ROM with exact contact terms (no hyper-reduction); key kept from the EIM-only releases
+  E0.Fill(&rep.root["test_exact"]);
+  {
+    std::vector<double> mus;
+    for (const auto &mu : test.points) mus.insert(mus.end(), mu.begin(), mu.end());
+    rep.root["test"]["mu"] = mus;
+  }
+  const double onlineMedian = Median(medians), fomMedian = Median(fomTimes);
+  rep.root["online_time_s"]["median"] = onlineMedian;
+  rep.root["online_time_s"]["max"]    = medians.empty() ? 0.0 : *std::max_element(medians.begin(), medians.end());
+  rep.root["online_time_s"]["per_parameter_median"] = medians;
+  rep.root["online_time_s"]["repeat"] = (long long)repeat;
+  rep.root["fom_time_s"]["median"]    = fomMedian;
+  rep.root["fom_time_s"]["all"]       = fomTimes;
+  rep.root["speedup_median"]          = onlineMedian > 0 ? fomMedian / onlineMedian : 0.0;
+  rep.root["rom_kacanov_iterations"]["max"] = (long long)(romIts.empty() ? 0 : *std::max_element(romIts.begin(), romIts.end()));
+  {
+    std::vector<double> its(romIts.begin(), romIts.end());
+    rep.root["rom_kacanov_iterations"]["mean"]          = its.empty() ? 0.0 : std::accumulate(its.begin(), its.end(), 0.0) / its.size();
+    rep.root["rom_kacanov_iterations"]["per_parameter"] = its;
+  }
+  JsonValue &ro = rep.root["rom"];
+  ro["N"]  = (long long)model.N();
+  ro["R"]  = (long long)model.R();
+  ro["Mk"] = (long long)model.Mk();
+  ro["Mg"] = (long long)model.Mg();
+  ro["Mc"] = (long long)model.Mc();
+  ro["hyper"] = model.HyperName();
+  ro["ecsw_sum"] = model.EcswSumsByDofs() ? "dofs" : "points";
+  ro["ndofs"] = (long long)order.NumDofs();
+
+  // speed against error over truncations of the same ROM
+  if (sweep) {
+    JsonValue         &rows = rep.root["sweep"];
+    std::ostringstream csv;
+    csv << "N,R,Mk,Mg,online_median_s,max_rel_err_u,max_rel_err_lambda,max_rel_err_force,failed\n";
+    const PetscInt Npod = (PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; });
+    const PetscInt R0 = model.R(), Mk0 = model.Mk(), Mg0 = model.Mg();
+    for (PetscReal fr : fractions) {
+      const PetscInt n = std::max<PetscInt>(1, (PetscInt)std::ceil(fr * Npod - 1e-9)), r = std::max<PetscInt>(1, (PetscInt)std::ceil(fr * R0 - 1e-9));
+      const PetscInt mk = (PetscInt)std::ceil(fr * Mk0 - 1e-9), mg = (PetscInt)std::ceil(fr * Mg0 - 1e-9);
+      PetscCall(model.Truncate(n, r, mk, mg));
+      Errors              Es;
+      std::vector<double> meds;
+      PetscCall(evaluate(model, true, &Es, &meds, nullptr));
+      JsonValue row;
+      auto      mx = [](const std::vector<double> &v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); };
+      row["N"] = (long long)model.N();
+      row["R"] = (long long)r;
+      row["Mk"] = (long long)mk;
+      row["Mg"] = (long long)mg;
+      row["online_median_s"] = Median(meds);
+      row["max_rel_err_u"] = Es.failed ? NAN : mx(Es.u);
+      row["max_rel_err_lambda"] = Es.failed ? NAN : mx(Es.lambda);
+      row["max_rel_err_force"] = Es.failed ? NAN : mx(Es.force);
+      row["failed"] = (long long)Es.failed;
+      if (Es.failed) row["first_failure"] = Es.firstFailure;
+      csv.precision(6);
+      csv << model.N() << "," << r << "," << mk << "," << mg << "," << Median(meds) << "," << row["max_rel_err_u"].AsNumber() << "," << row["max_rel_err_lambda"].AsNumber() << "," << row["max_rel_err_force"].AsNumber() << "," << Es.failed << "\n";
+      rows.Push(row);
+    }
+    PetscCall(model.Truncate(Npod, R0, Mk0, Mg0));
+    csv << "# FOM median " << fomMedian << " s\n";
+    JsonValue table;
+    table["rows"]            = rows;
+    table["fom_median_s"]    = fomMedian;
+    table["fom_tolerance"]   = (double)std::max(kac.loop.rtolPrimal, kac.loop.rtolDual);
+    table["scene"]           = scene.name;
+    table["hyper"]           = model.HyperName();
+    table["Mc"]              = (long long)model.Mc();
+    table["ndofs"]           = (long long)order.NumDofs();
+    PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".csv", csv.str()));
+    PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".json", table.Dump()));
+    rep.root["sweep_files"] = std::string(sweepOut) + ".{csv,json}";
+  }
+  PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " %s: max rel err u %.3e lambda %.3e force %.3e (exact contact terms: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), model.HyperSizes().c_str(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
+  for (auto &s : F) {
+    PetscCall(VecDestroy(&s.u));
+    PetscCall(VecDestroy(&s.lambda));
+  }
+  PetscCall(VecDestroy(&work));
+  PetscCall(VecDestroy(&work2));
+  PetscCall(VecDestroy(&lwork));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
