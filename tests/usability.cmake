@@ -1,7 +1,8 @@
 # tests/usability.cmake -- what a PETSc user meets driving rbcontact from outside: provenance in every
 # report and HDF5 file, the report of a failed run, -help, the boundary options renamed out of PETSc's
 # -bc_ namespace, the README's iterative solver on a contact scene (tests/usability_checks.py), the
-# installation (tests/install_check.sh).
+# installation (tests/install_check.sh), the "your own scene" tutorial with the installed package
+# (tests/tutorial_check.sh, docs/tutorial.md).
 find_program(RBC_PYTHON3_U NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_UC ${RBC_PYTHON3_U} ${CMAKE_CURRENT_SOURCE_DIR}/usability_checks.py)
 foreach(np 1 2)
@@ -17,3 +18,7 @@ set_tests_properties(usability_gamg_np2 PROPERTIES PROCESSORS 2)
 # cmake --install into a fresh prefix; the installed binary and two outside programs (find_package, pkg-config)
 add_test(NAME usability_install COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/install_check.sh ${CMAKE_BINARY_DIR})
 set_tests_properties(usability_install PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 LABELS usability)
+# docs/tutorial.md as written: cmake --install into a fresh prefix, its .geo/.opts blocks and commands from an
+# empty directory with the installed binary (1 rank, about 15 s)
+add_test(NAME usability_tutorial COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tutorial_check.sh ${CMAKE_BINARY_DIR})
+set_tests_properties(usability_tutorial PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)
