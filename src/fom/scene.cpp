@@ -1,5 +1,6 @@
 // src/fom/scene.cpp: parses a scene from the options database and checks its values.
 #include "rbcontact/scene.hpp"
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -238,6 +239,33 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   scene->contact = (!scene->slave.empty() || !scene->master.empty()) ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-contact", "Solve with contact (default: when a pair is given)", kMan, scene->contact, &scene->contact, NULL));
 
+  { // the options that name a body (-map_<body>[_...], -param_E_<body>, -param_nu_<body>) must name one of -bodies:
+    // a misspelled body would otherwise leave its map or parameter silently unused (the run "succeeds")
+    char *all = NULL;
+    PetscCall(PetscOptionsGetAll(NULL, &all));
+    std::istringstream in(all ? all : "");
+    PetscCall(PetscFree(all));
+    auto lower = [](std::string x) {
+      for (auto &c : x) c = (char)std::tolower((unsigned char)c);
+      return x;
+    };
+    std::string tok, names;
+    for (const auto &b : scene->bodies) names += (names.empty() ? "" : ", ") + b.name;
+    while (in >> tok) {
+      if (tok.size() < 2 || tok[0] != '-' || !std::isalpha((unsigned char)tok[1])) continue;
+      const std::string name = lower(tok.substr(1));
+      for (const std::string pre : {"map_", "param_e_", "param_nu_"}) {
+        if (name.compare(0, pre.size(), pre) != 0) continue;
+        const std::string rest = name.substr(pre.size());
+        bool              ok   = false;
+        for (const auto &b : scene->bodies) {
+          const std::string bn = lower(b.name);
+          ok = ok || rest == bn || (pre == "map_" && rest.compare(0, bn.size() + 1, bn + "_") == 0);
+        }
+        PetscCheck(ok, comm, PETSC_ERR_USER_INPUT, "option %s names no body of -bodies (%s): a misspelled body name?", tok.c_str(), names.c_str());
+      }
+    }
+  }
   // Material and load parameters: -param_E_<body>, -param_nu_<body>, -param_bc_<label>, -param_t_<label>
   auto paramIndex = [&](const std::string &opt, PetscInt *idx) -> PetscErrorCode {
     char      nm[128];

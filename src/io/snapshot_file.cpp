@@ -257,7 +257,7 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
     if (!ReadHeaderH5(c, file->get(), &fh)) return false;
     const std::string diff = SnapshotHeaderDiff(fh, h);
     if (!diff.empty()) {
-      c.err = "Snapshot file '" + path + "' was made for another scene/mesh/parameter box: " + diff + "; delete it or start without restart";
+      c.err = "Snapshot file '" + path + "' was made for another scene/mesh/parameter box: " + diff + "; delete it, give another file (-rom or -snapshots), or start afresh with -snapshots_restart 0";
       return false;
     }
     return ReadDone(c, file->get(), h.trainingPoints.size(), done);

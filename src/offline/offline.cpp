@@ -390,7 +390,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }
-    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " groups of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, (double)(t1 - t0), bases ? romPath : snapPath));
+    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " group%s of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, k == 1 ? "" : "s", (double)(t1 - t0), bases ? romPath : snapPath));
   }
   PetscCall(PetscSubcommDestroy(&psub));
   PetscFunctionReturn(0);
