@@ -80,6 +80,7 @@ struct Solution {
   bool                converged = false;
   PetscInt            iterations = 0;
   double              contactForce = std::numeric_limits<double>::quiet_NaN();
+  double              maxPressure = std::numeric_limits<double>::quiet_NaN(), halfwidth = std::numeric_limits<double>::quiet_NaN(), contactLength = std::numeric_limits<double>::quiet_NaN();
   std::string         message;
 };
 
@@ -126,6 +127,13 @@ public:
     s.converged  = sol.converged;
     s.iterations = sol.iterations;
     if (!sol.force.empty() && sol.converged) s.contactForce = sol.ForceMagnitude();
+    if (sol.converged) {
+      rbc::SurfaceOutputValues so;
+      model_.SurfaceOutputsOf(m, sol, &so);
+      s.maxPressure   = so.maxPressure;
+      s.halfwidth     = so.halfwidth;
+      s.contactLength = so.contactLength;
+    }
     s.message = sol.message;
     return s;
   }
@@ -246,6 +254,9 @@ PYBIND11_MODULE(_rbcontact, m)
     .def_readonly("lambda_hat", &Solution::lambda_hat, "reduced multiplier coordinates (R)")
     .def_readonly("force", &Solution::force, "resultant contact force vector (dim; empty with the EIM)")
     .def_readonly("contact_force", &Solution::contactForce, "its norm (the FOM report's contact_force; nan with the EIM)")
+    .def_readonly("max_pressure", &Solution::maxPressure, "max nodal contact pressure (the FOM report's max_pressure; nan without the ROM file's surface data)")
+    .def_readonly("contact_halfwidth", &Solution::halfwidth, "2D: the moment half-width of the pressure (the FOM report's contact_halfwidth_moment)")
+    .def_readonly("contact_length", &Solution::contactLength, "2D: twice the half-width")
     .def_readonly("converged", &Solution::converged)
     .def_readonly("iterations", &Solution::iterations, "reduced Kacanov iterations")
     .def_readonly("message", &Solution::message, "why the solve failed (empty on success)")

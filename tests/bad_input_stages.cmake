@@ -24,6 +24,9 @@ rbc_bad_stage(dualbasis_missing_file "nosuch[.]h5" dualbasis -snapshots nosuch.h
 rbc_bad_stage(real_value_unparsed "Input string 100abc has no numeric value [(]option -body_E 100abc,100[)]" fom -options_file runs/ring_on_block.opts -body_E 100abc,100)
 rbc_bad_stage(int_value_unparsed "Input string 2x has no integer value.*[(]option -mesh_refine 2x[)]" fom -options_file runs/ring_on_block.opts -mesh_refine 2x)
 rbc_bad_stage(bool_value_unparsed "Unknown logical value: maybe [(]option -contact maybe[)]" fom -options_file runs/ring_on_block.opts -contact maybe)
+# an option naming a body that -bodies does not declare (a misspelled body left its map silently unused)
+rbc_bad_stage(map_unknown_body "option -map_rign names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -map_rign dilation)
+rbc_bad_stage(param_unknown_body "option -param_E_blok names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -param_E_blok radius)
 # the parameter names in a count mismatch; an out-of-box value with the digits that were given
 rbc_bad_stage(mu_count "-mu has 2 values; the scene has 1 parameters [(]radius, in this order[)]" fom -options_file runs/ring_on_block.opts -mu 1,1.1)
 rbc_bad_stage(mu_outside_box_digits "'radius' = 1.1500000001 is outside its box [[]0.95, 1.15[]]" fom -options_file runs/ring_on_block.opts -mu 1.1500000001)

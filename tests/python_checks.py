@@ -75,6 +75,10 @@ def main():
         check(s.converged and s.iterations >= 1 and s.v.shape == (m.N,) and s.lambda_hat.shape == (m.R,) and s.message == "", "solve([%g]): converged in %d iterations, v (%d), lambda_hat (%d)" % (r, s.iterations, m.N, m.R))
         check(s.force.shape == (2,) and abs(np.linalg.norm(s.force) - s.contact_force) <= 1e-14 * s.contact_force, "force vector %s, its norm = contact_force" % s.force)
         check(abs(s.contact_force - ff) <= 1e-3 * ff, "contact force %.8f vs the FOM's %.8f (rel %.1e <= 1e-3)" % (s.contact_force, ff, abs(s.contact_force - ff) / ff))
+        fj = json.load(open(d + "/fom.json"))
+        pm, hw = fj["max_pressure"], fj["contact_halfwidth_moment"]
+        check(abs(s.max_pressure - pm) <= 1e-2 * pm and abs(s.contact_halfwidth - hw) <= 1e-2 * hw and s.contact_length == 2 * s.contact_halfwidth,
+              "max pressure %.6f and half-width %.6f vs the FOM's %.6f, %.6f (rel %.1e, %.1e <= 1e-2)" % (s.max_pressure, s.contact_halfwidth, pm, hw, abs(s.max_pressure - pm) / pm, abs(s.contact_halfwidth - hw) / hw))
         check(np.array_equal(m.contact_forces(np.array([[r]])), np.array([s.contact_force])), "contact_forces on an (n, 1) array = solve")
 
         def raises(f, words, what):

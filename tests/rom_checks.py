@@ -164,7 +164,9 @@ def pipeline(args):
     check(t["max_rel_err_lambda"] <= 1e-2, "max rel err lambda %.2e <= 1e-2" % t["max_rel_err_lambda"])
     fo = t["max_rel_err_force_online"]
     check(fo is not None and fo <= 1e-3, "the contact force computed online (no mesh) against the FOM's: max rel err %s <= 1e-3" % fo)
-    for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force", "max_rel_err_force_online"):
+    pm, hw = t["max_rel_err_max_pressure_online"], t["max_rel_err_halfwidth_online"]
+    check(pm is not None and pm <= 1e-2 and hw is not None and hw <= 1e-2, "max pressure and contact half-width computed online (no mesh) against the FOM's: max rel err %s, %s <= 1e-2" % (pm, hw))
+    for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force", "max_rel_err_force_online", "max_rel_err_max_pressure_online", "max_rel_err_halfwidth_online"):
         a, b = val[1]["test"][k], val[2]["test"][k]
         check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
     check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
@@ -197,6 +199,8 @@ def pipeline(args):
     check(fo is not None and abs(fo - rf["contact_force"]) <= 1e-3 * rf["contact_force"] and len(rr["outputs"]["force"]) == 2,
           "online contact force (no mesh) %.6e vs FOM %.6e (rel %.1e <= 1e-3)" % (fo, rf["contact_force"], abs(fo - rf["contact_force"]) / rf["contact_force"]))
     check(xr.shape == xf.shape and np.abs(xr - xf).max() <= 1e-12, "reconstructed fields on the FOM's (physical, radius 1.02) configuration")
+    po = rr["outputs"]["max_pressure"]
+    check(po is not None and abs(po - rr["max_pressure"]) <= 1e-12 * rr["max_pressure"], "online max pressure (surface data of the ROM file) %.12g = that of the reconstructed field on the mesh %.12g" % (po, rr["max_pressure"]))
     shutil.rmtree(d, ignore_errors=True)
 
 

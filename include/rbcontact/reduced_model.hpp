@@ -18,6 +18,7 @@
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/reduced_qp.hpp"
+#include "rbcontact/surface_outputs.hpp"
 #include "rbcontact/rom_file.hpp"
 
 namespace rbc {
@@ -132,6 +133,10 @@ public:
   ContactPatch           patch;                      // local data around the EIM and cubature points
   std::vector<PetscReal> warmMu, warmV, warmL;       // training parameters and their reduced solutions
   std::vector<PetscReal> dualGram;                   // W'W (Rfull x Rfull): the Kacanov change of lambda = W lambda^ is measured in it
+  SurfaceOutputs         surface;                    // the dual basis on the slave vertices and the slave facets (optional)
+  // Max pressure and (2D) contact half-width of sol at mu from the reduced multipliers (NaN when the file has no
+  // /online/outputs, or without an online force for the half-width); not part of Solve: called when wanted.
+  void SurfaceOutputsOf(const std::vector<PetscReal> &mu, const ReducedSolution &sol, SurfaceOutputValues *out) const { surface.Evaluate(par.map, mu, sol.lambda, sol.force, out); }
   // options
   // -rom_kacanov_max_it (30), _rtol_primal, _rtol_dual, _relaxation, _anderson (3), _monitor: the loop shared with
   // the FOM (kacanov_loop.hpp). Tolerances matched to the ROM's accuracy targets (docs/online.md): 1e-5 on the

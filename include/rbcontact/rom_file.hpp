@@ -34,6 +34,8 @@ private:
 // Reads a dataset (any rank, independent); errors name the file and the dataset.
 PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, std::vector<unsigned long long> *dims, std::vector<double> *data);
 PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value);
+// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
+PetscErrorCode RomReadOptional(const std::string &path, const std::string &name, std::vector<double> *data, bool *found);
 // The integer format_version attribute.
 PetscErrorCode RomReadVersion(const std::string &path, int *version);
 

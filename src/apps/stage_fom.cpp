@@ -73,6 +73,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["contact_force"]      = (double)cs.force;
     rep.root["max_pressure"]       = (double)cs.maxPressure;
     rep.root["contact_halfwidth"]  = (double)cs.halfwidth;
+    rep.root["contact_halfwidth_moment"] = (double)cs.halfwidthMoment; // 2 sqrt(int p s^2 / int p - ...): Hertz's a; the ROM's online half-width
     rep.root["pressure_spread"]    = (double)cs.pressureSpread;
     rep.root["pressure_roughness"] = (double)cs.pressureRoughness;
     JsonValue &k                   = rep.root["kkt"];

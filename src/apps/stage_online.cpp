@@ -90,6 +90,11 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     o["contact_force"] = (double)sol.ForceMagnitude();
     o["force"]         = std::vector<double>(sol.force.begin(), sol.force.end());
   }
+  SurfaceOutputValues so; // NaN (JSON null) without the surface data or the online force
+  model.SurfaceOutputsOf(mu, sol, &so);
+  o["max_pressure"]      = (double)so.maxPressure;
+  o["contact_halfwidth"] = (double)so.halfwidth;
+  o["contact_length"]    = (double)so.contactLength;
   JsonValue &k                   = rep.root["kkt"];
   k["primal_infeas"]             = (double)sol.qp.primal;
   k["dual_infeas"]               = (double)sol.qp.dual;

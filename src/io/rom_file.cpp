@@ -127,4 +127,19 @@ PetscErrorCode RomReadVersion(const std::string &path, int *version)
   PetscFunctionReturn(0);
 }
 
+// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
+PetscErrorCode RomReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found)
+{
+  std::vector<unsigned long long> dims;
+  PetscErrorCode   ierr;
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = RomReadDataset(file, name, &dims, data);
+  PetscCall(PetscPopErrorHandler());
+  *found = !ierr;
+  if (*found)
+    for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
+  PetscFunctionReturn(0);
+}
+
 } // namespace rbc

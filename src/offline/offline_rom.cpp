@@ -6,6 +6,7 @@
 // restricted to the facets around the EIM points; warm starts. Every rank of the group computes the
 // same (deterministic) data; world rank 0 writes it.
 #include "rbcontact/offline_rom.hpp"
+#include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/empirical_cubature.hpp"
@@ -422,6 +423,31 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   }
   PetscCall(PetscLogEventEnd(OFF_EIM, 0, 0, 0, 0));
   PetscCall(PetscTime(&t2));
+  // outputs of interest on the slave surface (max pressure, contact half-width; surface_outputs.hpp): the dual
+  // basis on the slave vertices and the slave facets; their weights checked against the FOM's at the default
+  PetscReal surfaceWeightDiff = -1;
+  {
+    std::vector<SurfaceFacet> facets;
+    PetscCall(cmap.Slave().Gather(PetscObjectComm((PetscObject)fom.dm), &facets));
+    const PetscInt        Rfom = dual.W.rows;
+    std::vector<PetscInt> canon(Rfom);
+    for (PetscInt g = 0; g < Rfom; ++g) canon[g] = order.CanonicalMultiplier(g);
+    rm.surface.Build(fom.elas.dim, facets, canon, Rfom, R, dual.W.a);
+    ContactSystem          sys;
+    std::vector<PetscReal> wf, wc(Rfom), ws, xs;
+    PetscCall(AssembleReferenceContact(fom, cmap, order, &sys));
+    PetscCall(GatherVec(sys.weight, &wf));
+    for (PetscInt g = 0; g < Rfom; ++g) wc[canon[g]] = wf[g];
+    rm.surface.Weights(fom.map, ParamValues(fom.scene), &ws, &xs);
+    PetscReal dmax = 0, wmax = 0;
+    for (PetscInt i = 0; i < Rfom; ++i) {
+      dmax = std::max(dmax, std::abs(ws[i] - wc[i]));
+      wmax = std::max(wmax, std::abs(wc[i]));
+    }
+    surfaceWeightDiff = wmax > 0 ? dmax / wmax : dmax;
+    // a multiplier space whose int psi_i is not |facet| / vertices (not ours today): no surface outputs rather than wrong ones
+    if (!(surfaceWeightDiff <= 1e-10)) rm.surface = SurfaceOutputs();
+  }
   if (wrank == 0) {
     WriteReducedModel(rm, w);
     w->Dataset("/online/eim_quadrature", {1}, {(double)nsub}); // the contact quadrature of kappa, gamma (validation)
@@ -503,6 +529,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["Mc"] = (long long)rm.Mc();
   ro["Mk_stored"] = (long long)rm.MkFull;
   ro["Mg_stored"] = (long long)rm.MgFull;
+  ro["surface_outputs"] = !rm.surface.Empty();                 // max pressure, contact half-width online
+  ro["surface_weight_check"] = (double)surfaceWeightDiff;      // max rel diff of int psi_i: facets vs the FOM
   ro["affine_A"] = (long long)rm.par.NumA();
   ro["affine_f"] = (long long)rm.par.NumF();
   rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);

@@ -53,6 +53,7 @@ namespace {
 struct Errors {
   std::vector<double> u, lambda, force;
   std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
+  std::vector<double> pmaxOnline, halfwidthOnline; // the online max pressure and half-width (surface_outputs.hpp)
   PetscInt            failed = 0;
   std::string         firstFailure;
   void Fill(JsonValue *j) const
@@ -80,6 +81,14 @@ struct Errors {
       (*j)["max_rel_err_force_online"] = JsonValue();
       (*j)["rel_err_force_online"]     = JsonValue();
     }
+    auto online = [&](const char *key, const std::vector<double> &v) {
+      if (!v.empty() && v.size() == u.size()) {
+        (*j)[std::string("max_rel_err_") + key + "_online"] = mx(v);
+        (*j)[std::string("rel_err_") + key + "_online"]     = v;
+      } else (*j)[std::string("max_rel_err_") + key + "_online"] = JsonValue();
+    };
+    online("max_pressure", pmaxOnline);
+    online("halfwidth", halfwidthOnline);
     (*j)["failed"]              = (long long)failed;
     if (failed) (*j)["first_failure"] = firstFailure;
   }
@@ -89,7 +98,7 @@ struct Errors {
 struct FomSolution {
   std::vector<PetscReal> mu;
   Vec                    u = nullptr, lambda = nullptr;
-  PetscReal              energyNorm = 0, lambdaNorm = 0, force[3] = {0, 0, 0};
+  PetscReal              energyNorm = 0, lambdaNorm = 0, force[3] = {0, 0, 0}, maxPressure = 0, halfwidth = 0;
 };
 
 double Median(std::vector<double> v)
@@ -233,6 +242,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     ContactSummary cs;
     PetscCall(SummarizeContact(kac.sys, kac.lambda, dim, &cs));
     for (PetscInt d = 0; d < 3; ++d) F[j].force[d] = cs.forceVec[d];
+    F[j].maxPressure = cs.maxPressure;
+    F[j].halfwidth   = cs.halfwidthMoment;
     // keep the contact system (weights, normals) of this solution
     auto s = std::make_shared<ContactSystem>();
     PetscCall(VecDuplicate(kac.sys.weight, &s->weight));
@@ -290,6 +301,10 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         }
         E->forceOnline.push_back(nf > 0 ? std::sqrt(df / nf) : std::sqrt(df));
       }
+      SurfaceOutputValues so;
+      m.SurfaceOutputsOf(F[j].mu, sol, &so);
+      if (std::isfinite(so.maxPressure) && F[j].maxPressure > 0) E->pmaxOnline.push_back(std::abs(so.maxPressure - F[j].maxPressure) / F[j].maxPressure);
+      if (std::isfinite(so.halfwidth) && F[j].halfwidth > 0) E->halfwidthOnline.push_back(std::abs(so.halfwidth - F[j].halfwidth) / F[j].halfwidth);
     }
     PetscFunctionReturn(0);
   };

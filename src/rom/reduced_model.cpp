@@ -58,20 +58,7 @@ PetscErrorCode ReadChecked(const std::string &file, const std::string &name, siz
   PetscFunctionReturn(0);
 }
 
-// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
-PetscErrorCode ReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found)
-{
-  std::vector<U64> dims;
-  PetscErrorCode   ierr;
-  PetscFunctionBeginUser;
-  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = RomReadDataset(file, name, &dims, data);
-  PetscCall(PetscPopErrorHandler());
-  *found = !ierr;
-  if (*found)
-    for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
-  PetscFunctionReturn(0);
-}
+PetscErrorCode ReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found) { return RomReadOptional(file, name, data, found); }
 
 std::vector<PetscInt> ToInt(const std::vector<double> &d) { return std::vector<PetscInt>(d.begin(), d.end()); }
 } // namespace
@@ -216,6 +203,7 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
     w->Dataset("/online/gap/C", {(U64)m.MgFull, R}, m.gC);
   }
   w->Dataset("/online/dual_gram", {R, R}, m.dualGram);
+  m.surface.Write(w);
   if (!m.cPoint.empty()) {
     w->Dataset("/online/ecsw/points", {(U64)m.cPoint.size()}, std::vector<double>(m.cPoint.begin(), m.cPoint.end()));
     w->Dataset("/online/ecsw/Pw", {R, (U64)m.cPoint.size()}, m.cPw);
@@ -327,6 +315,10 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       MkDefault = (PetscInt)d[0];
       MgDefault = (PetscInt)d[1];
     }
+  }
+  { // optional (files of before 2026-11-25): the surface data of the max pressure and the contact half-width
+    bool found;
+    PetscCall(surface.Read(path, &found));
   }
   PetscCall(Truncate(-1, -1, -1, -1));
   PetscFunctionReturn(0);

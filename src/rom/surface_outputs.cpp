@@ -1,0 +1,118 @@
+// src/rom/surface_outputs.cpp: the maximum pressure and the contact half-width of a reduced solution from
+// the dual basis on the slave vertices and the slave facets (include/rbcontact/surface_outputs.hpp).
+#include "rbcontact/surface_outputs.hpp"
+#include <algorithm>
+#include <cmath>
+
+namespace rbc {
+
+static constexpr size_t kRec = 14; // body, nv, row[3], Xref[9]
+
+void SurfaceOutputs::Build(PetscInt dim, const std::vector<SurfaceFacet> &slave, const std::vector<PetscInt> &canonRow, PetscInt Rfom, PetscInt r, const std::vector<PetscReal> &Wc)
+{
+  dim_  = dim;
+  Rfom_ = Rfom;
+  r_    = r;
+  W_.assign((size_t)r * Rfom, 0.0);
+  for (PetscInt k = 0; k < r; ++k)
+    for (PetscInt i = 0; i < Rfom; ++i) W_[(size_t)k * Rfom + i] = Wc[i + (size_t)k * Rfom];
+  facets_.clear();
+  for (const auto &F : slave) {
+    std::vector<PetscReal> rec(kRec, -1.0);
+    rec[0] = F.body;
+    rec[1] = F.nv;
+    for (PetscInt k = 0; k < F.nv; ++k) rec[2 + k] = F.row[k] >= 0 ? canonRow[F.row[k]] : -1;
+    for (PetscInt i = 0; i < 9; ++i) rec[5 + i] = F.Xref[i];
+    facets_.insert(facets_.end(), rec.begin(), rec.end());
+  }
+}
+
+void SurfaceOutputs::Weights(const GeometryMap &map, const std::vector<PetscReal> &mu, std::vector<PetscReal> *w, std::vector<PetscReal> *x) const
+{
+  w->assign(Rfom_, 0.0);
+  x->assign((size_t)Rfom_ * 3, 0.0);
+  for (size_t f = 0; f + kRec <= facets_.size(); f += kRec) {
+    const PetscReal *rec = &facets_[f];
+    const PetscInt   nv  = (PetscInt)rec[1];
+    const Affine     a   = map.Evaluate((PetscInt)rec[0], mu);
+    PetscReal        X[9] = {0};
+    for (PetscInt k = 0; k < nv; ++k) a.Apply(dim_, rec + 5 + k * dim_, X + k * dim_);
+    // the facet's measure at mu (a segment or a triangle)
+    PetscReal meas = 0;
+    if (dim_ == 2) meas = std::hypot(X[2] - X[0], X[3] - X[1]);
+    else {
+      const PetscReal u[3] = {X[3] - X[0], X[4] - X[1], X[5] - X[2]}, v[3] = {X[6] - X[0], X[7] - X[1], X[8] - X[2]};
+      meas = 0.5 * std::sqrt(PetscSqr(u[1] * v[2] - u[2] * v[1]) + PetscSqr(u[2] * v[0] - u[0] * v[2]) + PetscSqr(u[0] * v[1] - u[1] * v[0]));
+    }
+    for (PetscInt k = 0; k < nv; ++k) {
+      const PetscInt i = (PetscInt)rec[2 + k];
+      if (i < 0 || i >= Rfom_) continue;
+      (*w)[i] += meas / nv;
+      for (PetscInt d = 0; d < dim_; ++d) (*x)[3 * (size_t)i + d] = X[k * dim_ + d];
+    }
+  }
+}
+
+void SurfaceOutputs::Write(RomWriter *w) const
+{
+  if (Empty()) return;
+  w->Dataset("/online/outputs/meta", {3}, {(double)dim_, (double)Rfom_, (double)r_});
+  w->Dataset("/online/outputs/W", {(unsigned long long)r_, (unsigned long long)Rfom_}, W_);
+  w->Dataset("/online/outputs/slave_facets", {(unsigned long long)(facets_.size() / kRec), (unsigned long long)kRec}, facets_);
+}
+
+PetscErrorCode SurfaceOutputs::Read(const std::string &file, bool *found)
+{
+  std::vector<double> meta;
+
+  PetscFunctionBeginUser;
+  Rfom_ = r_ = 0;
+  W_.clear();
+  facets_.clear();
+  PetscCall(RomReadOptional(file, "/online/outputs/meta", &meta, found));
+  if (!*found) PetscFunctionReturn(0);
+  PetscCheck(meta.size() == 3 && (meta[0] == 2 || meta[0] == 3) && meta[1] >= 1 && meta[2] >= 1, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs/meta is malformed", file.c_str());
+  dim_  = (PetscInt)meta[0];
+  Rfom_ = (PetscInt)meta[1];
+  r_    = (PetscInt)meta[2];
+  bool f1, f2;
+  PetscCall(RomReadOptional(file, "/online/outputs/W", &W_, &f1));
+  PetscCall(RomReadOptional(file, "/online/outputs/slave_facets", &facets_, &f2));
+  PetscCheck(f1 && f2 && W_.size() == (size_t)r_ * Rfom_ && facets_.size() % kRec == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs is incomplete or has the wrong sizes (corrupt file?)", file.c_str());
+  for (size_t f = 0; f < facets_.size(); f += kRec) {
+    const PetscInt nv = (PetscInt)facets_[f + 1];
+    PetscCheck(nv == dim_, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs/slave_facets: a facet with %" PetscInt_FMT " vertices in %" PetscInt_FMT "D", file.c_str(), nv, dim_);
+    for (PetscInt k = 0; k < nv; ++k) PetscCheck(facets_[f + 2 + k] >= -1 && facets_[f + 2 + k] < Rfom_, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs/slave_facets: a multiplier row out of range", file.c_str());
+  }
+  PetscFunctionReturn(0);
+}
+
+void SurfaceOutputs::Evaluate(const GeometryMap &map, const std::vector<PetscReal> &mu, const std::vector<PetscReal> &lhat, const std::vector<PetscReal> &force, SurfaceOutputValues *out) const
+{
+  *out = SurfaceOutputValues();
+  if (Empty() || lhat.empty() || (PetscInt)lhat.size() > r_) return;
+  std::vector<PetscReal> lam(Rfom_, 0.0), w, x;
+  for (size_t k = 0; k < lhat.size(); ++k)
+    for (PetscInt i = 0; i < Rfom_; ++i) lam[i] += lhat[k] * W_[k * Rfom_ + i];
+  out->maxPressure = 0;
+  for (PetscReal l : lam) out->maxPressure = std::max(out->maxPressure, l);
+  PetscReal fn = 0;
+  for (PetscReal f : force) fn += f * f;
+  fn = std::sqrt(fn);
+  if (dim_ != 2 || force.size() != 2 || !(fn > 0)) return;
+  Weights(map, mu, &w, &x);
+  const PetscReal t[2] = {-force[1] / fn, force[0] / fn};
+  PetscReal       m0 = 0, m1 = 0, m2 = 0;
+  for (PetscInt i = 0; i < Rfom_; ++i) {
+    const PetscReal s = x[3 * (size_t)i] * t[0] + x[3 * (size_t)i + 1] * t[1], f = lam[i] * w[i];
+    m0 += f;
+    m1 += f * s;
+    m2 += f * s * s;
+  }
+  if (m0 > 0) {
+    out->halfwidth     = 2 * std::sqrt(std::max<PetscReal>(0, m2 / m0 - (m1 / m0) * (m1 / m0)));
+    out->contactLength = 2 * out->halfwidth;
+  }
+}
+
+} // namespace rbc
