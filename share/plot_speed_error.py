@@ -40,6 +40,7 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import matplotlib.transforms as mtransforms
+    import matplotlib.ticker as mticker
 except ImportError as e:  # pragma: no cover
     fail("%s (interpreter %s). Run with /usr/bin/python3 after share/setup.sh "
          "(python3-numpy python3-matplotlib)" % (e, sys.executable))
@@ -212,9 +213,13 @@ def main(argv=None):
     palette = [("tab:blue", "tab:orange"), ("tab:green", "tab:red"), ("tab:purple", "tab:brown"), ("tab:cyan", "tab:olive"),
                ("tab:gray", "tab:pink")]
 
-    fig, ax = plt.subplots(figsize=(9.0, 6.2), layout="constrained")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    # two panels sharing the error axis: the reduced models (their times span a factor of a few) and the FOM
+    # (5-6 decades slower): one axis across both squeezed every ROM point and its label into a corner
+    fig, (ax, axf) = plt.subplots(1, 2, figsize=(10.0, 6.4), layout="constrained", sharey=True,
+                                  gridspec_kw=dict(width_ratios=[4.2, 1.0], wspace=0.02))
+    for x_ in (ax, axf):
+        x_.set_xscale("log")
+        x_.set_yscale("log")
     labels = []  # (x, y, text, color): placed once the axes are final
     xs, ys, bad_all, foms = [], [], [], []
     for ti, t in enumerate(tables):
@@ -244,10 +249,12 @@ def main(argv=None):
     if not ys and not bad_all:
         fail("%s: no row has a positive time and error to plot" % ", ".join(a.json))
 
-    # limits: all times and the FOM lines in x, all errors and targets in y (decades, with margins)
-    xall = xs + [f[0] for f in foms]
-    xlo, xhi = min(xall), max(xall)
-    ax.set_xlim(xlo / 2.5, xhi * 4.0)
+    # limits: the ROM times (left) and the FOM times (right) in x, all errors and targets in y
+    xlo, xhi = (min(xs), max(xs)) if xs else (1e-5, 1e-4)
+    ax.set_xlim(xlo / 1.5, xhi * 1.6)
+    if foms:
+        flo, fhi = min(f[0] for f in foms), max(f[0] for f in foms)
+        axf.set_xlim(flo / 3.0, fhi * 3.0)
     yall = ys + [tv for tv, _ in targets] + [f[1] for f in foms]
     ylo, yhi = (min(yall), max(yall)) if yall else (1e-3, 1.0)
     ylo, yhi = 10 ** math.floor(math.log10(ylo) - 0.15), 10 ** math.ceil(math.log10(yhi) + 0.15)
@@ -260,20 +267,21 @@ def main(argv=None):
             continue
         seen.add(key)
         tag = ("FOM, %s dofs" % ndofs) if (multi and ndofs is not None) else "FOM"
-        ax.axvline(fom, color="k", linestyle="--", linewidth=1.0, zorder=2)
-        ax.text(fom, 0.98, "%s (exact to solver tolerance) " % tag, rotation=90, ha="right", va="top",
-                fontsize=7.5, transform=mtransforms.blended_transform_factory(ax.transData, ax.transAxes),
-                bbox=dict(boxstyle="square,pad=0.05", facecolor="white", edgecolor="none", alpha=0.8))
+        axf.axvline(fom, color="k", linestyle="--", linewidth=1.0, zorder=2)
+        axf.text(fom, 0.98, "%s (exact to solver tolerance) " % tag, rotation=90, ha="right", va="top",
+                 fontsize=7.5, transform=mtransforms.blended_transform_factory(axf.transData, axf.transAxes),
+                 bbox=dict(boxstyle="square,pad=0.05", facecolor="white", edgecolor="none", alpha=0.8))
         # the FOM as a point: its error is the solver's tolerance (Kacanov, KKT)
-        ax.plot([fom], [fom_tol], marker="*", color="k", markersize=12, linestyle="none", zorder=4,
-                label="%s: median %.3g s, error ~ solver tolerance %.0e" % (tag, fom, fom_tol))
+        axf.plot([fom], [fom_tol], marker="*", color="k", markersize=12, linestyle="none", zorder=4,
+                 label="%s: median %.3g s, error ~ solver tolerance %.0e" % (tag, fom, fom_tol))
     if len(foms) == 1 or (foms and not multi):
         fom = foms[0][0]
         sec = ax.secondary_xaxis("top", functions=(lambda t: fom / np.maximum(t, 1e-300),
                                                    lambda s: fom / np.maximum(s, 1e-300)))
         sec.set_xlabel("speedup over the FOM (FOM median time / time per solve)", fontsize=9)
     for tv, tok in targets:
-        ax.axhline(tv, color="tab:green", linestyle=":", linewidth=1.2, zorder=1)
+        for x_ in (ax, axf):
+            x_.axhline(tv, color="tab:green", linestyle=":", linewidth=1.2, zorder=1)
         ax.text(0.995, tv, "target %s" % tok, ha="right", va="bottom", fontsize=8, color="tab:green",
                 transform=mtransforms.blended_transform_factory(ax.transAxes, ax.transData))
     if bad_all:  # failed truncations: crosses at the top edge (there is no error to plot)
@@ -286,12 +294,22 @@ def main(argv=None):
                             textcoords="offset points", fontsize=7, color="tab:red", va="top")
         ax.plot([], [], "x", color="tab:red", mew=2, label="truncation with failed solves (no error)")
 
-    ax.set_xlabel("time per online solve [s] (median)")
+    # the ROM panel spans less than a decade or two: ticks at 1, 2, 3, 5 x 10^k, in microseconds
+    ax.xaxis.set_major_locator(mticker.LogLocator(base=10, subs=(1.0, 2.0, 3.0, 5.0)))
+    ax.xaxis.set_minor_locator(mticker.LogLocator(base=10, subs=np.arange(1, 10)))
+    ax.xaxis.set_major_formatter(mticker.FuncFormatter(lambda t, _: "%g" % float("%.2g" % (t * 1e6))))
+    ax.xaxis.set_minor_formatter(mticker.NullFormatter())
+    ax.set_xlabel("reduced model: time per online solve [$\\mu$s] (median)")
+    axf.set_xlabel("full-order model [s]")
     ax.set_ylabel("max relative error over the test set")
-    ax.grid(True, which="major", alpha=0.35)
-    ax.grid(True, which="minor", alpha=0.12)
-    # legend below the axes: the plot area is for the points and their labels
-    leg = ax.legend(fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=2, frameon=False)
+    for x_ in (ax, axf):
+        x_.grid(True, which="major", alpha=0.35)
+        x_.grid(True, which="minor", alpha=0.12)
+    axf.tick_params(labelleft=False)
+    # legend below both panels: the plot area is for the points and their labels
+    hs, ls_ = ax.get_legend_handles_labels()
+    hf, lf = axf.get_legend_handles_labels()
+    leg = ax.legend(hs + hf, ls_ + lf, fontsize=7.5, loc="upper center", bbox_to_anchor=(0.6, -0.11), ncol=2, frameon=False)
     place_labels(fig, ax, labels, [leg])
     nrows = sum(len(t["rows"]) for t in tables)
     sub = "point labels: N,R (ECSW: reduced primal and dual sizes) or N,R,Mk,Mg (EIM: + kappa and gap terms); %d truncations" % nrows

@@ -184,6 +184,8 @@ def pipeline(args):
     rows = sw["rows"]
     check(len(rows) == 2 and os.path.exists(d + "/val1_sweep.csv"), "sweep table: 2 rows, CSV and JSON")
     check(abs(rows[-1]["max_rel_err_u"] - t["max_rel_err_u"]) <= 1e-12 * t["max_rel_err_u"], "sweep's full row = the main test (u %.3e)" % rows[-1]["max_rel_err_u"])
+    pp = subprocess.run(["/usr/bin/python3", "share/plot_speed_error.py", d + "/val1_sweep.json", "-o", d + "/se.png", "--targets", "1e-4,1e-2"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(pp.returncode == 0 and os.path.getsize(d + "/se.png") > 10000, "share/plot_speed_error.py draws the sweep (%s)" % pp.stdout.strip()[-80:])
 
     # reconstructed fields against the FOM at the same radius
     run(args, 2, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-rom_reconstruct", d + "/rec.h5", "-report", d + "/rec.json"])
