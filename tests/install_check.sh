@@ -29,6 +29,12 @@ grep -q "mesh file meshes/ring_on_block.geo -> $t/prefix/bin/../share/rbcontact/
   || { grep "mesh file" offline.log; fail "the installed binary did not use the installed mesh"; }
 [ -f rom.h5 ] || fail "no ROM file"
 echo "ok: installed binary, offline from an empty directory with the installed scene"
+# a missing mesh: the installed binary names where it looked, and that is not the build machine's checkout
+src=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build/CMakeCache.txt")
+"$t/prefix/bin/rbcontact" fom -options_file "$share/runs/ring_on_block.opts" -mesh_file meshes/nosuch.geo > missing.log 2>&1 && fail "a missing mesh was accepted"
+grep -q "Mesh file 'meshes/nosuch.geo' not found" missing.log || { cat missing.log; fail "no clear message for a missing mesh"; }
+if [ -n "$src" ] && grep "looked in" missing.log | grep -qF "$src"; then grep "looked in" missing.log; fail "the installed binary looks in the source tree $src"; fi
+echo "ok: the installed binary does not look in the source tree"
 
 # an outside program with find_package(rbcontact)
 mkdir "$t/app" && cat > "$t/app/CMakeLists.txt" <<'CM'

@@ -41,10 +41,13 @@ static bool FileExists(const std::string &p)
 
 // Where a relative data file (a mesh of runs/<scene>.opts) is looked for, in this order: the working
 // directory, $RBC_DATA_DIR, the installed share/rbcontact beside the running program (<bin>/../share/
-// rbcontact: an installed rbcontact, even moved), the configured install prefix's, the source tree.
+// rbcontact: an installed rbcontact, even moved), the configured install prefix's, and the source tree, the
+// last only for a program that is not installed (no share/rbcontact beside it: the build tree's binary, an
+// example): an installed binary never reads the build machine's checkout.
 static std::vector<std::string> DataDirs()
 {
   std::vector<std::string> d;
+  bool                     installed = false;
   if (const char *e = std::getenv("RBC_DATA_DIR")) d.push_back(e);
   char          exe[PETSC_MAX_PATH_LEN];
   const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -52,9 +55,11 @@ static std::vector<std::string> DataDirs()
     exe[n]              = 0;
     const std::string s = exe;
     d.push_back(s.substr(0, s.find_last_of('/')) + "/../share/rbcontact");
+    struct stat st;
+    installed = stat(d.back().c_str(), &st) == 0 && S_ISDIR(st.st_mode);
   }
   d.push_back(RBC_INSTALL_DATA_DIR);
-  d.push_back(RBC_SOURCE_DIR);
+  if (!installed) d.push_back(RBC_SOURCE_DIR);
   return d;
 }
 
