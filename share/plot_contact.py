@@ -61,12 +61,15 @@ def read_contact(path, coord):
                                                  ", ".join("/contact/" + k for k in g.keys()) or "nothing"))
         data = {n: np.asarray(g[n][...], dtype=float).ravel() for n in need}
         dim = sum(1 for c in ("x", "y", "z") if c in g)
+        # the master normals (files of rbcontact fom have them): the resultant is sum lambda_i w_i n_i
+        normals = [np.asarray(g["normal_" + c][...], dtype=float).ravel() for c in ("x", "y", "z")[:dim] if "normal_" + c in g]
     lam, w, s = data["lambda"], data["weight"], data[coord]
+    data["normals"] = normals if len(normals) == dim and dim > 0 else None
     if not (lam.shape == w.shape == s.shape):
         fail("/contact datasets disagree in size: lambda %s, weight %s, %s %s" % (lam.shape, w.shape, coord, s.shape))
     if lam.size == 0:
         fail("'%s': the slave surface has no vertices (/contact/lambda is empty)" % path)
-    return lam, w, s, dim
+    return lam, w, s, dim, data["normals"]
 
 
 def hertz_from_report(path):
@@ -100,7 +103,7 @@ def main(argv=None):
     a = p.parse_args(argv)
 
     out = a.output or (a.h5[:-3] if a.h5.endswith(".h5") else a.h5) + "_pressure.png"
-    lam, w, s, dim = read_contact(a.h5, a.coord)
+    lam, w, s, dim, normals = read_contact(a.h5, a.coord)
     if dim == 3:
         print("plot_contact.py: 3D slave surface: plotting the pressure against %s only (a projection)" % a.coord)
 
@@ -116,13 +119,16 @@ def main(argv=None):
     if ha is not None and not (ha > 0 and hp0 > 0):
         fail("Hertz overlay: a = %g and p0 = %g must be > 0" % (ha, hp0))
 
+    # the resultant's norm |sum_i lambda_i w_i n_i| (the report's contact_force); sum lambda_i w_i without normals
+    force_vec = [float((lam * w * n).sum()) for n in normals] if normals is not None else None
     order = np.argsort(s, kind="stable")
     s, lam, w = s[order], lam[order], w[order]
     active = lam > a.active_tol
     nact = int(active.sum())
-    force = float((lam * w).sum())  # resultant magnitude (the normals are ~ parallel in these scenes)
+    force = float(np.hypot.reduce(force_vec)) if force_vec is not None else float((lam * w).sum())
     pmax = float(lam.max())
-    xc = float((lam * w * s).sum() / force) if force > 0 else float(s.mean())
+    mass = float((lam * w).sum())
+    xc = float((lam * w * s).sum() / mass) if mass > 0 else float(s.mean())
 
     fig, ax = plt.subplots(figsize=(8, 4.8), layout="constrained")
     ax.plot(s, lam, "-", color="tab:blue", linewidth=1.0, zorder=2, label="FE nodal pressure $\\lambda_i$")

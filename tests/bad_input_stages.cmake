@@ -27,6 +27,7 @@ rbc_bad_stage(bool_value_unparsed "Unknown logical value: maybe [(]option -conta
 # an option naming a body that -bodies does not declare (a misspelled body left its map silently unused)
 rbc_bad_stage(map_unknown_body "option -map_rign names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -map_rign dilation)
 rbc_bad_stage(param_unknown_body "option -param_E_blok names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -param_E_blok radius)
+rbc_bad_stage(dirichlet_value_missing "-dirichlet_slave_u is not given: -dirichlet lists the label 'slave'" fom -options_file runs/ring_on_block.opts -dirichlet ring_top,block_bottom,slave)
 # the parameter names in a count mismatch; an out-of-box value with the digits that were given
 rbc_bad_stage(mu_count "-mu has 2 values; the scene has 1 parameters [(]radius, in this order[)]" fom -options_file runs/ring_on_block.opts -mu 1,1.1)
 rbc_bad_stage(mu_outside_box_digits "'radius' = 1.1500000001 is outside its box [[]0.95, 1.15[]]" fom -options_file runs/ring_on_block.opts -mu 1.1500000001)

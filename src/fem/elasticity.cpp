@@ -350,6 +350,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
     DMLabel label;
     PetscCall(MeshCheckLabel(dm, bc.label, "-dirichlet", scene.mesh.file));
     PetscCall(DMGetLabel(dm, bc.label.c_str(), &label));
+    if (!bc.fn) PetscCheck(!bc.values.empty(), comm, PETSC_ERR_USER_INPUT, "-dirichlet_%s_u is not given: -dirichlet lists the label '%s', give its %" PetscInt_FMT " displacement components (e.g. -dirichlet_%s_u 0,0)", bc.label.c_str(), bc.label.c_str(), dim, bc.label.c_str());
     if (!bc.fn) PetscCheck((PetscInt)bc.values.size() == dim, comm, PETSC_ERR_USER_INPUT, "-dirichlet_%s_u has %zu components, the mesh is %" PetscInt_FMT "D (give all components; -dirichlet_%s_comps selects the constrained ones)", bc.label.c_str(), bc.values.size(), dim, bc.label.c_str());
     for (PetscInt c : bc.comps) PetscCheck(c < dim, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dirichlet_%s_comps: component %" PetscInt_FMT " >= dimension %" PetscInt_FMT, bc.label.c_str(), c, dim);
     IS              valueIS;
