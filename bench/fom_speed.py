@@ -30,7 +30,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-REFERENCE = ["-fem_assembly", "petscfe", "-fom_tao_type", "bqpip", "-kacanov_anderson", "0", "-contact_compliance", "redundant"]
+REFERENCE = ["-fem_assembly", "petscfe", "-fom_qp_tao_type", "bqpip", "-kacanov_anderson", "0", "-contact_compliance", "redundant"]
 SLAVE_CLAMP = {"ring_on_block": ["-dirichlet", "ring_top,block_bottom,slave", "-dirichlet_slave_u", "0,0"],
                "half_disks": ["-dirichlet", "upper_top,lower_bottom,slave", "-dirichlet_slave_u", "0,0"]}
 

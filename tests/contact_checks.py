@@ -217,12 +217,12 @@ def dual_shell(args):
         for tt in ["bqpip", "blmvm", "gpcg"]:
             rep, h5 = os.path.join(out, tag + tt + ".json"), os.path.join(out, tag + tt + ".h5")
             cmd = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/%s.opts" % s] + opts + \
-                  ["-fom_dual_matrix", "shell", "-fom_dual_shell_tao", "1", "-fom_tao_type", tt, "-kacanov_monitor",
+                  ["-fom_dual_matrix", "shell", "-fom_dual_shell_tao", "1", "-fom_qp_tao_type", tt, "-kacanov_monitor",
                    "-report", rep, "-fom_output", h5] + args.extra
             p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
             if p.returncode != 0:
                 print(p.stdout[-4000:])
-                check(False, "%s -fom_tao_type %s: exit %d" % (tag, tt, p.returncode))
+                check(False, "%s -fom_qp_tao_type %s: exit %d" % (tag, tt, p.returncode))
                 continue
             with open(rep) as f:
                 rs = json.load(f)
@@ -327,7 +327,7 @@ def paths(args):
     independent second method: PetscFE assembly, two factorizations (redundant compliance), plain Kacanov,
     TAO BQPIP from zero. Same active set and contact force / energy to 1e-9 (solver tolerance 1e-8)."""
     print("FOM fast path vs reference settings (np %d)" % args.np)
-    ref = ["-fem_assembly", "petscfe", "-contact_compliance", "redundant", "-kacanov_anderson", "0", "-fom_tao_type", "bqpip"]
+    ref = ["-fem_assembly", "petscfe", "-contact_compliance", "redundant", "-kacanov_anderson", "0", "-fom_qp_tao_type", "bqpip"]
     for scene, opts in (("ring_on_block", ["-mu", "1.15"]), ("half_disks", ["-mu", "0.8,0.11", "-fem_degree", "2"]), ("hertz", [])):
         rf, _ = run(args, args.np, "runs/%s.opts" % scene, opts + args.extra, scene + "_fast")
         rr, _ = run(args, args.np, "runs/%s.opts" % scene, opts + ref + args.extra, scene + "_ref")

@@ -10,7 +10,8 @@ Subcommands (exit 0 = pass; a failure prints what was seen):
   rename      the boundary options out of PETSc's -bc_ namespace: the old spelling gives the same run
               with one deprecation warning per option; both spellings at once are refused
   gamg        the README's iterative elastic solver (-fom_ksp_type cg -fom_pc_type gamg) on a contact
-              scene: the direct solver's contact force to 1e-6
+              scene: the direct solver's contact force to 1e-6, also with a TAO contact QP (its own prefix
+              fom_qp_); the former -fom_tao_* spelling warns once and gives the same run
   paraview    the XDMF files ParaView opens: every HDF dataset an .xmf names exists with the dimensions and
               the number type / precision the .xmf says (the FOM output, the reconstructed ROM fields, the
               offline basis view); the contact grid's points are the slave vertices; the basis view's POD
@@ -181,6 +182,11 @@ def rename(args):
           "both spellings: refused, naming both (exit %d)" % p.returncode)
 
 
+def run_force(args, d, extra):
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/rf.json"] + extra)
+    return load(d + "/rf.json")["contact_force"]
+
+
 def gamg(args):
     d = workdir()
     run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/direct.json"])
@@ -188,6 +194,16 @@ def gamg(args):
     a, b = load(d + "/direct.json"), load(d + "/gamg.json")
     rel = abs(a["contact_force"] - b["contact_force"]) / abs(a["contact_force"])
     check(b["converged"] and rel <= 1e-6, "cg + gamg: contact force %.12g against the direct %.12g (rel %.1e <= 1e-6)" % (b["contact_force"], a["contact_force"], rel))
+    # with a TAO contact QP as well: its inner KSP has its own prefix (fom_qp_), the elastic solver's options do not reach it
+    run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-fom_qp_tao_type", "bqpip", "-fom_ksp_type", "cg", "-fom_pc_type", "gamg", "-report", d + "/gamg_tao.json"])
+    c = load(d + "/gamg_tao.json")
+    rel = abs(a["contact_force"] - c["contact_force"]) / abs(a["contact_force"])
+    check(c["converged"] and rel <= 1e-6, "cg + gamg with the TAO QP (-fom_qp_tao_type bqpip): contact force %.12g (rel %.1e <= 1e-6)" % (c["contact_force"], rel))
+    # the former spelling -fom_tao_type: the same run, one deprecation warning, no "not used" warning
+    p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-fom_tao_type", "bqpip", "-report", d + "/old.json"])
+    o = load(d + "/old.json")
+    check(p.stdout.count("option -fom_tao_type is deprecated") == 1 and "was not used" not in p.stdout and o["contact_force"] == run_force(args, d, ["-fom_qp_tao_type", "bqpip"]),
+          "-fom_tao_type bqpip: one deprecation warning, the same force as -fom_qp_tao_type bqpip")
 
 
 def check_xdmf(xmf):

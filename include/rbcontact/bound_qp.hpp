@@ -36,7 +36,8 @@ public:
   DualQPSolver(const DualQPSolver &) = delete;
   DualQPSolver &operator=(const DualQPSolver &) = delete;
   ~DualQPSolver();
-  // prefix: options prefix of the Tao (e.g. "fom_" -> -fom_tao_type, -fom_tao_gatol); -<prefix>qp_polish.
+  // prefix: the stage's prefix; the Tao's is <prefix>qp_ (e.g. "fom_" -> -fom_qp_tao_type, -fom_qp_tao_gatol, and
+  // TAO's inner KSP -fom_qp_ksp_type: apart from the elastic solver's -fom_ksp_*); -<prefix>qp_polish.
   // Default -<prefix>tao_type activeset: the active-set method alone, warm-started; bqpip (or any
   // bound-constrained TAO type) runs TAO from zero, then the active-set polish.
   PetscErrorCode Setup(const std::string &prefix);

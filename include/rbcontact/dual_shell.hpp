@@ -11,8 +11,8 @@
 // threshold for adding a multiplier), -pdas_monitor, -diag lumped|exact (Jacobi diagonal:
 // diag(K diag(A)^{-1} K^T), or exact by R products), -ksp_* / -pc_* of the CG.
 // Optional TAO phase before the active-set method (-fom_dual_shell_tao, default off: with BQPIP it costs
-// 700-1000 products on the ring, 2-3x the shell time; docs/contact.md): TAO (prefix fom_: -fom_tao_type,
-// default BQPIP by TaoBQPIPRecipe, at most -fom_tao_max_it 50 iterations) on the Jacobi-equilibrated S
+// 700-1000 products on the ring, 2-3x the shell time; docs/contact.md): TAO (prefix fom_qp_: -fom_qp_tao_type,
+// default BQPIP by TaoBQPIPRecipe, at most -fom_qp_tao_max_it 50 iterations) on the Jacobi-equilibrated S
 // (a second MATSHELL, full S, unit diagonal estimate, with its own MatDiagonalSet / MatShift: BQPIP
 // shifts the diagonal in place and MATSHELL's native shifts do not survive its MatAssemblyEnd),
 // bounds [0, inf]; its inner KSP has prefix fom_dual_tao_ (cg + jacobi for BQPIP; TRON / GPCG get
@@ -63,7 +63,7 @@ public:
   PetscReal   looseRtol = 1e-3; // CG rtol while the free set still changes (-pdas_rtol_loose)
   std::string diag    = "lumped";
   PetscBool   monitor = PETSC_FALSE; // -fom_dual_pdas_monitor
-  PetscBool   useTao  = PETSC_FALSE; // -fom_dual_shell_tao (off with -fom_tao_type activeset)
+  PetscBool   useTao  = PETSC_FALSE; // -fom_dual_shell_tao (off with -fom_qp_tao_type activeset)
   PetscBool   taoWarm = PETSC_FALSE; // -fom_dual_shell_tao_warm: TAO on warm starts too
   PetscReal   taoSupport = 1e-6;     // -fom_dual_shell_tao_support: free if > this * max
 

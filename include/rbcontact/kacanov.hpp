@@ -4,7 +4,7 @@
 // with A factored once (ElasticFOM) and reused for every back-solve; then u = u0 - A^{-1} K^T lambda.
 // Stops on the relative changes of u and lambda; non-convergence is an error with the history.
 // Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
-// -kacanov_monitor; the dual QP takes the fom_ prefix (-fom_tao_type, -fom_qp_polish); -fom_kkt_tol.
+// -kacanov_monitor; the dual QP takes the fom_qp_ prefix (-fom_qp_tao_type, its TAO's -fom_qp_ksp_*; -fom_qp_polish; the former -fom_qp_tao_* warn); -fom_kkt_tol.
 // -fom_dual_matrix dense|shell|auto (-fom_dual_dense_max R): dense S through the surface compliance
 // (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), or S as a MATSHELL with the matrix-free
 // primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*).

@@ -119,8 +119,8 @@ PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
   char type[64] = "activeset";
 
   PetscFunctionBeginUser;
-  prefix_ = prefix;
-  PetscCall(PetscOptionsGetBool(NULL, prefix_.c_str(), "-qp_polish", &polish_, NULL));
+  prefix_ = prefix + "qp_"; // the QP's own prefix: its TAO (and TAO's KSP/PC) never read the elastic solver's options
+  PetscCall(PetscOptionsGetBool(NULL, prefix.c_str(), "-qp_polish", &polish_, NULL));
   PetscCall(PetscOptionsGetString(NULL, prefix_.c_str(), "-tao_type", type, sizeof type, NULL));
   // "-<prefix>tao_type activeset" skips TAO: the active-set method alone
   useTao_ = strcmp(type, "activeset") ? PETSC_TRUE : PETSC_FALSE;

@@ -150,7 +150,7 @@ static PetscErrorCode TaoHessShift(Mat H, PetscScalar a)
   PetscFunctionReturn(0);
 }
 
-// H(is, is) for TRON and GPCG (-fom_tao_subset_type subvec, the default): a MATSHELL that scatters into
+// H(is, is) for TRON and GPCG (-fom_qp_tao_subset_type subvec, the default): a MATSHELL that scatters into
 // a full vector, multiplies by H (with its shifts, if any) and gathers.
 struct TaoSubCtx {
   Mat H  = nullptr;
@@ -252,7 +252,7 @@ static PetscErrorCode TaoHessNoop(Tao, Vec, Mat, Mat, void *)
 
 // The inner KSP of the TAO (if its type has one): prefix fom_dual_tao_ (not fom_, the prefix of the
 // FOM's own Cholesky KSP), jacobi (the Hessian is a shell: no factorization), cg for BQPIP (the recipe's
-// preonly + cholesky needs an assembled matrix). Again after TaoSetFromOptions if -fom_tao_type made a new KSP.
+// preonly + cholesky needs an assembled matrix). Again after TaoSetFromOptions if -fom_qp_tao_type made a new KSP.
 static PetscErrorCode ConfigureTaoKSP(Tao tao, const std::string &kspPrefix)
 {
   KSP         ksp;
@@ -313,11 +313,11 @@ PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string 
   PetscCall(PetscOptionsReal("-pdas_tol", "Add a multiplier when its scaled gradient is below -tol |b|", NULL, setTol, &setTol, NULL));
   PetscCall(PetscOptionsBool("-pdas_monitor", "Print each active-set step", NULL, monitor, &monitor, NULL));
   PetscCall(PetscOptionsString("-diag", "Jacobi diagonal: lumped (diag(K diag(A)^-1 K^T)) or exact (R products)", NULL, dtype, dtype, sizeof dtype, &set));
-  PetscCall(PetscOptionsBool("-shell_tao", "TAO (-fom_tao_type, default bqpip) on the shell first, its support starts the active-set method", NULL, useTao, &useTao, NULL));
+  PetscCall(PetscOptionsBool("-shell_tao", "TAO (-fom_qp_tao_type, default bqpip) on the shell first, its support starts the active-set method", NULL, useTao, &useTao, NULL));
   PetscCall(PetscOptionsBool("-shell_tao_warm", "Run the TAO phase on warm starts too (default: only when there is no previous support)", NULL, taoWarm, &taoWarm, NULL));
   PetscCall(PetscOptionsReal("-shell_tao_support", "TAO entries above this times their max start the free set", NULL, taoSupport, &taoSupport, NULL));
   PetscOptionsEnd();
-  taoPrefix_ = prefix;
+  taoPrefix_ = std::string(prefix) + "qp_"; // the dual QP's TAO prefix, as in dense mode (bound_qp.cpp)
   {
     char tt[64] = "";
     PetscCall(PetscOptionsGetString(NULL, taoPrefix_.c_str(), "-tao_type", tt, sizeof tt, NULL));

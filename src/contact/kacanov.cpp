@@ -2,6 +2,7 @@
 // matrix-free S of dual_shell.cpp: -fom_dual_matrix), KKT checks and the contact summary (force,
 // pressure, active zone).
 #include "rbcontact/kacanov.hpp"
+#include <cctype>
 #include "contact_point.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -15,6 +16,40 @@ namespace rbc {
 static PetscLogEvent KAC_Assemble = 0, KAC_Schur = 0, KAC_QP = 0;
 
 KacanovSolver::~KacanovSolver() { (void)VecDestroy(&lambda); }
+
+// The contact QP's TAO had the prefix fom_ until 2026-11-25, shared with the elastic KSP/PC (so that
+// -fom_ksp_type cg -fom_pc_type gamg reached TAO's inner KSP on the dense dual matrix). Its prefix is fom_qp_ now;
+// a -fom_tao_* option still works for one release, moved to -fom_qp_tao_* with a deprecation warning.
+static PetscErrorCode RenameTaoOptions(MPI_Comm comm)
+{
+  char                    *all = NULL;
+  std::vector<std::string> old;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  {
+    std::istringstream in(all ? all : "");
+    std::string        tok;
+    while (in >> tok) {
+      std::string low = tok;
+      for (auto &c : low) c = (char)std::tolower((unsigned char)c);
+      if (low.compare(0, 9, "-fom_tao_") == 0) old.push_back(tok);
+    }
+  }
+  PetscCall(PetscFree(all));
+  for (const auto &o : old) {
+    const std::string now = "-fom_qp_tao_" + o.substr(9);
+    char              val[PETSC_MAX_PATH_LEN] = "";
+    PetscBool         hasNew = PETSC_FALSE, set = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, now.c_str(), &hasNew));
+    PetscCheck(!hasNew, comm, PETSC_ERR_USER_INPUT, "%s and its deprecated spelling %s are both given: keep %s", now.c_str(), o.c_str(), now.c_str());
+    PetscCall(PetscOptionsGetString(NULL, NULL, o.c_str(), val, sizeof val, &set));
+    PetscCall(PetscOptionsSetValue(NULL, now.c_str(), val[0] ? val : NULL));
+    PetscCall(PetscOptionsClearValue(NULL, o.c_str()));
+    PetscCall(PetscPrintf(comm, "rbcontact: warning: option %s is deprecated (the contact QP has its own prefix fom_qp_): use %s\n", o.c_str(), now.c_str()));
+  }
+  PetscFunctionReturn(0);
+}
 
 PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
 {
@@ -36,6 +71,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, shell above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscOptionsEnd();
   PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCall(RenameTaoOptions(comm));
   PetscCall(qp_.Setup("fom_"));
   PetscCall(shell_.SetFromOptions(comm, "fom_"));
   PetscFunctionReturn(0);
