@@ -23,7 +23,7 @@
 
 namespace rbc {
 
-static PetscLogEvent OFF_Snapshots = 0;
+static PetscLogEvent OFF_Snapshots = 0, OFF_SnapshotSolve = 0, OFF_SnapshotIO = 0;
 
 PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
 {
@@ -117,7 +117,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   PetscLogDouble  t0, t1, tSnap0;
 
   PetscFunctionBeginUser;
-  if (!OFF_Snapshots) PetscCall(PetscLogEventRegister("RBCSnapshots", DM_CLASSID, &OFF_Snapshots));
+  if (!OFF_Snapshots) {
+    PetscCall(PetscLogEventRegister("RBCSnapshots", DM_CLASSID, &OFF_Snapshots));
+    PetscCall(PetscLogEventRegister("RBCSnapshotSolve", DM_CLASSID, &OFF_SnapshotSolve)); // the FOM solves
+    PetscCall(PetscLogEventRegister("RBCSnapshotIO", DM_CLASSID, &OFF_SnapshotIO));       // gather + checkpoint writes (and the wait for the other groups)
+  }
   PetscCall(PetscTime(&t0));
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   PetscCallMPI(MPI_Comm_size(world, &wsize));
@@ -249,6 +253,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
         pack[0] = idx;
         if (idx >= 0) {
           PetscLogDouble s0, s1;
+          PetscCall(PetscLogEventBegin(OFF_SnapshotSolve, 0, 0, 0, 0));
           PetscCall(PetscTime(&s0));
           const std::vector<PetscReal> &mu = train.points[idx];
           PetscCall(fom.SetMu(mu));
@@ -267,6 +272,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           } else PetscCall(fom.SolveElastic());
           PetscCall(order.DofsToCanonical(fom.u, &u));
           PetscCall(PetscTime(&s1));
+          PetscCall(PetscLogEventEnd(OFF_SnapshotSolve, 0, 0, 0, 0));
           if (grank == 0) {
             size_t o = 1;
             pack[o++] = kac.iterations;
@@ -288,6 +294,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           itsSolved.push_back(kac.iterations);
         }
         // group roots -> world rank 0 (other ranks send an empty slot)
+        PetscCall(PetscLogEventBegin(OFF_SnapshotIO, 0, 0, 0, 0));
         if (grank != 0) pack[0] = -1;
         PetscCallMPI(MPI_Gather(pack.data(), (int)L, MPIU_REAL, gathered.data(), (int)L, MPIU_REAL, 0, world));
         std::vector<Snapshot> snaps;
@@ -319,6 +326,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
         PetscInt nsnap = (PetscInt)snaps.size();
         PetscCallMPI(MPI_Bcast(&nsnap, 1, MPIU_INT, 0, world));
         for (PetscInt i = 0; i < nsnap; ++i) PetscCall(file.Write(wrank == 0 ? snaps[i] : Snapshot()));
+        PetscCall(PetscLogEventEnd(OFF_SnapshotIO, 0, 0, 0, 0));
         if (monitor && wrank == 0) {
           PetscLogDouble now;
           PetscCall(PetscTime(&now));
