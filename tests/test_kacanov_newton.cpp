@@ -5,7 +5,9 @@
 //      same factorization: both converge, the contact forces agree to -test_force_rtol (1e-8), Newton needs
 //      at most -test_max_its iterations and no more than the fixed point, and at least one Newton step
 //      was taken;
-//   2. the tangent against central finite differences of the assembly at the converged state, in three
+//   2. every Newton step refused (-kacanov_newton_max_ratio 1e-6): the plain Kacanov iterates (the same
+//      iterations and force as -kacanov_type fixed_point -kacanov_anderson 0);
+//   3. the tangent against central finite differences of the assembly at the converged state, in three
 //      random directions on the contact dofs: H dx = d(K^T lambda) and Q dx = d(g - K y) (active rows,
 //      y = the solution plus a random field) to -test_fd_rtol (1e-6) relative.
 // Serial and parallel (the tangent is gathered on every rank; the direction is the same on every rank).
@@ -182,6 +184,24 @@ int main(int argc, char **argv)
     const PetscReal df = std::abs(sn.force - sf.force) / std::abs(sf.force);
     PetscCall(Check(comm, sf.force > 0 && df <= forceTol, "contact force: |Newton - fixed point| / |fixed point|", df, forceTol));
     PetscCall(Check(comm, sn.nactive == sf.nactive, "same active count", (double)sn.nactive, (double)sf.nactive));
+    // every Newton step refused (-kacanov_newton_max_ratio 1e-6): the fallback is the plain Kacanov
+    // iterate, so the iterations are plain Kacanov's (fixed point without Anderson) and the force the same
+    KacanovSolver refused, plain;
+    PetscCall(refused.SetFromOptions(comm));
+    PetscCall(plain.SetFromOptions(comm));
+    refused.type           = "newton";
+    refused.newtonMaxRatio = 1e-6;
+    plain.type             = "fixed_point";
+    plain.loop.anderson    = 0;
+    ContactSummary sr, sp;
+    PetscCall(refused.Solve(fom, map));
+    PetscCall(SummarizeContact(refused.sys, refused.lambda, fom.elas.dim, &sr));
+    PetscCall(plain.Solve(fom, map));
+    PetscCall(SummarizeContact(plain.sys, plain.lambda, fom.elas.dim, &sp));
+    PetscCall(PetscPrintf(comm, "every Newton step refused: %" PetscInt_FMT " iterations, force %.16g; plain Kacanov %" PetscInt_FMT " iterations, force %.16g\n", refused.iterations, (double)sr.force, plain.iterations, (double)sp.force));
+    PetscCall(Check(comm, refused.newtonSteps == 0 && refused.iterations == plain.iterations, "refused steps: no Newton step, plain Kacanov's iterations", (double)refused.iterations, (double)plain.iterations));
+    const PetscReal dr = std::abs(sr.force - sp.force) / std::abs(sp.force);
+    PetscCall(Check(comm, dr <= 1e-14, "refused steps: force vs plain Kacanov (the same iterates)", dr, 1e-14));
     // the tangent at the solution: with the scene's quadrature, and with fixed composite points (no moving
     // mortar cuts: the pointwise derivative alone, to rounding)
     PetscCall(TangentCheck(comm, fom, map, nw.lambda, fdTol, "scene's rule"));
