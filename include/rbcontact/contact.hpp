@@ -127,8 +127,8 @@ public:
   PetscErrorCode Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys);
   // The tangent of the last Assemble (same u, same integration points; collective): lambda (R, every
   // rank), y on the sorted free dofs D (yD, every rank; constrained dofs take their Dirichlet values).
-  // 2D only: *supported = false in 3D, or where a point depends on more than 32 dofs (nothing computed). With -contact_normal facet the normal's jump
-  // where the closest master facet changes is not differentiated (the tangent is then approximate).
+  // 2D only: *supported = false in 3D, or where a point depends on more than 32 dofs (nothing computed).
+  // The integration points are held fixed: the motion of the mortar cuts is left out (docs/fom_speed.md).
   PetscErrorCode AssembleTangent(MPI_Comm comm, const std::vector<PetscReal> &lambda, const std::vector<PetscInt> &D, const std::vector<PetscReal> &yD, ContactTangent *tan, bool *supported) const;
   PetscInt NumMultipliers() const { return R_; }
   // The free global dofs the constraint rows can touch (slave and master facet closures), sorted,
