@@ -1,7 +1,8 @@
 # tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test, no-contact gap,
 # ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers, the matrix-free
 # dual (-fom_dual_matrix shell) against the dense one, the fast FOM path against the reference settings,
-# the compliance methods against each other, the mortar segment search against the full search.
+# the compliance methods against each other, the mortar segment search against the full search, the Newton
+# Kacanov step against the fixed point (test_kacanov_newton).
 find_program(RBC_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_CC ${RBC_PYTHON3} ${CMAKE_CURRENT_SOURCE_DIR}/contact_checks.py)
 foreach(np 1 2)
@@ -28,3 +29,8 @@ rbc_test_exe(test_bound_qp)
 rbc_add_mpi_test(NAME bound_qp RANKS 1 COMMAND $<TARGET_FILE:test_bound_qp> LABELS contact)
 rbc_test_exe(test_closest_point)
 rbc_add_mpi_test(NAME closest_point RANKS 1 COMMAND $<TARGET_FILE:test_closest_point> LABELS contact)
+# -kacanov_type newton against fixed_point (iterations, force) and the contact tangent against finite differences
+rbc_test_exe(test_kacanov_newton)
+rbc_add_mpi_test(NAME kacanov_newton_half_disks RANKS 1 2 COMMAND $<TARGET_FILE:test_kacanov_newton> -options_file runs/half_disks.opts -test_max_its 7 LABELS contact)
+rbc_add_mpi_test(NAME kacanov_newton_ring RANKS 1 2 COMMAND $<TARGET_FILE:test_kacanov_newton> -options_file runs/ring_on_block.opts -test_max_its 7 LABELS contact)
+rbc_add_mpi_test(NAME kacanov_newton_hertz RANKS 1 2 COMMAND $<TARGET_FILE:test_kacanov_newton> -options_file runs/hertz.opts -test_max_its 7 LABELS contact)

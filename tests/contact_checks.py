@@ -187,8 +187,9 @@ def dual_shell(args):
     dense = {}
     for s, opts in cases:
         tag = s + "".join(opts)
-        # the dense reference without Anderson mixing (the shell path has none): the same Kacanov iterates
-        rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + ["-kacanov_anderson", "0"] + args.extra, tag + "_dense")
+        # the dense reference as plain Kacanov, without Anderson mixing or Newton steps (the shell path has
+        # neither): the same Kacanov iterates
+        rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + ["-kacanov_type", "fixed_point", "-kacanov_anderson", "0"] + args.extra, tag + "_dense")
         dense[tag] = (rd, h5d)
         # auto with a tiny -fom_dual_dense_max must pick the shell (and shell must skip the compliance)
         shell = ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"] if s == "flat_punch" else ["-fom_dual_matrix", "shell"]

@@ -101,6 +101,16 @@ enum class ContactQuadrature { Gauss, Composite, Nodal };
 // int psi_k phi_j = delta_kj int phi_j on every facet (Wohlmuth): the slave block of K is diagonal
 // (lumped), and lambda_i is still the nodal pressure with int psi_i = int phi_i (docs/contact.md).
 enum class ContactMultiplier { Standard, Dual };
+
+// The derivative of the contact geometry with respect to the displacement u at which K(u), g(u) were
+// assembled (ContactMap::AssembleTangent; docs/fom_speed.md "Newton on the contact dofs"), as triplets on
+// global free dofs, the same on every rank (gathered in rank order):
+//   H_ij = d (K(u)^T lambda)_i / du_j  at fixed multipliers lambda (the geometric stiffness),
+//   Q_rj = d (g(u) - K(u) y)_r / du_j  at a fixed field y, for the rows r with lambda_r > 0.
+struct ContactTangent {
+  std::vector<PetscInt>  hRow, hCol, qRow, qCol;
+  std::vector<PetscReal> hVal, qVal;
+};
 inline PetscReal MultiplierShape(ContactMultiplier m, PetscInt nv, const PetscReal b[], PetscInt k) { return m == ContactMultiplier::Dual ? (nv + 1) * b[k] - 1 : b[k]; }
 
 // The contact map: slave/master surfaces of a scene and the assembly of K(u), g(u).
@@ -115,6 +125,11 @@ public:
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   // Assembles K(u), g(u) at the full local field uloc (Dirichlet values included).
   PetscErrorCode Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys);
+  // The tangent of the last Assemble (same u, same integration points; collective): lambda (R, every
+  // rank), y on the sorted free dofs D (yD, every rank; constrained dofs take their Dirichlet values).
+  // 2D only: *supported = false in 3D, or where a point depends on more than 32 dofs (nothing computed).
+  // The integration points are held fixed: the motion of the mortar cuts is left out (docs/fom_speed.md).
+  PetscErrorCode AssembleTangent(MPI_Comm comm, const std::vector<PetscReal> &lambda, const std::vector<PetscInt> &D, const std::vector<PetscReal> &yD, ContactTangent *tan, bool *supported) const;
   PetscInt NumMultipliers() const { return R_; }
   // The free global dofs the constraint rows can touch (slave and master facet closures), sorted,
   // the same on every rank.
@@ -151,6 +166,11 @@ private:
   std::vector<SurfaceFacet> masterAll_;
   std::vector<PetscInt>     endRows_;
   std::vector<PetscInt>     pastMasterEnd_; // rows (local list, may repeat) of the last Assemble: PastMasterEndRows
+  struct IntegrationPoint {
+    PetscInt  s = -1, m = -1;                // slave facet (local), closest master facet (masterAll_)
+    PetscReal b[3] = {0, 0, 0}, w = 0, bm[3] = {0, 0, 0};
+  };
+  std::vector<IntegrationPoint> points_; // the integration points of the last Assemble (AssembleTangent)
   std::vector<std::array<PetscReal, 2>> endNext_;
 };
 

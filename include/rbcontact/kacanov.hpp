@@ -4,7 +4,8 @@
 // with A factored once (ElasticFOM) and reused for every back-solve; then u = u0 - A^{-1} K^T lambda.
 // Stops on the relative changes of u and lambda; non-convergence is an error with the history.
 // Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
-// -kacanov_monitor; the dual QP takes the fom_qp_ prefix (-fom_qp_tao_type, its TAO's -fom_qp_ksp_*; -fom_qp_polish; the former -fom_qp_tao_* warn); -fom_kkt_tol.
+// -kacanov_monitor, -kacanov_type fixed_point|newton (kacanov_newton.cpp); the dual QP takes the fom_qp_ prefix (-fom_qp_tao_type, its
+// TAO's -fom_qp_ksp_*; -fom_qp_polish; the former -fom_tao_* warn); -fom_kkt_tol.
 // -fom_dual_matrix dense|shell|auto (-fom_dual_dense_max R): dense S through the surface compliance
 // (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), or S as a MATSHELL with the matrix-free
 // primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*).
@@ -24,10 +25,35 @@ struct KKTResiduals {
   PetscReal Max() const { return std::max(std::max(primal, dual), std::max(complementarity, stationarity)); }
 };
 
+// The Newton step of the contact-dof fixed point x = F(x) (src/contact/kacanov_newton.cpp, docs/fom_speed.md):
+// the data of one dense iterate, on every rank.
+struct KacanovNewtonData {
+  const std::vector<PetscInt> *D   = nullptr; // the sorted contact dofs (nD)
+  PetscInt                     R   = 0;
+  const PetscReal             *G   = nullptr; // compliance (A^-1)_DD, nD x nD
+  const PetscReal             *KD  = nullptr; // K on D, R x nD (column-major)
+  const PetscReal             *T   = nullptr; // G K_D^T, nD x R
+  const PetscReal             *S   = nullptr; // K_D G K_D^T, R x R
+  const PetscReal             *lam = nullptr; // the QP's multipliers at x (R)
+  const ContactTangent        *tan = nullptr; // the geometry's derivative at x (lambda, y = F(x))
+  const PetscReal             *x = nullptr, *Fx = nullptr; // the input and its image (nD)
+};
+struct KacanovNewtonInfo {
+  bool        accepted = false;
+  PetscInt    active = 0, columns = 0; // |A|, |C|
+  PetscReal   ratio = 0, pivotRatio = 0; // |dx| / |F(x) - x|; min / max |pivot| of I - J_CC
+  std::string reason; // why the step was refused
+};
+// next = x + dx with (I - J) dx = F(x) - x; info->accepted = false (next untouched) when the step cannot be
+// trusted: no active constraint, S_AA not positive definite, I - J singular or ill-conditioned, a
+// non-finite step or one longer than maxRatio |F(x) - x|. Serial.
+PetscErrorCode KacanovNewtonStep(const KacanovNewtonData &in, PetscReal maxRatio, std::vector<PetscReal> *next, KacanovNewtonInfo *info);
+
 struct KacanovHistory {
   std::vector<PetscReal> du, dl;
   std::vector<PetscInt>  nactive;
   std::vector<PetscInt>  dualSteps, dualCG; // shell dual: active-set steps and CG iterations per iterate
+  std::vector<PetscInt>  newton; // -kacanov_type newton: 1 if the next input is a Newton step, 0 a plain one
 };
 
 class KacanovSolver {
@@ -54,6 +80,12 @@ public:
   // -kacanov_max_it (30), _rtol_primal, _rtol_dual (1e-8 each), _relaxation, _anderson (3: Anderson mixing of
   // the contact-dof displacement, dense dual matrix), _monitor: the loop shared with the ROM (kacanov_loop.hpp)
   KacanovLoop    loop;
+  // -kacanov_type fixed_point|newton: the next input is the (Anderson-mixed) image, or a Newton step on the
+  // fixed point with the derivative of the contact geometry (dense dual matrix, 2D; plain steps otherwise).
+  // -kacanov_newton_max_ratio: longest Newton step accepted, in units of |F(x) - x|.
+  std::string    type = "newton";
+  PetscReal      newtonMaxRatio = 10;
+  PetscInt       newtonSteps = 0; // accepted Newton steps of the last Solve
   PetscReal      kktTol = 1e-8;
   DualQPInfo     lastQP;
   DualShellInfo  lastShell;

@@ -86,6 +86,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
     std::vector<double> dl(kacanov.history.dl.begin(), kacanov.history.dl.end()), na(kacanov.history.nactive.begin(), kacanov.history.nactive.end());
     h["dlambda"] = dl;
     h["nactive"] = na;
+    rep.root["kacanov_type"] = kacanov.type; // -kacanov_type (newton: plain Kacanov on the shell path and in 3D)
+    if (!kacanov.history.newton.empty()) h["newton"] = std::vector<double>(kacanov.history.newton.begin(), kacanov.history.newton.end()); // 1: the next input was a Newton step
     if (!kacanov.history.dualCG.empty()) h["dual_cg"] = std::vector<double>(kacanov.history.dualCG.begin(), kacanov.history.dualCG.end());
     if (hertz) {
       PetscReal a, p0;

@@ -397,6 +397,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     for (const auto &M : masterAll_)
       for (PetscInt k = 0; k < nv; ++k) ++vcount[M.vglobal[k]];
   pastMasterEnd_.clear();
+  points_.clear();
 
   std::vector<PetscInt>    cols;
   std::vector<PetscScalar> vals;
@@ -440,6 +441,17 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       EvaluateContactPoint(
         F, dim, b, masterAll_, cp.Vertices(0), smoothNormal, [&](const PetscReal *p, PetscInt *m, PetscReal *bm, PetscReal *dist) { cp.Find(p, m, bm, dist); },
         [&](const SurfaceFacet &M, PetscInt k) { return vnormal[M.vglobal[k]].data(); }, &e);
+      {
+        IntegrationPoint P;
+        P.s = (PetscInt)s;
+        P.m = e.m;
+        P.w = w;
+        for (PetscInt k = 0; k < 3; ++k) {
+          P.b[k]  = b[k];
+          P.bm[k] = e.bm[k];
+        }
+        points_.push_back(P);
+      }
       const SurfaceFacet &M = masterAll_[e.m];
       const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2, gap = e.gap;
       if (dim == 2)

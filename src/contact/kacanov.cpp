@@ -60,6 +60,16 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
     PetscCall(PetscLogEventRegister("RBCContactQP", MAT_CLASSID, &KAC_QP));
   }
   PetscCall(loop.SetFromOptions(comm, "")); // -kacanov_* (Anderson mixing on the contact-dof displacement: dense dual matrix only)
+  PetscOptionsBegin(comm, "kacanov_", "Kacanov iterations of the full-order model", "KacanovSolver");
+  {
+    const char *types[] = {"fixed_point", "newton"};
+    PetscInt    t       = type == "fixed_point" ? 0 : 1;
+    PetscCall(PetscOptionsEList("-type", "Next input: fixed_point (the image, Anderson-mixed) or newton (Newton step with the contact geometry's derivative; dense dual, 2D)", "docs/fom_speed.md", types, 2, types[t], &t, NULL));
+    type = types[t];
+  }
+  PetscCall(PetscOptionsReal("-newton_max_ratio", "Longest Newton step accepted, in units of the plain step |F(x) - x|", "docs/fom_speed.md", newtonMaxRatio, &newtonMaxRatio, NULL));
+  PetscOptionsEnd();
+  PetscCheck(newtonMaxRatio > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_newton_max_ratio %g must be > 0", (double)newtonMaxRatio);
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
   {
@@ -307,6 +317,24 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   const PetscBLASInt nD = (PetscBLASInt)D.size();
   loop.Begin(shell ? 0 : (PetscInt)nD); // the shell path keeps its state distributed: it records its own changes
   mixed.assign(nD, 0.0);
+  // -kacanov_type newton: dense dual matrix and 2D (the contact geometry's derivative); plain Kacanov otherwise
+  const bool             newton = type == "newton" && !shell && fom.elas.dim == 2;
+  std::vector<PetscReal> image, relaxed, newtonNext; // F(x), the relaxed image, the Newton step's input
+  PetscReal              duPrev = kInf;             // the previous iterate's change (Newton: a step that made it grow is not repeated)
+  bool                   lastNewton = false;
+  newtonSteps = 0;
+  // the contact dofs' values x (on D, every rank) into the distributed usurf
+  auto setSurface = [&](const std::vector<PetscReal> &x) -> PetscErrorCode {
+    PetscInt     lo, hi;
+    PetscScalar *us;
+    PetscFunctionBeginUser;
+    PetscCall(VecGetOwnershipRange(usurf, &lo, &hi));
+    PetscCall(VecGetArray(usurf, &us));
+    for (PetscBLASInt j = 0; j < nD; ++j)
+      if (D[j] >= lo && D[j] < hi) us[D[j] - lo] = x[j];
+    PetscCall(VecRestoreArray(usurf, &us));
+    PetscFunctionReturn(0);
+  };
   if (loop.monitor) {
     if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ")\n", R0, dualMatrixOption.c_str(), dualDenseMax));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
@@ -424,17 +452,15 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       std::vector<PetscReal> uD(u0D);
       if (nD) BLASgemv_("N", &nD, &nD, &m1, compliance.G.data(), &nD, w.data(), &one, &p1, uD.data(), &one);
       if (uDprev.empty()) uDprev.assign(nD, 0.0);
+      if (newton) image = uD; // F(x) before the relaxation: the Newton step's right-hand side F(x) - x
       du = loop.Relax(uDprev.data(), uD.data()); // the relaxed image and the change of the input
-      // the next geometry: u_D itself, or Anderson's mix of this input (uDprev) and its image (uD)
-      loop.Next(uDprev.data(), uD.data(), mixed.data());
-      uDprev = mixed;
-      PetscInt lo, hi;
-      PetscScalar *us;
-      PetscCall(VecGetOwnershipRange(usurf, &lo, &hi));
-      PetscCall(VecGetArray(usurf, &us));
-      for (PetscBLASInt j = 0; j < nD; ++j)
-        if (D[j] >= lo && D[j] < hi) us[D[j] - lo] = uDprev[j];
-      PetscCall(VecRestoreArray(usurf, &us));
+      if (newton) relaxed = uD; // the plain next input; Newton's is chosen after the stopping test
+      else {
+        // the next geometry: u_D itself, or Anderson's mix of this input (uDprev) and its image (uD)
+        loop.Next(uDprev.data(), uD.data(), mixed.data());
+        uDprev = mixed;
+        PetscCall(setSurface(uDprev));
+      }
     }
     PetscCall(PetscTime(&t0));
     fom.times.solve += t0 - t1;
@@ -470,6 +496,44 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       converged = PETSC_TRUE;
       break;
     }
+    if (newton) {
+      // Newton step on x = F(x) (kacanov_newton.cpp) from this iterate's input uDprev; the plain (relaxed)
+      // image when the step is refused or when the last Newton step made the change grow
+      KacanovNewtonInfo ni;
+      if (lastNewton && du > duPrev) ni.reason = "the last Newton step increased |F(x) - x| / |x|";
+      else {
+        ContactTangent tan;
+        bool           supported = false;
+        PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
+        PetscCall(map.AssembleTangent(comm, lam, D, image, &tan, &supported));
+        PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
+        if (!supported) ni.reason = "no tangent of the contact geometry (3D, or a point on too many dofs)";
+        else {
+          KacanovNewtonData in;
+          in.D   = &D;
+          in.R   = sys.R;
+          in.G   = compliance.G.data();
+          in.KD  = KD.data();
+          in.T   = T.data();
+          in.S   = Sfull.data();
+          in.lam = lam.data();
+          in.tan = &tan;
+          in.x   = uDprev.data();
+          in.Fx  = image.data();
+          PetscCall(KacanovNewtonStep(in, newtonMaxRatio, &newtonNext, &ni));
+        }
+      }
+      if (loop.monitor) {
+        if (ni.accepted) PetscCall(PetscPrintf(comm, "        Newton step: |dx|/|F(x)-x| %.3f, %" PetscInt_FMT " active rows, %" PetscInt_FMT " geometric dofs\n", (double)ni.ratio, ni.active, ni.columns));
+        else PetscCall(PetscPrintf(comm, "        plain step (%s)\n", ni.reason.c_str()));
+      }
+      lastNewton = ni.accepted;
+      newtonSteps += ni.accepted ? 1 : 0;
+      history.newton.push_back(ni.accepted ? 1 : 0);
+      uDprev = ni.accepted ? newtonNext : relaxed;
+      PetscCall(setSurface(uDprev));
+    }
+    duPrev = du;
     PetscCall(fom.elas.GlobalToLocalWithBC(shell ? fom.u : usurf, uloc));
   }
   if (!shell) { // the whole field at the last multipliers: u = A^{-1} (f - K^T lambda)
