@@ -81,7 +81,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   PetscFunctionReturn(0);
 }
 
-// Rank 0 reads the mesh file: its checksum and node count (msh22: the line after $Nodes).
+// Rank 0 reads the mesh file: its checksum and node count.
 static PetscErrorCode MeshFacts(MPI_Comm comm, const SceneSpec &scene, unsigned long long *checksum, PetscInt *nnodes)
 {
   std::string path;
@@ -97,8 +97,16 @@ static PetscErrorCode MeshFacts(MPI_Comm comm, const SceneSpec &scene, unsigned 
     ss << f.rdbuf();
     const std::string text = ss.str();
     buf[0]                 = (long long)Fnv1a(text);
-    const auto pos         = text.find("$Nodes");
-    if (pos != std::string::npos) buf[1] = std::atoll(text.c_str() + text.find('\n', pos) + 1);
+    // the node count: msh 2.2 has it alone on the line after $Nodes; msh 4.1 (what MeshGenerate writes) has
+    // "numEntityBlocks numNodes minNodeTag maxNodeTag" there
+    const auto fmt = text.find("$MeshFormat"), pos = text.find("$Nodes");
+    const bool v4  = fmt != std::string::npos && text.compare(text.find('\n', fmt) + 1, 1, "4") == 0;
+    if (pos != std::string::npos) {
+      std::istringstream line(text.substr(text.find('\n', pos) + 1, 200));
+      long long          a = 0, b = 0;
+      line >> a >> b;
+      buf[1] = v4 ? b : a;
+    }
   }
   PetscCallMPI(MPI_Bcast(buf, 2, MPI_LONG_LONG, 0, comm));
   *checksum = (unsigned long long)buf[0];
@@ -390,6 +398,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     rep.root["time_s"]["total"]       = (double)(t1 - t0);
     rep.root["nranks"]                = (int)wsize;
     rep.root["subcomms"]              = (long long)k;
+    rep.root["mesh_nodes"]            = (long long)nnodes; // the default -snapshots_subcomm reads it
     rep.root["snapshots"]             = snapPath;
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
