@@ -413,6 +413,23 @@ def files(args):
               "offline failing on %d rank(s) (-ecsw_max_points 1): ROM and basis file unchanged, no temporary file (%s)" % (np_, left))
     p = run(args, 1, "validate", val)
     check(p.returncode == 0, "the previous ROM and basis file still validate")
+    # the optional surface data of the max pressure and half-width (/online/outputs, since 2026-11-25): a file
+    # without it (older) solves with null outputs; a corrupt one is refused with the dataset named
+    old_rom, bad_rom = d + "/old.h5", d + "/bad.h5"
+    shutil.copy(rom, old_rom)
+    shutil.copy(rom, bad_rom)
+    with h5py.File(old_rom, "a") as f:
+        del f["/online/outputs"]
+    with h5py.File(bad_rom, "a") as f:
+        w = f["/online/outputs/W"][()]
+        del f["/online/outputs/W"]
+        f["/online/outputs/W"] = w[:, :-1]
+    run(args, 1, "online", ["-rom", old_rom, "-mu", "1.02", "-report", d + "/old.json"])
+    o = report(d + "/old.json")["outputs"]
+    check(o["max_pressure"] is None and o["contact_halfwidth"] is None and o["contact_force"] is not None,
+          "a ROM file without /online/outputs: solved, max pressure and half-width null, the force still there")
+    p = run(args, 1, "online", ["-rom", bad_rom, "-mu", "1.02"], expect_ok=False)
+    check(p.returncode != 0 and "/online/outputs" in p.stdout and bad_rom in p.stdout, "a corrupt /online/outputs/W: refused naming the file and the group (exit %d)" % p.returncode)
     shutil.rmtree(d, ignore_errors=True)
 
 
