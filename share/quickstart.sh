@@ -124,6 +124,7 @@ step "done: outputs"
 for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
 echo "fields:  $ROOT/$OUT/fom.h5, $ROOT/$OUT/online_fields.h5 (ROM)"
 echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf (open them in ParaView)"
+echo "bases:   $ROOT/$OUT/basis_view.xmf (POD modes, supremizers and the dual basis on the mesh, for ParaView)"
 echo "ROM:     $ROOT/$OUT/rom.h5 (online data), rom.basis.h5, rom.snapshots.h5"
 echo "sweep:   $ROOT/$OUT/sweep.csv, sweep_eim.csv, refine2/sweep.csv, refine2/sweep_eim.csv"
 for p in "${PICTURES[@]}"; do echo "picture: $ROOT/$p"; done
