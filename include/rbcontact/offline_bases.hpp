@@ -36,6 +36,11 @@ struct OfflineBasisSet {
 // contact). Collective on fom's communicator; world names the stage in messages.
 PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b);
 
+// The multiplier snapshots of `rbcontact dualbasis -snapshots spec` as a matrix (rows = multipliers, columns =
+// snapshots): "file.h5:/dataset" or a PETSc binary matrix (ImportSnapshotMatrix), or an offline snapshot file
+// (its lambda); negative entries beyond round-off (-1e-12 max |.|) are refused, round-off ones clipped to 0.
+PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &spec, DenseMatrix *L);
+
 // Report keys dual {type, r, train_max_err, train_max_rel_err, history, tol_abs, norm, gram_cond,
 // selected, min_entry} and nnls {solves, max_kkt, retries}; a negative basis entry is an error.
 PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Report *rep);

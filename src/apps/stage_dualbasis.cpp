@@ -6,8 +6,6 @@
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/rom_file.hpp"
-#include "rbcontact/snapshot_file.hpp"
-#include <algorithm>
 
 namespace rbc {
 
@@ -20,10 +18,12 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-snapshots", spec, sizeof spec, &set));
+  PetscOptionsBegin(comm, NULL, "rbcontact dualbasis: a nonnegative dual basis of multiplier snapshots", "rbcontact");
+  PetscCall(PetscOptionsString("-snapshots", "the multiplier snapshots: file.h5:/dataset, a PETSc binary matrix, or an offline snapshot file", "", spec, spec, sizeof spec, &set));
+  PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
+  PetscCall(PetscOptionsString("-dual_out", "write the basis (and its history) to this HDF5 file", "", out, out, sizeof out, NULL));
+  PetscOptionsEnd();
   PetscCheck(set && spec[0], comm, PETSC_ERR_USER_INPUT, "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)");
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_out", out, sizeof out, NULL));
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, out, "-dual_out"));
   {
@@ -33,26 +33,8 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
     const std::string t(type);
     PetscCheck(t == "nmf" || t == "angle" || t == "cpg" || t == "mcpg", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-dual_type: unknown value '%s' (nmf, angle, cpg or mcpg)", type);
   }
-  std::vector<std::vector<PetscReal>> cols;
-  const std::string                   s(spec);
-  if (s.find(':') == std::string::npos && s.size() > 3 && s.substr(s.size() - 3) == ".h5") {
-    std::vector<Snapshot> snaps;
-    PetscCall(SnapshotFile::ReadAll(s, &snaps));
-    for (const auto &sn : snaps) cols.push_back(sn.lambda);
-  } else PetscCall(ImportSnapshotMatrix(comm, s, &cols));
-  PetscCheck(!cols.empty() && !cols[0].empty(), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds no snapshots", spec);
   DenseMatrix L;
-  L.Resize((PetscInt)cols[0].size(), (PetscInt)cols.size());
-  PetscReal vmax = 0, vmin = 0;
-  for (PetscInt j = 0; j < L.cols; ++j)
-    for (PetscInt i = 0; i < L.rows; ++i) {
-      L(i, j) = cols[j][i];
-      vmax    = std::max(vmax, std::abs(L(i, j)));
-      vmin    = std::min(vmin, L(i, j));
-    }
-  // multipliers are nonnegative; round-off negatives of imported data are clipped, real ones refused
-  PetscCheck(vmin >= -1e-12 * vmax, comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' has negative entries (min %g, max |.| %g): multiplier snapshots must be nonnegative", spec, (double)vmin, (double)vmax);
-  for (auto &v : L.a) v = std::max(v, 0.0);
+  PetscCall(DualSnapshotMatrix(comm, spec, &L));
   PetscCall(PetscTime(&t1));
   DualBasisResult dual;
   PetscCall(BuildDualBasis(L, &dual));

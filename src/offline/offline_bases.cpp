@@ -1,6 +1,7 @@
 // src/offline/offline_bases.cpp: POD of the displacement snapshots (energy, H1 or l2 inner product of the
 // reference configuration) and the nonnegative dual basis of the multiplier snapshots; ROM file.
 #include "rbcontact/offline_bases.hpp"
+#include <algorithm>
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
@@ -359,6 +360,31 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   rep->root["time_s"]["pod"]  = (double)bs.seconds[0];
   rep->root["time_s"]["dual"] = (double)bs.seconds[1];
   rep->root["rom_file"]       = romPath;
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatrix *Lout)
+{
+  PetscFunctionBeginUser;
+  std::vector<std::vector<PetscReal>> cols;
+  if (s.find(':') == std::string::npos && s.size() > 3 && s.substr(s.size() - 3) == ".h5") {
+    std::vector<Snapshot> snaps;
+    PetscCall(SnapshotFile::ReadAll(s, &snaps));
+    for (const auto &sn : snaps) cols.push_back(sn.lambda);
+  } else PetscCall(ImportSnapshotMatrix(comm, s, &cols));
+  PetscCheck(!cols.empty() && !cols[0].empty(), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds no snapshots", s.c_str());
+  DenseMatrix &L    = *Lout;
+  PetscReal    vmax = 0, vmin = 0;
+  L.Resize((PetscInt)cols[0].size(), (PetscInt)cols.size());
+  for (PetscInt j = 0; j < L.cols; ++j)
+    for (PetscInt i = 0; i < L.rows; ++i) {
+      L(i, j) = cols[j][i];
+      vmax    = std::max(vmax, std::abs(L(i, j)));
+      vmin    = std::min(vmin, L(i, j));
+    }
+  // multipliers are nonnegative; round-off negatives of imported data are clipped, real ones refused
+  PetscCheck(vmin >= -1e-12 * vmax, comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' has negative entries (min %g, max |.| %g): multiplier snapshots must be nonnegative", s.c_str(), (double)vmin, (double)vmax);
+  for (auto &v : L.a) v = std::max(v, 0.0);
   PetscFunctionReturn(0);
 }
 
