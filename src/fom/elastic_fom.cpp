@@ -315,6 +315,22 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PCGetFailedReasonRank(pc, &pcr));
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &pcr, 1, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)ksp)));
+    // a MUMPS factorization says why in INFOG(1) (e.g. -38: -fom_mat_mumps_icntl_28 2 asks for a parallel ordering
+    // this MUMPS was built without; -9 and friends: workspace), which the generic zero-pivot hint would hide
+    PetscInt  infog1 = 0;
+    PetscBool isfactor = PETSC_FALSE;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &isfactor, PCCHOLESKY, PCLU, ""));
+    if (isfactor) {
+      MatSolverType st = NULL;
+      PetscCall(PCFactorGetMatSolverType(pc, &st));
+      if (st && !strcmp(st, MATSOLVERMUMPS)) {
+        Mat F = NULL;
+        PetscCall(PCFactorGetMatrix(pc, &F));
+        if (F) PetscCall(MatMumpsGetInfog(F, 1, &infog1));
+      }
+    }
+    PetscCheck(infog1 >= 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: the MUMPS factorization failed with INFOG(1) = %" PetscInt_FMT "%s (MUMPS manual, section 8; -fom_mat_mumps_* options set its controls)", infog1,
+               infog1 == -38 ? ": a parallel ordering (-fom_mat_mumps_icntl_28 2) that this MUMPS build lacks (PT-Scotch/ParMETIS); drop -fom_mat_mumps_icntl_28" : infog1 == -9 || infog1 == -8 || infog1 == -14 || infog1 == -15 || infog1 == -17 || infog1 == -20 ? ": its workspace is too small: raise -fom_mat_mumps_icntl_14" : infog1 == -10 ? ": the stiffness is numerically singular: a body without enough Dirichlet conditions (-dirichlet)?" : "");
     SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet)", PCFailedReasons[pcr]);
   }
   PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-dirichlet)", KSPConvergedReasons[reason]);
