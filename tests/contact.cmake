@@ -1,4 +1,4 @@
-# tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test, no-contact gap,
+# tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test (2D and 3D), no-contact gap,
 # ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers, the matrix-free
 # dual (-fom_dual_matrix shell) against the dense one, the fast FOM path against the reference settings,
 # the compliance methods against each other, the mortar segment search against the full search, the Newton
@@ -18,7 +18,8 @@ foreach(np 1 2)
   add_test(NAME contact_paths_np${np} COMMAND ${RBC_CC} paths --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_compliance_np${np} COMMAND ${RBC_CC} compliance --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_segments_np${np} COMMAND ${RBC_CC} segments --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np}
+  add_test(NAME contact_flat_punch3d_np${np} COMMAND ${RBC_CC} flat_punch3d --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np} contact_flat_punch3d_np${np}
     PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
 endforeach()
 # runs both rank counts itself and compares them

@@ -132,6 +132,25 @@ def flat_punch(args):
     check_kkt(rn)
 
 
+def flat_punch3d(args):
+    print("3D flat punch patch test: uniform pressure across non-matching interface meshes (segment-based 3D mortar)")
+    # exact: uniaxial stress in both bodies (rollers on x = 0 and y = 0, faces x = 1, y = 1 free): p = E d / H = 1
+    for tag, extra in (("slave 4 x 4, master 7 x 7", []), ("slave 6 x 6, master 4 x 4 (master coarser)", ["-mesh_geo_set", "n_punch=6,n_base=4"])):
+        r, h5 = run(args, args.np, "runs/flat_punch3d.opts", extra + args.extra, "punch3d")
+        lam, _ = contact_fields(h5)
+        with h5py.File(h5, "r") as f:
+            X = f["geometry/vertices"][()]
+        z0 = np.abs(X[:, 2]) < 1e-12
+        xy, cnt = np.unique(np.round(X[z0, :2], 9), axis=0, return_counts=True)
+        check(int((cnt == 1).sum()) > 0.5 * len(xy), "%s: the interface meshes do not match (%d of %d interface positions carry one vertex only)" % (tag, int((cnt == 1).sum()), len(xy)))
+        err = np.max(np.abs(lam - 1.0))
+        spread = (lam.max() - lam.min()) / lam.mean()
+        check(r["nactive"] == r["ncontact"] and spread <= 1e-10 and err <= 1e-10,
+              "%s: %d of %d slave nodes active, pressure %.14f .. %.14f (spread %.1e, |p - 1| %.1e <= 1e-10)" % (tag, r["nactive"], r["ncontact"], lam.min(), lam.max(), spread, err))
+        check(abs(r["contact_force"] - 1.0) <= 1e-10, "%s: contact force %.14f = p x area = 1" % (tag, r["contact_force"]))
+        check_kkt(r)
+
+
 def no_contact(args):
     print("Gap larger than any motion: lambda = 0 exactly and u = the elastic solution")
     # the ring hangs from its top ends under a body force, 0.3 above the block: both bodies deform
@@ -390,7 +409,7 @@ def compliance(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
+    ap.add_argument("check", choices=["hertz", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

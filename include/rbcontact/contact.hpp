@@ -158,6 +158,11 @@ private:
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
   PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);
   void           SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const;
+  // 3D: the slave triangle F clipped against the master triangles projected onto its plane (the segment-based
+  // mortar rule of 3D: polygon clipping, fan triangulation, the facet rule on every cell). Integration points
+  // (slave barycentric b, weight = fraction of the facet x rule weight x meas); false when the projections do
+  // not cover F (the end of the master surface): the caller keeps the plain rule there.
+  bool           ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts) const;
   ContactSurface        slave_, master_;
   std::vector<PetscInt> vertexRow_;  // local vertex point - vStart -> multiplier row (-1: not a slave vertex)
   PetscInt              R_ = 0, rStart_ = 0, rEnd_ = 0;

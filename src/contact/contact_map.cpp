@@ -267,6 +267,102 @@ static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[],
   }
 }
 
+// 3D segment-based integration (ClipFacet3). The slave triangle's deformed vertices span a plane with
+// orthonormal axes (e1, e2); every master triangle near it is projected onto that plane along its normal and
+// clipped against the slave triangle (Sutherland-Hodgman: both convex); each clipped polygon is split into a
+// fan of triangles and the facet rule (quadPoints_, quadWeights_) is applied on each. Where the master is
+// planar over a cell the integrand is polynomial there, so the rule is exact: a flat punch on non-matching
+// meshes transmits a uniform pressure (tests/contact_checks.py flat_punch3d).
+bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts) const
+{
+  using P2 = std::array<PetscReal, 2>;
+  PetscReal Z[3][3], e1[3], e2[3], n[3];
+  for (PetscInt k = 0; k < 3; ++k) {
+    const PetscReal b[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
+    SlavePoint(F, 3, b, Z[k]);
+  }
+  const PetscReal a[3] = {Z[1][0] - Z[0][0], Z[1][1] - Z[0][1], Z[1][2] - Z[0][2]}, c[3] = {Z[2][0] - Z[0][0], Z[2][1] - Z[0][1], Z[2][2] - Z[0][2]};
+  n[0] = a[1] * c[2] - a[2] * c[1];
+  n[1] = a[2] * c[0] - a[0] * c[2];
+  n[2] = a[0] * c[1] - a[1] * c[0];
+  const PetscReal la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  if (!(la > 0 && ln > 0)) return false;
+  for (PetscInt d = 0; d < 3; ++d) {
+    e1[d] = a[d] / la;
+    n[d] /= ln;
+  }
+  e2[0] = n[1] * e1[2] - n[2] * e1[1];
+  e2[1] = n[2] * e1[0] - n[0] * e1[2];
+  e2[2] = n[0] * e1[1] - n[1] * e1[0];
+  auto to2 = [&](const PetscReal *x) { const PetscReal r[3] = {x[0] - Z[0][0], x[1] - Z[0][1], x[2] - Z[0][2]}; return P2{r[0] * e1[0] + r[1] * e1[1] + r[2] * e1[2], r[0] * e2[0] + r[1] * e2[1] + r[2] * e2[2]}; };
+  const P2        S[3] = {to2(Z[0]), to2(Z[1]), to2(Z[2])};
+  const PetscReal area = 0.5 * ((S[1][0] - S[0][0]) * (S[2][1] - S[0][1]) - (S[2][0] - S[0][0]) * (S[1][1] - S[0][1])); // > 0 by construction
+  PetscReal       diam = 0, zmin[3], zmax[3];
+  for (PetscInt d = 0; d < 3; ++d) {
+    zmin[d] = std::min({Z[0][d], Z[1][d], Z[2][d]});
+    zmax[d] = std::max({Z[0][d], Z[1][d], Z[2][d]});
+    diam    = std::max(diam, zmax[d] - zmin[d]);
+  }
+  // slave barycentric coordinates of a point of the plane
+  auto bary = [&](const P2 &x, PetscReal b[3]) {
+    b[1] = 0.5 * ((x[0] - S[0][0]) * (S[2][1] - S[0][1]) - (S[2][0] - S[0][0]) * (x[1] - S[0][1])) / area;
+    b[2] = 0.5 * ((S[1][0] - S[0][0]) * (x[1] - S[0][1]) - (x[0] - S[0][0]) * (S[1][1] - S[0][1])) / area;
+    b[0] = 1 - b[1] - b[2];
+  };
+  PetscReal covered = 0;
+  std::vector<std::array<PetscReal, 4>> out;
+  for (PetscInt m = 0; m < cp.NumFacets(); ++m) {
+    const PetscReal *y = cp.Vertices(m);
+    // near the slave triangle: bounding boxes within one slave diameter
+    bool near = true;
+    for (PetscInt d = 0; d < 3 && near; ++d) {
+      const PetscReal lo = std::min({y[d], y[3 + d], y[6 + d]}), hi = std::max({y[d], y[3 + d], y[6 + d]});
+      near = hi >= zmin[d] - diam && lo <= zmax[d] + diam;
+    }
+    if (!near) continue;
+    // the master triangle projected onto the slave plane, counter-clockwise
+    std::vector<P2> clip = {to2(y), to2(y + 3), to2(y + 6)};
+    const PetscReal ma = (clip[1][0] - clip[0][0]) * (clip[2][1] - clip[0][1]) - (clip[2][0] - clip[0][0]) * (clip[1][1] - clip[0][1]);
+    if (std::abs(ma) <= 1e-14 * area) continue; // seen edge-on
+    if (ma < 0) std::swap(clip[1], clip[2]);
+    std::vector<P2> poly(S, S + 3);
+    for (PetscInt e = 0; e < 3 && !poly.empty(); ++e) {
+      const P2 &p0 = clip[e], &p1 = clip[(e + 1) % 3];
+      auto side = [&](const P2 &q) { return (p1[0] - p0[0]) * (q[1] - p0[1]) - (p1[1] - p0[1]) * (q[0] - p0[0]); };
+      std::vector<P2> next;
+      for (size_t i = 0; i < poly.size(); ++i) {
+        const P2 &u = poly[i], &v = poly[(i + 1) % poly.size()];
+        const PetscReal su = side(u), sv = side(v);
+        if (su >= 0) next.push_back(u);
+        if ((su >= 0) != (sv >= 0)) {
+          const PetscReal t = su / (su - sv);
+          next.push_back({u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1])});
+        }
+      }
+      poly.swap(next);
+    }
+    if (poly.size() < 3) continue;
+    for (size_t i = 1; i + 1 < poly.size(); ++i) { // fan from poly[0]
+      const P2       &A = poly[0], &B = poly[i], &C = poly[i + 1];
+      const PetscReal ar = 0.5 * ((B[0] - A[0]) * (C[1] - A[1]) - (C[0] - A[0]) * (B[1] - A[1]));
+      if (!(ar > 1e-14 * area)) continue;
+      covered += ar;
+      for (size_t qp = 0; qp < quadWeights_.size(); ++qp) {
+        const PetscReal *l = &quadPoints_[qp * 3];
+        const P2         x = {l[0] * A[0] + l[1] * B[0] + l[2] * C[0], l[0] * A[1] + l[1] * B[1] + l[2] * C[1]};
+        PetscReal        b[3];
+        bary(x, b);
+        out.push_back({b[0], b[1], b[2], quadWeights_[qp] * meas * ar / area});
+      }
+    }
+  }
+  // the master's projections overlap only on sets of zero area (a conforming facet soup): covered = area
+  // within rounding; anything else (the end of the master, a gap or an overlap of the projections) keeps the plain rule
+  if (std::abs(covered - area) > 1e-10 * area) return false;
+  ipts->insert(ipts->end(), out.begin(), out.end());
+  return true;
+}
+
 // 2D: pieces [s0, s1] of the slave segment (parameter t, b = (1 - t, t)) on which the closest master
 // facet does not change; the switch points are located by bisection to 1e-13. Where the closest facet is
 // ma at one end of an interval and mb at the other and the two are neighbours on the master (a common
@@ -432,6 +528,8 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
           const PetscReal t = sg.first + (sg.second - sg.first) * quadPoints_[qp * nv + 1];
           ipts.push_back({1 - t, t, 0, quadWeights_[qp] * meas * (sg.second - sg.first)});
         }
+    } else if (dim == 3 && quadrature == ContactQuadrature::Gauss && ClipFacet3(F, cp, meas, &ipts)) {
+      // segment-based: the slave triangle clipped against the projected master triangles (ClipFacet3)
     } else {
       for (PetscInt qp = 0; qp < nq; ++qp) ipts.push_back({quadPoints_[qp * nv], quadPoints_[qp * nv + 1], quadPoints_[qp * nv + 2], quadWeights_[qp] * meas});
     }
