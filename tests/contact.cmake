@@ -23,6 +23,8 @@ foreach(np 1 2)
     PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
 endforeach()
 # runs both rank counts itself and compares them
+add_test(NAME contact_hertz3d_np1_np2 COMMAND ${RBC_CC} hertz3d --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(contact_hertz3d_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
 add_test(NAME contact_ring_np1_np2 COMMAND ${RBC_CC} ring --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(contact_ring_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
 

@@ -151,6 +151,22 @@ def flat_punch3d(args):
         check_kkt(r)
 
 
+def hertz3d(args):
+    print("3D Hertz: a hemisphere on a block, against Hertz's point contact at the computed force; 1 and 2 ranks")
+    rep = {}
+    for np_ in (1, 2):
+        r, _ = run(args, np_, "runs/hertz3d.opts", args.extra, "hertz3d_np%d" % np_)
+        h = r["hertz"]
+        ea, ep = h["a"] / h["a_exact"] - 1, h["p0"] / h["p0_exact"] - 1
+        print("  %d rank(s): P %.10f, a %.5f (Hertz %.5f, %+.2f %%), p0 %.3f (Hertz %.3f, %+.2f %%), %d Kacanov iterations"
+              % (np_, h["P"], h["a"], h["a_exact"], 100 * ea, h["p0"], h["p0_exact"], 100 * ep, r["kacanov_iterations"]))
+        check(abs(ea) <= 0.03 and abs(ep) <= 0.05, "%d rank(s): contact radius within 3 %% (%+.2f %%), peak pressure within 5 %% (%+.2f %%)" % (np_, 100 * ea, 100 * ep))
+        check_kkt(r)
+        rep[np_] = r
+    rel = abs(rep[1]["contact_force"] - rep[2]["contact_force"]) / rep[1]["contact_force"]
+    check(rel <= 1e-8, "1 and 2 ranks: the same contact force to %.1e <= 1e-8" % rel)
+
+
 def no_contact(args):
     print("Gap larger than any motion: lambda = 0 exactly and u = the elastic solution")
     # the ring hangs from its top ends under a body force, 0.3 above the block: both bodies deform
@@ -409,7 +425,7 @@ def compliance(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

@@ -66,9 +66,10 @@ public:
   // Squared distance from p to facet f, b its closest point's barycentric coordinates (the searches
   // compare squares: no square root per facet).
   PetscReal DistToFacet2(PetscInt f, const PetscReal p[], PetscReal b[]) const;
+  // The facets whose bins meet the box [lo, hi] (a superset of those whose bounding box meets it; after Build).
+  void      Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const;
 
 private:
-  void                  Candidates(const PetscReal lo[], const PetscReal hi[], std::vector<PetscInt> *c) const;
   PetscInt              dim_ = 2, nv_ = 2;
   std::vector<PetscReal> xdef_;
   std::vector<PetscReal> invLen2_; // 2D: 1 / |x1 - x0|^2 per facet (0 for a degenerate one), set with the vertices
@@ -162,7 +163,8 @@ private:
   // mortar rule of 3D: polygon clipping, fan triangulation, the facet rule on every cell). Integration points
   // (slave barycentric b, weight = fraction of the facet x rule weight x meas); false when the projections do
   // not cover F (the end of the master surface): the caller keeps the plain rule there.
-  bool           ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts) const;
+  // cand: the master facets near F (every facet within `reach` of a point of F is among them), for the search.
+  bool           ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts, std::vector<PetscInt> *cand, PetscReal *reach) const;
   ContactSurface        slave_, master_;
   std::vector<PetscInt> vertexRow_;  // local vertex point - vStart -> multiplier row (-1: not a slave vertex)
   PetscInt              R_ = 0, rStart_ = 0, rEnd_ = 0;

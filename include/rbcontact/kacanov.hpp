@@ -110,7 +110,7 @@ private:
 struct ContactSummary {
   PetscInt  R = 0, nactive = 0;
   PetscReal force = 0, forceVec[3] = {0, 0, 0}, maxPressure = 0, halfwidth = 0;
-  PetscReal halfwidthMoment = 0; // 2D: 2 sqrt(int p x^2 / int p), x from the pressure centroid (= a for a Hertz profile)
+  PetscReal halfwidthMoment = 0; // 2D: 2 sqrt(int p x^2 / int p), x from the pressure centroid (= a for a Hertz profile); 3D: sqrt(5/2 int p r^2 / int p), the contact radius a of Hertz's profile
   PetscReal pressureSpread = 0; // 2D: max/min - 1 of the nodal pressure over the active nodes but the two ends
   PetscReal pressureRoughness = 0; // 2D: RMS of the second difference of the nodal pressure over the active nodes but the two ends, / their mean (node-to-node oscillation)
 };
@@ -132,5 +132,8 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
 // by the force P: the contact half-width a = sqrt(4 P Rc / (pi E*)) and the peak pressure p0 = 2 P / (pi a),
 // with 1/E* = sum over the scene's first two bodies of (1 - nu^2) / E (`rbcontact fom -hertz_radius`).
 void HertzLineContact(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0);
+// Hertz's point contact of a sphere of radius Rs on a half-space (3D) pressed by P: the contact radius
+// a = (3 P Rs / (4 E*))^(1/3) and the peak pressure p0 = 3 P / (2 pi a^2).
+void HertzPointContact(const SceneSpec &scene, PetscReal Rs, PetscReal P, PetscReal *a, PetscReal *p0);
 
 } // namespace rbc

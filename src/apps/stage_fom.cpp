@@ -22,7 +22,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscOptionsBegin(comm, NULL, "rbcontact fom: the full-order model at one parameter", "rbcontact");
   PetscCall(PetscOptionsString("-report", "Write the run's summary (JSON) here", "README.md", reportPath, reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsString("-fom_output", "Write the fields (HDF5 + XDMF for ParaView) here", "README.md", outPath, outPath, sizeof outPath, NULL));
-  PetscCall(PetscOptionsReal("-hertz_radius", "Compare with Hertz's line contact of a cylinder of this radius", "docs/contact.md", hertzRadius, &hertzRadius, &hertz));
+  PetscCall(PetscOptionsReal("-hertz_radius", "Compare with Hertz's contact of a cylinder (2D) or a sphere (3D) of this radius", "docs/contact.md", hertzRadius, &hertzRadius, &hertz));
   PetscCall(PetscOptionsBool("-fom_affine", "Assemble A(mu), f(mu) from the affine terms (default with parameters)", "docs/reference_configuration.md", affine, &affine, &affineSet));
   PetscOptionsEnd();
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
@@ -91,7 +91,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
     if (!kacanov.history.dualCG.empty()) h["dual_cg"] = std::vector<double>(kacanov.history.dualCG.begin(), kacanov.history.dualCG.end());
     if (hertz) {
       PetscReal a, p0;
-      HertzLineContact(scene, hertzRadius, cs.force, &a, &p0);
+      if (fom.elas.dim == 3) HertzPointContact(scene, hertzRadius, cs.force, &a, &p0); // a sphere of radius -hertz_radius
+      else HertzLineContact(scene, hertzRadius, cs.force, &a, &p0);                      // a cylinder
       JsonValue &hz  = rep.root["hertz"];
       hz["a"]        = (double)cs.halfwidthMoment; // from the pressure's second moment (docs/contact.md)
       hz["a_nodes"]  = (double)cs.halfwidth;       // half the extent of the active nodes

@@ -273,7 +273,7 @@ static void SlavePoint(const SurfaceFacet &F, PetscInt dim, const PetscReal b[],
 // fan of triangles and the facet rule (quadPoints_, quadWeights_) is applied on each. Where the master is
 // planar over a cell the integrand is polynomial there, so the rule is exact: a flat punch on non-matching
 // meshes transmits a uniform pressure (tests/contact_checks.py flat_punch3d).
-bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts) const
+bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, PetscReal meas, std::vector<std::array<PetscReal, 4>> *ipts, std::vector<PetscInt> *candOut, PetscReal *reach) const
 {
   using P2 = std::array<PetscReal, 2>;
   PetscReal Z[3][3], e1[3], e2[3], n[3];
@@ -286,6 +286,8 @@ bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, Petsc
   n[1] = a[2] * c[0] - a[0] * c[2];
   n[2] = a[0] * c[1] - a[1] * c[0];
   const PetscReal la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  candOut->clear();
+  *reach = 0;
   if (!(la > 0 && ln > 0)) return false;
   for (PetscInt d = 0; d < 3; ++d) {
     e1[d] = a[d] / la;
@@ -311,7 +313,13 @@ bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, Petsc
   };
   PetscReal covered = 0;
   std::vector<std::array<PetscReal, 4>> out;
-  for (PetscInt m = 0; m < cp.NumFacets(); ++m) {
+  std::vector<PetscInt> &cand = *candOut;
+  {
+    const PetscReal lo[3] = {zmin[0] - diam, zmin[1] - diam, zmin[2] - diam}, hi[3] = {zmax[0] + diam, zmax[1] + diam, zmax[2] + diam};
+    cp.Candidates(lo, hi, &cand); // the bins of the closest-point search (Build)
+    *reach = diam;                // a facet within diam of a point of F meets the box: it is a candidate
+  }
+  for (PetscInt m : cand) {
     const PetscReal *y = cp.Vertices(m);
     // near the slave triangle: bounding boxes within one slave diameter
     bool near = true;
@@ -495,8 +503,9 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   pastMasterEnd_.clear();
   points_.clear();
 
-  std::vector<PetscInt>    cols;
+  std::vector<PetscInt>    cols, near3;
   std::vector<PetscScalar> vals;
+  PetscReal                reach3 = 0;
   const PetscInt           nq = (PetscInt)quadWeights_.size();
   for (size_t s = 0; s < slave_.facets.size(); ++s) {
     const SurfaceFacet &F    = slave_.facets[s];
@@ -504,6 +513,8 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     const PetscInt     *rows = F.row.data();
     // Integration points of this slave facet (barycentric b, weight w)
     std::vector<std::array<PetscReal, 4>> ipts;
+    near3.clear();
+    reach3 = 0;
     if (quadrature == ContactQuadrature::Nodal) {
       for (PetscInt k = 0; k < nv; ++k) {
         std::array<PetscReal, 4> q = {0, 0, 0, meas / nv}; // weight: int psi_k over this facet
@@ -528,7 +539,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
           const PetscReal t = sg.first + (sg.second - sg.first) * quadPoints_[qp * nv + 1];
           ipts.push_back({1 - t, t, 0, quadWeights_[qp] * meas * (sg.second - sg.first)});
         }
-    } else if (dim == 3 && quadrature == ContactQuadrature::Gauss && ClipFacet3(F, cp, meas, &ipts)) {
+    } else if (dim == 3 && quadrature == ContactQuadrature::Gauss && ClipFacet3(F, cp, meas, &ipts, &near3, &reach3)) {
       // segment-based: the slave triangle clipped against the projected master triangles (ClipFacet3)
     } else {
       for (PetscInt qp = 0; qp < nq; ++qp) ipts.push_back({quadPoints_[qp * nv], quadPoints_[qp * nv + 1], quadPoints_[qp * nv + 2], quadWeights_[qp] * meas});
@@ -537,7 +548,16 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       const PetscReal  b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
       ContactPointEval e;
       EvaluateContactPoint(
-        F, dim, b, masterAll_, cp.Vertices(0), smoothNormal, [&](const PetscReal *p, PetscInt *m, PetscReal *bm, PetscReal *dist) { cp.Find(p, m, bm, dist); },
+        F, dim, b, masterAll_, cp.Vertices(0), smoothNormal,
+        [&](const PetscReal *p, PetscInt *m, PetscReal *bm, PetscReal *dist) {
+          // 3D clipped facets: the closest point among the facets near F is the global one when it lies within
+          // their reach (a closer facet would be among them); else the bin search
+          if (!near3.empty()) {
+            cp.FindAmong(p, near3.data(), (PetscInt)near3.size(), m, bm, dist);
+            if (*m >= 0 && *dist < reach3) return;
+          }
+          cp.Find(p, m, bm, dist);
+        },
         [&](const SurfaceFacet &M, PetscInt k) { return vnormal[M.vglobal[k]].data(); }, &e);
       {
         IntegrationPoint P;

@@ -700,6 +700,24 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
   }
   for (PetscInt d = 0; d < dim; ++d) s->force += s->forceVec[d] * s->forceVec[d];
   s->force = std::sqrt(s->force);
+  // 3D: the contact radius from the pressure's second moment in the plane normal to the resultant,
+  // a = sqrt(5/2 (int p |q|^2 / int p - |int p q / int p|^2)) (= a for Hertz's p0 sqrt(1 - r^2/a^2))
+  if (dim == 3 && s->force > 0) {
+    const PetscReal nh[3] = {s->forceVec[0] / s->force, s->forceVec[1] / s->force, s->forceVec[2] / s->force};
+    PetscReal       m0 = 0, m1[3] = {0, 0, 0}, m2 = 0;
+    for (size_t i = 0; i < lam.size(); ++i) {
+      const PetscReal xn = x[0][i] * nh[0] + x[1][i] * nh[1] + x[2][i] * nh[2], f = lam[i] * w[i];
+      PetscReal       q[3], q2 = 0;
+      for (PetscInt d = 0; d < 3; ++d) {
+        q[d] = x[d][i] - xn * nh[d];
+        q2 += q[d] * q[d];
+        m1[d] += f * q[d];
+      }
+      m0 += f;
+      m2 += f * q2;
+    }
+    if (m0 > 0) s->halfwidthMoment = std::sqrt(std::max<PetscReal>(0.0, 2.5 * (m2 / m0 - (m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]) / (m0 * m0))));
+  }
   // 2D half-width: extent of the active nodes along the tangent of the mean normal, half of it.
   if (dim == 2 && s->nactive && s->force > 0) {
     const PetscReal t[2] = {-s->forceVec[1] / s->force, s->forceVec[0] / s->force};
@@ -734,6 +752,15 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
     }
   }
   PetscFunctionReturn(0);
+}
+
+void HertzPointContact(const SceneSpec &scene, PetscReal Rs, PetscReal P, PetscReal *a, PetscReal *p0)
+{
+  PetscReal inv = 0;
+  for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
+  const PetscReal Estar = 1.0 / inv;
+  *a                    = std::cbrt(3 * P * Rs / (4 * Estar));
+  *p0                   = 3 * P / (2 * PETSC_PI * *a * *a);
 }
 
 void HertzLineContact(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0)
