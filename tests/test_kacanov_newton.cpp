@@ -19,16 +19,12 @@
 #include <cmath>
 #include <random>
 
+#include "test_check.hpp"
+
 using namespace rbc;
 
-static int failures = 0;
-static PetscErrorCode Check(MPI_Comm comm, bool ok, const char *what, double v, double bound)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(comm, "  %-6s %-74s %.3e (bound %.1e)\n", ok ? "ok" : "FAIL", what, v, bound));
-  if (!ok) ++failures;
-  PetscFunctionReturn(0);
-}
+using rbctest::Check;
+using rbctest::failures;
 
 // The values of a global vector at the sorted global indices D, on every rank.
 static PetscErrorCode ValuesAt(Vec v, const std::vector<PetscInt> &D, std::vector<PetscReal> *out)

@@ -22,21 +22,14 @@
 #include <cstring>
 #include <string>
 
+#include "test_check.hpp"
+
 using namespace rbc;
 
-static int failures = 0;
 
 // ok must be the same on every rank (all data compared here is replicated); reduced anyway.
-static PetscErrorCode Check(MPI_Comm comm, bool ok, const char *what, double v, double bound)
-{
-  int okl = ok ? 1 : 0, okg = 0;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Allreduce(&okl, &okg, 1, MPI_INT, MPI_MIN, comm));
-  PetscCall(PetscPrintf(comm, "  %-6s %-66s %.3e (bound %.1e)\n", okg ? "ok" : "FAIL", what, v, bound));
-  if (!okg) ++failures;
-  PetscFunctionReturn(0);
-}
+using rbctest::Check;
+using rbctest::failures;
 
 // rank 0's vector on every rank
 static PetscErrorCode Bcast(MPI_Comm comm, std::vector<PetscReal> *v)

@@ -8,16 +8,12 @@
 #include "rbcontact/mesh.hpp"
 #include <cmath>
 
+#include "test_check.hpp"
+
 using namespace rbc;
 
-static int failures = 0;
-static PetscErrorCode Check(MPI_Comm comm, bool ok, const char *what, double v, double bound)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(comm, "  %-6s %-58s %.3e (bound %.0e)\n", ok ? "ok" : "FAIL", what, v, bound));
-  if (!ok) ++failures;
-  PetscFunctionReturn(0);
-}
+using rbctest::Check;
+using rbctest::failures;
 
 // Moves the DM's vertices by the body maps at mu (every vertex belongs to the cells of one body).
 static PetscErrorCode MoveNodes(DM dm, const Elasticity &elas, const GeometryMap &map, const std::vector<PetscReal> &mu)
