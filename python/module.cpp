@@ -216,24 +216,9 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
   char          reportPath[PETSC_MAX_PATH_LEN] = "";
   Check(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   Check(rbc::CheckOutputPath(PETSC_COMM_WORLD, reportPath, "-report"));
-  rbc::SceneSpec scene;
-  rbc::Report    rep;
-  if (stage == "offline") {
-    rbc::OfflineSettings s;
-    Check(rbc::OfflineSettingsFromOptions(PETSC_COMM_WORLD, &s));
-    Check(rbc::SceneSpecFromOptions(PETSC_COMM_WORLD, &scene));
-    Check(rbc::RunOffline(PETSC_COMM_WORLD, scene, s, &rep));
-  } else {
-    char romPath[PETSC_MAX_PATH_LEN] = "";
-    Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
-    if (!romPath[0]) throw std::runtime_error("rbcontact.validate: give the ROM file (rom=... or -rom <file.h5>)");
-    rbc::ValidationSettings vs;
-    rbc::ParameterSet       test;
-    Check(rbc::ValidationSettingsFromOptions(PETSC_COMM_WORLD, reportPath, &vs));
-    Check(rbc::SceneSpecFromOptions(PETSC_COMM_WORLD, &scene));
-    Check(rbc::ParameterSetFromOptions(PETSC_COMM_WORLD, scene.params, "test_", &test));
-    Check(rbc::RunValidation(PETSC_COMM_WORLD, scene, romPath, test, vs, &rep));
-  }
+  rbc::Report rep;
+  if (stage == "offline") Check(rbc::RunOfflineFromOptions(PETSC_COMM_WORLD, &rep));
+  else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
   Check(rep.Write(PETSC_COMM_WORLD, reportPath));
   return rep.root.Dump();
 }

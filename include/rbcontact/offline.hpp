@@ -28,7 +28,7 @@ struct OfflineSettings {
 };
 
 // Reads the settings above (one PetscOptionsBegin block: `rbcontact offline -help` lists them) and checks
-// them: a known -offline_stop, a ROM file for the bases and rom steps, writable output paths.
+// -offline_stop; RunOffline checks the files (a ROM file for the bases and rom steps, writable paths).
 PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s);
 
 // The whole offline stage for scene on the ranks of world: checks the later steps' options first (hours
@@ -38,5 +38,9 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s);
 // affine_terms, time_s {snapshots, total, pod, dual, ...}, nranks, subcomms, snapshots, and the steps' keys
 // (pod, dual, nnls, eim, ecsw, rom, greedy). Collective on world.
 PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineSettings &s, Report *rep);
+
+// The offline stage from the options database alone, as `rbcontact offline` and the Python module run it:
+// OfflineSettingsFromOptions, SceneSpecFromOptions, RunOffline.
+PetscErrorCode RunOfflineFromOptions(MPI_Comm world, Report *rep);
 
 } // namespace rbc

@@ -18,6 +18,7 @@
 #include "rbcontact/eim.hpp"
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/reduced_qp.hpp"
+#include "rbcontact/report.hpp"
 #include "rbcontact/surface_outputs.hpp"
 #include "rbcontact/rom_file.hpp"
 
@@ -182,6 +183,9 @@ private:
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
 };
+
+// The sizes in use into a report object: N, R, Mk, Mg, Mc, hyper (ecsw|eim), ecsw_sum (points|dofs).
+void ReportSizes(const ReducedModel &m, JsonValue *r);
 
 // Writes the online part of a model (everything Open reads) to w.
 void WriteReducedModel(const ReducedModel &m, RomWriter *w);

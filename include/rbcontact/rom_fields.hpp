@@ -35,6 +35,8 @@ PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const Sc
 // The contact system at the default parameter and u = 0 (Dirichlet values lifted); numbers order's
 // multipliers if needed. Its weight is the slave mass int psi_i of the reference configuration.
 PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys);
+// Its weights int psi_i (the slave mass) on every rank, in canonical multiplier order. Collective on fom.
+PetscErrorCode ReferenceSlaveMass(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, std::vector<PetscReal> *w);
 // The full contact patch (ContactPatch::BuildFull) on the support of the dual basis Wt (r x R_fom,
 // row-major, canonical) with the primal basis modes (N x ndofs, canonical), nsub composite pieces, and
 // P = W' Psi (r x Q, row-major). The surfaces are assembled at the default parameter with u = 0 (they

@@ -72,6 +72,9 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene);
 // Lamé coefficients of a body: L = E nu / ((1 + nu)(1 - 2 nu)), G = E / (2 (1 + nu)).
 void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G);
 
+// The names of the options in PETSc's database, as given (with the leading '-'), and lowered (without it).
+PetscErrorCode OptionNames(std::vector<std::string> *given, std::vector<std::string> *lowered);
+
 // Splits "a,b,c" (no empty items).
 std::vector<std::string> SplitList(const std::string &s, char sep = ',');
 // The shortest decimal that reads back to x (1.1500000001, not 1.15 or 1.1500000000999999).

@@ -29,4 +29,9 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 // also sweep [rows] and sweep_files. An error if the ROM fails on a test parameter. Collective on comm.
 PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::string &romPath, const ParameterSet &test, const ValidationSettings &s, Report *rep);
 
+// The validate stage from the options database alone, as `rbcontact validate` and the Python module run it: -rom
+// (required), ValidationSettingsFromOptions (reportPath: the sweep's default stem), the scene, the test set
+// (-test_*), RunValidation.
+PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &reportPath, Report *rep);
+
 } // namespace rbc

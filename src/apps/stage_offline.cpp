@@ -8,19 +8,15 @@ namespace rbc {
 
 PetscErrorCode StageOffline(MPI_Comm world)
 {
-  SceneSpec       scene;
-  Report          rep;
-  OfflineSettings s;
-  char            reportPath[PETSC_MAX_PATH_LEN] = "";
+  Report rep;
+  char   reportPath[PETSC_MAX_PATH_LEN] = "";
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(world, NULL, "rbcontact offline: report", "rbcontact");
   PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
   PetscOptionsEnd();
   PetscCall(CheckOutputPath(world, reportPath, "-report"));
-  PetscCall(OfflineSettingsFromOptions(world, &s));
-  PetscCall(SceneSpecFromOptions(world, &scene));
-  PetscCall(RunOffline(world, scene, s, &rep));
+  PetscCall(RunOfflineFromOptions(world, &rep));
   PetscCall(rep.Write(world, reportPath));
   PetscFunctionReturn(0);
 }

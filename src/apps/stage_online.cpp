@@ -102,13 +102,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   k["stationarity"]              = (double)sol.qp.stationarity;
   JsonValue &r                   = rep.root["rom"];
   r["file"]                      = romPath;
-  r["N"]                         = (long long)model.N();
-  r["R"]                         = (long long)model.R();
-  r["Mk"]                        = (long long)model.Mk();
-  r["Mg"]                        = (long long)model.Mg();
-  r["Mc"]                        = (long long)model.Mc();
-  r["hyper"]                     = model.HyperName();
-  r["ecsw_sum"]                  = model.EcswSumsByDofs() ? "dofs" : "points";
+  ReportSizes(model, &r);
   rep.root["time_s"]["open"]     = tOpen;
   rep.root["time_s"]["solve_median"] = times[times.size() / 2];
   rep.root["time_s"]["solve_min"]    = times.front();

@@ -281,10 +281,8 @@ bool ContactMap::ClipFacet3(const SurfaceFacet &F, const ClosestPoint &cp, Petsc
     const PetscReal b[3] = {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0};
     SlavePoint(F, 3, b, Z[k]);
   }
-  const PetscReal a[3] = {Z[1][0] - Z[0][0], Z[1][1] - Z[0][1], Z[1][2] - Z[0][2]}, c[3] = {Z[2][0] - Z[0][0], Z[2][1] - Z[0][1], Z[2][2] - Z[0][2]};
-  n[0] = a[1] * c[2] - a[2] * c[1];
-  n[1] = a[2] * c[0] - a[0] * c[2];
-  n[2] = a[0] * c[1] - a[1] * c[0];
+  const PetscReal a[3] = {Z[1][0] - Z[0][0], Z[1][1] - Z[0][1], Z[1][2] - Z[0][2]};
+  FacetNormal(&Z[0][0], 3, 1.0, n); // (Z1 - Z0) x (Z2 - Z0) / 2
   const PetscReal la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), ln = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   candOut->clear();
   *reach = 0;

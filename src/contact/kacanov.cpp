@@ -2,7 +2,6 @@
 // matrix-free S of dual_shell.cpp: -fom_dual_matrix), KKT checks and the contact summary (force,
 // pressure, active zone).
 #include "rbcontact/kacanov.hpp"
-#include <cctype>
 #include "contact_point.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -22,21 +21,12 @@ KacanovSolver::~KacanovSolver() { (void)VecDestroy(&lambda); }
 // a -fom_tao_* option still works for one release, moved to -fom_qp_tao_* with a deprecation warning.
 static PetscErrorCode RenameTaoOptions(MPI_Comm comm)
 {
-  char                    *all = NULL;
-  std::vector<std::string> old;
+  std::vector<std::string> given, lowered, old;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetAll(NULL, &all));
-  {
-    std::istringstream in(all ? all : "");
-    std::string        tok;
-    while (in >> tok) {
-      std::string low = tok;
-      for (auto &c : low) c = (char)std::tolower((unsigned char)c);
-      if (low.compare(0, 9, "-fom_tao_") == 0) old.push_back(tok);
-    }
-  }
-  PetscCall(PetscFree(all));
+  PetscCall(OptionNames(&given, &lowered));
+  for (size_t i = 0; i < given.size(); ++i)
+    if (lowered[i].compare(0, 8, "fom_tao_") == 0) old.push_back(given[i]);
   for (const auto &o : old) {
     const std::string now = "-fom_qp_tao_" + o.substr(9);
     char              val[PETSC_MAX_PATH_LEN] = "";
@@ -754,22 +744,24 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
   PetscFunctionReturn(0);
 }
 
-void HertzPointContact(const SceneSpec &scene, PetscReal Rs, PetscReal P, PetscReal *a, PetscReal *p0)
+// The contact modulus E* of the scene's first two bodies: 1/E* = sum (1 - nu^2) / E.
+static PetscReal ContactModulus(const SceneSpec &scene)
 {
   PetscReal inv = 0;
   for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
-  const PetscReal Estar = 1.0 / inv;
-  *a                    = std::cbrt(3 * P * Rs / (4 * Estar));
-  *p0                   = 3 * P / (2 * PETSC_PI * *a * *a);
+  return 1.0 / inv;
+}
+
+void HertzPointContact(const SceneSpec &scene, PetscReal Rs, PetscReal P, PetscReal *a, PetscReal *p0)
+{
+  *a  = std::cbrt(3 * P * Rs / (4 * ContactModulus(scene)));
+  *p0 = 3 * P / (2 * PETSC_PI * *a * *a);
 }
 
 void HertzLineContact(const SceneSpec &scene, PetscReal Rc, PetscReal P, PetscReal *a, PetscReal *p0)
 {
-  PetscReal inv = 0;
-  for (size_t b = 0; b < 2 && b < scene.bodies.size(); ++b) inv += (1 - scene.bodies[b].nu * scene.bodies[b].nu) / scene.bodies[b].E;
-  const PetscReal Estar = 1.0 / inv;
-  *a                    = std::sqrt(4 * P * Rc / (PETSC_PI * Estar));
-  *p0                   = 2 * P / (PETSC_PI * *a);
+  *a  = std::sqrt(4 * P * Rc / (PETSC_PI * ContactModulus(scene)));
+  *p0 = 2 * P / (PETSC_PI * *a);
 }
 
 } // namespace rbc

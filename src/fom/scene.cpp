@@ -95,6 +95,27 @@ static PetscErrorCode Renamed(MPI_Comm comm, const std::string &now, const std::
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode OptionNames(std::vector<std::string> *given, std::vector<std::string> *lowered)
+{
+  char *all = NULL;
+
+  PetscFunctionBeginUser;
+  given->clear();
+  lowered->clear();
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  std::istringstream in(all ? all : "");
+  PetscCall(PetscFree(all));
+  // "-name value -flag ...": a name is a word of '-' and a letter (a value like -0.1 is not)
+  for (std::string tok; in >> tok;) {
+    if (tok.size() < 2 || tok[0] != '-' || !std::isalpha((unsigned char)tok[1])) continue;
+    std::string low = tok.substr(1);
+    for (auto &c : low) c = (char)std::tolower((unsigned char)c);
+    given->push_back(tok);
+    lowered->push_back(low);
+  }
+  PetscFunctionReturn(0);
+}
+
 std::string ShortestReal(double x)
 {
   char buf[40];
@@ -241,19 +262,16 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
 
   { // the options that name a body (-map_<body>[_...], -param_E_<body>, -param_nu_<body>) must name one of -bodies:
     // a misspelled body would otherwise leave its map or parameter silently unused (the run "succeeds")
-    char *all = NULL;
-    PetscCall(PetscOptionsGetAll(NULL, &all));
-    std::istringstream in(all ? all : "");
-    PetscCall(PetscFree(all));
+    std::vector<std::string> given, lowered;
+    PetscCall(OptionNames(&given, &lowered));
     auto lower = [](std::string x) {
       for (auto &c : x) c = (char)std::tolower((unsigned char)c);
       return x;
     };
-    std::string tok, names;
+    std::string names;
     for (const auto &b : scene->bodies) names += (names.empty() ? "" : ", ") + b.name;
-    while (in >> tok) {
-      if (tok.size() < 2 || tok[0] != '-' || !std::isalpha((unsigned char)tok[1])) continue;
-      const std::string name = lower(tok.substr(1));
+    for (size_t o = 0; o < given.size(); ++o) {
+      const std::string &tok = given[o], &name = lowered[o];
       for (const std::string pre : {"map_", "param_e_", "param_nu_"}) {
         if (name.compare(0, pre.size(), pre) != 0) continue;
         const std::string rest = name.substr(pre.size());

@@ -70,15 +70,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   s->monitor   = monitor;
   s->trainType = trainType;
   s->basisView = viewPath;
-  PetscCheck(s->basisView.empty() || s->stop == OfflineStop::Rom, comm, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", stop);
-  if (!s->basisView.empty()) PetscCall(CheckOutputPath(comm, s->basisView, "-offline_basis_output"));
-  const bool bases = s->stop != OfflineStop::Snapshots;
-  PetscCheck(!bases || !s->rom.empty(), comm, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
-  PetscCheck(!s->snapshots.empty(), comm, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
-  if (bases) PetscCall(CheckOutputPath(comm, s->rom, "-rom"));
-  PetscCall(CheckOutputPath(comm, s->snapshots, "-snapshots"));
-  if (s->stop == OfflineStop::Rom) PetscCall(CheckOutputPath(comm, s->basis, "-rom_basis"));
-  PetscFunctionReturn(0);
+  PetscFunctionReturn(0); // the files are checked by RunOffline, before any work
 }
 
 // Rank 0 reads the mesh file: its checksum and node count.
@@ -138,6 +130,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   if (bases) PetscCall(CheckOutputPath(world, s.rom, "-rom"));
   PetscCall(CheckOutputPath(world, s.snapshots, "-snapshots"));
   if (full) PetscCall(CheckOutputPath(world, s.basis, "-rom_basis"));
+  PetscCheck(s.basisView.empty() || full, world, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
+  if (!s.basisView.empty()) PetscCall(CheckOutputPath(world, s.basisView, "-offline_basis_output"));
   PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
   // -train_type greedy (docs/greedy_training.md): the snapshot file's training set is the pool (initial
   // set, then the candidates); the FOM solves the initial set, then the parameters the indicator picks
@@ -410,6 +404,18 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " group%s of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, k == 1 ? "" : "s", (double)(t1 - t0), bases ? romPath : snapPath));
   }
   PetscCall(PetscSubcommDestroy(&psub));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RunOfflineFromOptions(MPI_Comm world, Report *rep)
+{
+  OfflineSettings s;
+  SceneSpec       scene;
+
+  PetscFunctionBeginUser;
+  PetscCall(OfflineSettingsFromOptions(world, &s));
+  PetscCall(SceneSpecFromOptions(world, &scene));
+  PetscCall(RunOffline(world, scene, s, rep));
   PetscFunctionReturn(0);
 }
 

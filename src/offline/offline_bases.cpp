@@ -129,12 +129,10 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     PetscCheck(!massWeighted || cmap, world, PETSC_ERR_ARG_INCOMP, "-dual_mass_weighted needs the scene's contact surfaces (-contact_slave, -contact_master)");
     std::vector<PetscReal> sw(R, 1.0);
     if (massWeighted) {
-      ContactSystem          sys;
       std::vector<PetscReal> w;
-      PetscCall(AssembleReferenceContact(fom, *cmap, order, &sys));
-      PetscCall(GatherVec(sys.weight, &w));
+      PetscCall(ReferenceSlaveMass(fom, *cmap, order, &w));
       PetscCheck((PetscInt)w.size() == R, world, PETSC_ERR_PLIB, "slave mass of %zu entries for %" PetscInt_FMT " multipliers", w.size(), R);
-      for (PetscInt i = 0; i < R; ++i) sw[order.CanonicalMultiplier(i)] = std::sqrt(std::max<PetscReal>(w[i], 0));
+      for (PetscInt i = 0; i < R; ++i) sw[i] = std::sqrt(std::max<PetscReal>(w[i], 0));
       for (PetscInt j = 0; j < m; ++j)
         for (PetscInt i = 0; i < R; ++i) L(i, j) *= sw[i];
     }

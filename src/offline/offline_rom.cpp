@@ -433,11 +433,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     std::vector<PetscInt> canon(Rfom);
     for (PetscInt g = 0; g < Rfom; ++g) canon[g] = order.CanonicalMultiplier(g);
     rm.surface.Build(fom.elas.dim, facets, canon, Rfom, R, dual.W.a);
-    ContactSystem          sys;
-    std::vector<PetscReal> wf, wc(Rfom), ws, xs;
-    PetscCall(AssembleReferenceContact(fom, cmap, order, &sys));
-    PetscCall(GatherVec(sys.weight, &wf));
-    for (PetscInt g = 0; g < Rfom; ++g) wc[canon[g]] = wf[g];
+    std::vector<PetscReal> wc, ws, xs;
+    PetscCall(ReferenceSlaveMass(fom, cmap, order, &wc));
     rm.surface.Weights(fom.map, ParamValues(fom.scene), &ws, &xs);
     PetscReal dmax = 0, wmax = 0;
     for (PetscInt i = 0; i < Rfom; ++i) {

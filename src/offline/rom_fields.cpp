@@ -143,6 +143,19 @@ PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, Canon
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ReferenceSlaveMass(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, std::vector<PetscReal> *w)
+{
+  ContactSystem          sys;
+  std::vector<PetscReal> wg;
+
+  PetscFunctionBeginUser;
+  PetscCall(AssembleReferenceContact(fom, cmap, order, &sys));
+  PetscCall(GatherVec(sys.weight, &wg));
+  w->assign(wg.size(), 0.0);
+  for (size_t g = 0; g < wg.size(); ++g) (*w)[order.CanonicalMultiplier((PetscInt)g)] = wg[g];
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BuildFullContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<double> &modes, PetscInt N, const std::vector<double> &Wt, PetscInt r, PetscInt nsub, std::shared_ptr<ContactPatch> *full, std::vector<PetscReal> *P)
 {
   ContactSystem sys;

@@ -342,13 +342,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     rep.root["rom_kacanov_iterations"]["per_parameter"] = its;
   }
   JsonValue &ro = rep.root["rom"];
-  ro["N"]  = (long long)model.N();
-  ro["R"]  = (long long)model.R();
-  ro["Mk"] = (long long)model.Mk();
-  ro["Mg"] = (long long)model.Mg();
-  ro["Mc"] = (long long)model.Mc();
-  ro["hyper"] = model.HyperName();
-  ro["ecsw_sum"] = model.EcswSumsByDofs() ? "dofs" : "points";
+  ReportSizes(model, &ro);
   ro["ndofs"] = (long long)order.NumDofs();
 
   // speed against error over truncations of the same ROM
@@ -403,6 +397,26 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   PetscCall(VecDestroy(&work));
   PetscCall(VecDestroy(&work2));
   PetscCall(VecDestroy(&lwork));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &reportPath, Report *rep)
+{
+  char               romPath[PETSC_MAX_PATH_LEN] = "";
+  PetscBool          set                         = PETSC_FALSE;
+  SceneSpec          scene;
+  ValidationSettings s;
+  ParameterSet       test;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "rbcontact validate: the ROM file", "rbcontact");
+  PetscCall(PetscOptionsString("-rom", "the ROM file (written by rbcontact offline)", "", romPath, romPath, sizeof romPath, &set));
+  PetscOptionsEnd();
+  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+  PetscCall(ValidationSettingsFromOptions(comm, reportPath, &s));
+  PetscCall(SceneSpecFromOptions(comm, &scene));
+  PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
+  PetscCall(RunValidation(comm, scene, romPath, test, s, rep));
   PetscFunctionReturn(0);
 }
 

@@ -58,8 +58,6 @@ PetscErrorCode ReadChecked(const std::string &file, const std::string &name, siz
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found) { return RomReadOptional(file, name, data, found); }
-
 std::vector<PetscInt> ToInt(const std::vector<double> &d) { return std::vector<PetscInt>(d.begin(), d.end()); }
 } // namespace
 
@@ -179,6 +177,17 @@ PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector
 }
 
 // ------------------------------------------------------------------ model I/O
+void ReportSizes(const ReducedModel &m, JsonValue *r)
+{
+  (*r)["N"]        = (long long)m.N();
+  (*r)["R"]        = (long long)m.R();
+  (*r)["Mk"]       = (long long)m.Mk();
+  (*r)["Mg"]       = (long long)m.Mg();
+  (*r)["Mc"]       = (long long)m.Mc();
+  (*r)["hyper"]    = m.HyperName();
+  (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
+}
+
 void WriteReducedModel(const ReducedModel &m, RomWriter *w)
 {
   const U64 N = m.Nfull, R = m.Rfull;
@@ -279,7 +288,7 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   warmL.clear();
   {
     bool found;
-    PetscCall(ReadOptional(path, "/online/warm/mu", &warmMu, &found));
+    PetscCall(RomReadOptional(path, "/online/warm/mu", &warmMu, &found));
     if (!found) warmMu.clear();
     else {
       const size_t nw = warmMu.size() / std::max<size_t>(1, par.params.size());
@@ -293,13 +302,13 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   hyperDefault = ContactMode::EIM;
   {
     bool found;
-    PetscCall(ReadOptional(path, "/online/ecsw/points", &d, &found));
+    PetscCall(RomReadOptional(path, "/online/ecsw/points", &d, &found));
     if (found) {
       cPoint = ToInt(d);
       for (PetscInt p : cPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw/points out of range", path.c_str());
       PetscCall(ReadChecked(path, "/online/ecsw/Pw", R * cPoint.size(), &cPw));
     }
-    PetscCall(ReadOptional(path, "/online/hyper_default", &d, &found));
+    PetscCall(RomReadOptional(path, "/online/hyper_default", &d, &found));
     if (found) {
       PetscCheck(d.size() == 1 && (d[0] == 0 || d[0] == 1) && (d[0] == 0 || !cPoint.empty()), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default is malformed", path.c_str());
       hyperDefault = d[0] == 1 ? ContactMode::Cubature : ContactMode::EIM;
@@ -309,7 +318,7 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   MkDefault = MgDefault = -1;
   { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
     bool found;
-    PetscCall(ReadOptional(path, "/online/eim_default", &d, &found));
+    PetscCall(RomReadOptional(path, "/online/eim_default", &d, &found));
     if (found) {
       PetscCheck(d.size() == 2 && d[0] >= -1 && d[0] <= MkFull && d[1] >= -1 && d[1] <= MgFull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_default must hold 2 sizes within [-1, Mk = %" PetscInt_FMT "] and [-1, Mg = %" PetscInt_FMT "]", path.c_str(), MkFull, MgFull);
       MkDefault = (PetscInt)d[0];

@@ -1,6 +1,7 @@
 // src/rom/surface_outputs.cpp: the maximum pressure and the contact half-width of a reduced solution from
 // the dual basis on the slave vertices and the slave facets (include/rbcontact/surface_outputs.hpp).
 #include "rbcontact/surface_outputs.hpp"
+#include "../contact/contact_point.hpp"
 #include <algorithm>
 #include <cmath>
 
@@ -37,13 +38,7 @@ void SurfaceOutputs::Weights(const GeometryMap &map, const std::vector<PetscReal
     const Affine     a   = map.Evaluate((PetscInt)rec[0], mu);
     PetscReal        X[9] = {0};
     for (PetscInt k = 0; k < nv; ++k) a.Apply(dim_, rec + 5 + k * dim_, X + k * dim_);
-    // the facet's measure at mu (a segment or a triangle)
-    PetscReal meas = 0;
-    if (dim_ == 2) meas = std::hypot(X[2] - X[0], X[3] - X[1]);
-    else {
-      const PetscReal u[3] = {X[3] - X[0], X[4] - X[1], X[5] - X[2]}, v[3] = {X[6] - X[0], X[7] - X[1], X[8] - X[2]};
-      meas = 0.5 * std::sqrt(PetscSqr(u[1] * v[2] - u[2] * v[1]) + PetscSqr(u[2] * v[0] - u[0] * v[2]) + PetscSqr(u[0] * v[1] - u[1] * v[0]));
-    }
+    const PetscReal meas = FacetMeasure(X, dim_); // the facet's measure at mu (a segment or a triangle)
     for (PetscInt k = 0; k < nv; ++k) {
       const PetscInt i = (PetscInt)rec[2 + k];
       if (i < 0 || i >= Rfom_) continue;
