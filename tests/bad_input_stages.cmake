@@ -49,6 +49,6 @@ rbc_bad_stage_np2(real_value_unparsed "Input string 100abc has no numeric value 
 rbc_bad_stage_np2(mu_count "-mu has 2 values; the scene has 1 parameters [(]radius, in this order[)]" fom -options_file runs/ring_on_block.opts -mu 1,1.1)
 rbc_bad_stage_np2(output_dir_fom "-report /nonexistent_rbc/r.json: cannot write there" fom -options_file runs/ring_on_block.opts -report /nonexistent_rbc/r.json)
 # a MUMPS control this build cannot honour: the failure names MUMPS's INFOG(1) and the option, not the generic zero-pivot hint
-rbc_bad_stage_np2(mumps_parallel_ordering "INFOG[(]1[)] = -38: a parallel ordering [(]-fom_mat_mumps_icntl_28 2[)]" fom -options_file runs/ring_on_block.opts -fom_mat_mumps_icntl_28 2 -fom_mat_mumps_icntl_29 2)
+rbc_bad_stage_np2(mumps_parallel_ordering "INFOG[(]1[)] = -38: a parallel ordering [(]-fom_mat_mumps_icntl_28 2[)]" fom -options_file runs/ring_on_block.opts -mesh_partitioner metis -fom_mat_mumps_icntl_28 2 -fom_mat_mumps_icntl_29 2)
 rbc_bad_stage_np2(output_dir_offline "-rom /nonexistent_rbc/rom.h5: cannot write there" offline -options_file runs/ring_on_block.opts -rom /nonexistent_rbc/rom.h5)
 rbc_bad_stage_np2(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of physical group 'master'[)] has the tag of physical group 'pin_core'" fom -options_file runs/hard_cases/pin_in_hole.opts -mesh_file @PIN_MSH22@)

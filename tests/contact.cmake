@@ -25,8 +25,9 @@ endforeach()
 # runs both rank counts itself and compares them
 add_test(NAME contact_hertz3d_np1_np2 COMMAND ${RBC_CC} hertz3d --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(contact_hertz3d_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
+add_test(NAME contact_partition_np1_np2 COMMAND ${RBC_CC} partition --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 add_test(NAME contact_ring_np1_np2 COMMAND ${RBC_CC} ring --exe $<TARGET_FILE:rbcontact_exe> WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-set_tests_properties(contact_ring_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
+set_tests_properties(contact_ring_np1_np2 contact_partition_np1_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS 2 LABELS contact)
 
 rbc_test_exe(test_bound_qp)
 rbc_add_mpi_test(NAME bound_qp RANKS 1 COMMAND $<TARGET_FILE:test_bound_qp> LABELS contact)

@@ -401,7 +401,7 @@ def segments(args):
 def compliance(args):
     """The compliance G = (A^-1)_DD by each method against the default: MUMPS's selected entries of the
     inverse on the KSP's factor (inverse) and one back-solve per contact dof (solves) give the same
-    multipliers and force as the default (schur on 1 rank, redundant on several) to 1e-9; inverse without a
+    multipliers and force as the default (schur on 1 rank, per rank with bodies on 2: check "partition") to 1e-9; inverse without a
     MUMPS factor is refused with a message naming the option."""
     print("Compliance methods (np %d)" % args.np)
     opts = ["-mu", "1.1"] + args.extra
@@ -423,9 +423,38 @@ def compliance(args):
           "inverse without a MUMPS factor: exit %d, message names the option" % p.returncode)
 
 
+def partition(args):
+    """2 ranks with whole bodies per rank (-mesh_partitioner auto picks bodies for two bodies on two ranks):
+    the stiffness has no coupling between ranks, each rank factors its own body with the Schur complement on
+    its contact dofs (report: partition bodies, compliance "schur per rank ..."). Against 1 rank and against
+    METIS's partition (compliance redundant): the same displacement, multipliers and force to 1e-9, the same
+    Kacanov iterations; for ring_on_block and half_disks P2 (their bodies differ in size)."""
+    print("Partition by bodies (np 1 and 2)")
+    for scene, extra in (("runs/ring_on_block.opts", ["-mu", "1.1"]), ("runs/half_disks.opts", ["-fem_degree", "2"])):
+        r1, h1 = run(args, 1, scene, extra + args.extra, "part_np1")
+        rb, hb = run(args, 2, scene, extra + args.extra, "part_bodies")
+        rm, hm = run(args, 2, scene, extra + args.extra + ["-mesh_partitioner", "metis"], "part_metis")
+        name = os.path.basename(scene)
+        check(r1["partition"] == "none" and rb["partition"] == "bodies" and rm["partition"] == "metis",
+              "%s: partitions %s / %s / %s (none, bodies, metis)" % (name, r1["partition"], rb["partition"], rm["partition"]))
+        check(rb["compliance"].startswith("schur per rank") and rm["compliance"] == "redundant",
+              "%s: compliance '%s' with bodies, '%s' with metis" % (name, rb["compliance"], rm["compliance"]))
+        l1, x1 = contact_fields(h1)
+        u1 = vertex_field(h1)
+        for tag, r, h5 in (("bodies", rb, hb), ("metis", rm, hm)):
+            l, x = contact_fields(h5)
+            u = vertex_field(h5)
+            df = abs(r["contact_force"] - r1["contact_force"]) / abs(r1["contact_force"])
+            dl = np.max(np.abs(l - l1)) / np.max(np.abs(l1)) if l.shape == l1.shape and np.allclose(x, x1) else float("inf")
+            du = np.max(np.abs(u - u1)) / np.max(np.abs(u1)) if u.shape == u1.shape else float("inf")
+            check(df <= 1e-9 and dl <= 1e-9 and du <= 1e-9, "%s %s vs 1 rank: force %.1e, multipliers %.1e, displacement %.1e <= 1e-9" % (name, tag, df, dl, du))
+            check(r["kacanov_iterations"] == r1["kacanov_iterations"], "%s %s: %d Kacanov iterations (1 rank %d)" % (name, tag, r["kacanov_iterations"], r1["kacanov_iterations"]))
+            check_kkt(r)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

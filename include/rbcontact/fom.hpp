@@ -36,12 +36,17 @@ public:
   // The contact dofs D of the dense dual solve (KacanovSolver::ShareFactor sets them). On 1 rank with the
   // default direct solver (preonly + Cholesky + MUMPS) and -contact_compliance auto|schur, A is then
   // factored once with MUMPS and its Schur complement on D: the compliance reads that Schur complement
-  // and every solve uses the same factor (one factorization per parameter; docs/fom_speed.md).
+  // and every solve uses the same factor (one factorization per parameter; docs/fom_speed.md). The same on
+  // several ranks when A has no coupling between them (-mesh_partitioner bodies): each rank factors its
+  // own block with the Schur complement on its dofs of D (SchurIsLocal).
   void SetSchurDofs(const std::vector<PetscInt> &D) { schurDofs_ = D; }
   const std::vector<PetscInt> &SchurDofs() const { return schurDofs_; }
   // The Schur complement S_A = A_DD - A_DI A_II^{-1} A_ID of the last factorization (a sequential
-  // dense copy), or null when A was factored by the KSP alone.
+  // dense copy), or null when A was factored by the KSP alone (or this rank holds no dof of D).
   Mat SchurComplement() const { return schurS_; }
+  // True (on every rank) when each rank factored its own block: SchurComplement() is then the block of
+  // this rank's dofs of D (those in its ownership range, in order) and (A^{-1})_DD is block diagonal.
+  bool SchurIsLocal() const { return schurFactor_ && schurLocal_; }
   // u = A^{-1} rhs with the factored operator.
   PetscErrorCode ApplyInverse(Vec rhs, Vec x);
   // Plain elastic solve u = A^{-1} f.
@@ -82,6 +87,10 @@ private:
   bool                  residualChecked_ = false; // the first solve after a factorization checks ||A x - rhs||
   std::vector<PetscInt> schurDofs_;
   Mat                   schurFactor_ = nullptr, schurS_ = nullptr; // MUMPS factor with the Schur on D, S copy
+  Mat                   factored_    = nullptr;                    // the matrix schurFactor_ factors (A, or its diagonal block)
+  bool                  schurLocal_  = false;                      // each rank factors its own block
+  PetscInt              schurRank_   = 0;                          // this rank's dofs of D in the factor's Schur set
+  Vec                   bLocal_ = nullptr, xLocal_ = nullptr;      // sequential views of the local parts (schurLocal_)
 };
 
 // One attribute of an XDMF grid: display name, HDF5 dataset path, components, node or cell centred.

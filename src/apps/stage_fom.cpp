@@ -66,6 +66,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["converged"]          = (bool)kacanov.converged;
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
     rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
+    if (kacanov.dualMatrix == "dense") rep.root["compliance"] = kacanov.compliance.method; // how G = (A^-1)_DD was computed (-contact_compliance)
     rep.root["initial_overlap"]["max_penetration"] = (double)kacanov.initialPenetration; // at u = 0 (0: none)
     rep.root["initial_overlap"]["nodes"]           = (long long)kacanov.initialPenetrating;
     rep.root["ncontact"]           = (long long)cs.R;

@@ -1,4 +1,5 @@
-// src/contact/compliance.cpp: G = (A^{-1})_{DD} by a MUMPS Schur complement (serial), by MUMPS's
+// src/contact/compliance.cpp: G = (A^{-1})_{DD} by a MUMPS Schur complement (serial, or per rank when
+// A has no coupling between ranks), by MUMPS's
 // selected entries of the inverse on the parallel factor, or by back-solves with unit right-hand sides.
 #include "rbcontact/compliance.hpp"
 #include <petscblaslapack.h>
@@ -30,6 +31,46 @@ static PetscErrorCode InverseOfSchur(Mat S, std::vector<PetscReal> *G)
   PetscCheck(!linfo, PETSC_COMM_SELF, PETSC_ERR_LIB, "Contact compliance: LAPACK potri info %d", (int)linfo);
   for (PetscInt j = 0; j < n; ++j)
     for (PetscInt i = 0; i < j; ++i) (*G)[i + (size_t)j * n] = (*G)[j + (size_t)i * n];
+  PetscFunctionReturn(0);
+}
+
+// G = blockdiag(G_r) from each rank's Schur complement on its dofs of D (A without coupling between ranks:
+// (A^{-1})_DD is block diagonal; the ranks' dofs of D are consecutive in D, rank by rank).
+static PetscErrorCode ComplianceFromLocalSchur(ElasticFOM &fom, const std::vector<PetscInt> &D, std::vector<PetscReal> *G)
+{
+  MPI_Comm               comm = PetscObjectComm((PetscObject)fom.A);
+  PetscMPIInt            size;
+  std::vector<PetscReal> Gr;
+  PetscInt               nr = 0;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  if (fom.SchurComplement()) {
+    PetscCall(InverseOfSchur(fom.SchurComplement(), &Gr));
+    PetscCall(MatGetSize(fom.SchurComplement(), &nr, NULL));
+  }
+  std::vector<PetscMPIInt> counts(size), cdispl(size), sizes(size);
+  PetscMPIInt              nrm = (PetscMPIInt)nr, cnt = (PetscMPIInt)(nr * nr);
+  PetscCallMPI(MPI_Allgather(&nrm, 1, MPI_INT, sizes.data(), 1, MPI_INT, comm));
+  size_t total = 0, nD = 0;
+  for (PetscMPIInt r = 0; r < size; ++r) {
+    counts[r] = sizes[r] * sizes[r];
+    cdispl[r] = (PetscMPIInt)total;
+    total += (size_t)counts[r];
+    nD += (size_t)sizes[r];
+  }
+  PetscCheck(nD == D.size(), comm, PETSC_ERR_PLIB, "compliance: the ranks' Schur complements cover %zu of the %zu contact dofs", nD, D.size());
+  std::vector<PetscReal> blocks(total);
+  PetscCallMPI(MPI_Allgatherv(Gr.data(), cnt, MPIU_REAL, blocks.data(), counts.data(), cdispl.data(), MPIU_REAL, comm));
+  const size_t n = D.size();
+  G->assign(n * n, 0.0);
+  size_t off = 0;
+  for (PetscMPIInt r = 0; r < size; ++r) {
+    const size_t m = (size_t)sizes[r];
+    for (size_t j = 0; j < m; ++j)
+      for (size_t i = 0; i < m; ++i) (*G)[(off + i) + (off + j) * n] = blocks[cdispl[r] + i + j * m];
+    off += m;
+  }
   PetscFunctionReturn(0);
 }
 
@@ -204,11 +245,16 @@ PetscErrorCode SurfaceCompliance::Compute(ElasticFOM &fom, const std::vector<Pet
   // was measured 20x slower on 2 ranks (ring_on_block refine 2: 14.5 s of an 18.8 s solve); the selected
   // entries of the inverse on the parallel factor 1.5-2x slower than the redundant Schur complement
   // (half_disks P2 refine 1, 2340 contact dofs: 2.7-3.9 s against 1.8 s), but without a copy of A per rank.
-  if (!strcmp(m, "auto")) method = size == 1 ? "schur" : "redundant";
+  // With A uncoupled between ranks (-mesh_partitioner bodies) each rank's Schur complement gives its block.
+  const bool local = fom.SchurIsLocal() && fom.SchurDofs() == D;
+  if (!strcmp(m, "auto")) method = size == 1 || local ? "schur" : "redundant";
   else method = m;
-  PetscCheck(method != "schur" || size == 1, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank (PETSc 3.18 has no parallel MUMPS Schur complement); use inverse, redundant or solves");
+  PetscCheck(method != "schur" || size == 1 || local, comm, PETSC_ERR_SUP, "-contact_compliance schur needs 1 rank or -mesh_partitioner bodies (PETSc 3.18 has no parallel MUMPS Schur complement); use inverse, redundant or solves");
   PetscCheck(method != "inverse" || F, comm, PETSC_ERR_SUP, "-contact_compliance inverse needs the FOM's stiffness factored by MUMPS (-fom_pc_type cholesky or lu, -fom_pc_factor_mat_solver_type mumps)");
-  if (method == "schur" && fom.SchurComplement() && fom.SchurDofs() == D) {
+  if (method == "schur" && local) {
+    method = "schur per rank (the factors of the solves)";
+    PetscCall(ComplianceFromLocalSchur(fom, D, &G));
+  } else if (method == "schur" && fom.SchurComplement() && fom.SchurDofs() == D) {
     method = "schur (the factor of the solves)"; // one factorization per parameter
     PetscCall(InverseOfSchur(fom.SchurComplement(), &G));
   } else if (method == "schur") PetscCall(ComplianceBySchur(fom.A, D, &G));

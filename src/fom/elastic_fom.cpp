@@ -1,6 +1,7 @@
 // src/fom/elastic_fom.cpp: assembly, factorization and solve of the elastic full-order model.
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
+#include "rbcontact/partition.hpp"
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -25,6 +26,8 @@ ElasticFOM::~ElasticFOM()
 {
   (void)MatDestroy(&schurS_);
   (void)MatDestroy(&schurFactor_);
+  (void)VecDestroy(&bLocal_);
+  (void)VecDestroy(&xLocal_);
   (void)KSPDestroy(&ksp);
   (void)MatDestroy(&A);
   (void)VecDestroy(&f);
@@ -148,24 +151,49 @@ static PetscErrorCode RefactorIfMumpsOutOfMemory(KSP ksp, Mat A)
   PetscFunctionReturn(0);
 }
 
-// One MUMPS Cholesky factorization with the Schur complement on the contact dofs, when the run is
-// serial, the KSP is the default direct solver and the compliance is the Schur one (*done = false
-// otherwise: the KSP factors A). The symbolic phase is kept across parameters (same pattern).
+// Is A without coupling between ranks (an MPIAIJ whose off-process block stores nothing on every rank:
+// every body on one rank, -mesh_partitioner bodies)? Then *Ad is this rank's diagonal block. Collective.
+static PetscErrorCode BlockDiagonalAcrossRanks(Mat A, PetscBool *yes, Mat *Ad)
+{
+  PetscBool mpiaij;
+  Mat       Ao;
+  PetscInt  coupled = 1;
+
+  PetscFunctionBeginUser;
+  *Ad = nullptr;
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpiaij));
+  if (mpiaij) {
+    MatInfo info;
+    PetscCall(MatMPIAIJGetSeqAIJ(A, Ad, &Ao, NULL));
+    PetscCall(MatGetInfo(Ao, MAT_LOCAL, &info));
+    coupled = info.nz_used > 0;
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &coupled, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
+  *yes = coupled ? PETSC_FALSE : PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+// One MUMPS Cholesky factorization with the Schur complement on the contact dofs, when the KSP is the
+// default direct solver, the compliance is the Schur one, and the run is serial or A has no coupling
+// between ranks (each rank then factors its own diagonal block, sequentially, with the Schur complement on
+// its part of D: no parallel factorization, no redundant copy). *done = false otherwise: the KSP factors A.
+// The symbolic phase is kept across parameters (same pattern).
 PetscErrorCode ElasticFOM::FactorWithSchur(bool *done)
 {
   PetscMPIInt size;
   PC          pc;
   KSPType     kt;
-  PetscBool   preonly, chol, mumps = PETSC_FALSE;
+  PetscBool   preonly, chol, mumps = PETSC_FALSE, local = PETSC_FALSE;
   MatSolverType st = NULL;
   char        m[32] = "auto";
+  Mat         Afac  = A;
 
   PetscFunctionBeginUser;
   *done = false;
   if (schurDofs_.empty()) PetscFunctionReturn(0);
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_compliance", m, sizeof m, NULL));
-  if (size > 1 || (strcmp(m, "auto") && strcmp(m, "schur"))) PetscFunctionReturn(0);
+  if (strcmp(m, "auto") && strcmp(m, "schur")) PetscFunctionReturn(0);
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscStrcmp(kt, KSPPREONLY, &preonly));
@@ -173,24 +201,51 @@ PetscErrorCode ElasticFOM::FactorWithSchur(bool *done)
   if (chol) PetscCall(PCFactorGetMatSolverType(pc, &st));
   if (st) PetscCall(PetscStrcmp(st, MATSOLVERMUMPS, &mumps));
   if (!preonly || !chol || !mumps) PetscFunctionReturn(0);
+  if (size > 1) {
+    PetscCall(BlockDiagonalAcrossRanks(A, &local, &Afac));
+    if (!local) PetscFunctionReturn(0);
+  }
   MatFactorInfo        info;
   MatFactorError       err;
   MatFactorSchurStatus status;
   PetscCall(MatFactorInfoInitialize(&info));
+  if (schurFactor_ && factored_ != Afac) PetscCall(MatDestroy(&schurFactor_)); // a new matrix: a new symbolic phase
   if (!schurFactor_) {
-    IS is;
-    PetscCall(MatGetFactor(A, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &schurFactor_));
+    // this rank's dofs of D (all of D on one rank), in the numbering of the factored matrix
+    PetscInt lo = 0, hi = PETSC_MAX_INT;
+    if (local) PetscCall(MatGetOwnershipRange(A, &lo, &hi));
+    std::vector<PetscInt> mine;
+    for (PetscInt d : schurDofs_)
+      if (d >= lo && d < hi) mine.push_back(d - lo);
+    PetscCall(MatGetFactor(Afac, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &schurFactor_));
     PetscCall(MatSetOptionsPrefix(schurFactor_, "fom_")); // -fom_mat_mumps_icntl_* as for the KSP's factor
-    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)schurDofs_.size(), schurDofs_.data(), PETSC_COPY_VALUES, &is));
-    PetscCall(MatFactorSetSchurIS(schurFactor_, is));
-    PetscCall(ISDestroy(&is));
-    PetscCall(MatCholeskyFactorSymbolic(schurFactor_, A, NULL, &info));
+    if (!mine.empty()) {
+      IS is;
+      PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)mine.size(), mine.data(), PETSC_COPY_VALUES, &is));
+      PetscCall(MatFactorSetSchurIS(schurFactor_, is));
+      PetscCall(ISDestroy(&is));
+    }
+    PetscCall(MatCholeskyFactorSymbolic(schurFactor_, Afac, NULL, &info));
+    factored_   = Afac;
+    schurLocal_ = local;
+    schurRank_  = (PetscInt)mine.size();
+    PetscCall(VecDestroy(&bLocal_));
+    PetscCall(VecDestroy(&xLocal_));
+    if (local) {
+      PetscInt n;
+      PetscCall(MatGetLocalSize(A, &n, NULL));
+      PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, NULL, &bLocal_));
+      PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, n, NULL, &xLocal_));
+    }
   }
-  PetscCall(MatCholeskyFactorNumeric(schurFactor_, A, &info));
+  PetscCall(MatCholeskyFactorNumeric(schurFactor_, Afac, &info));
   PetscCall(MatFactorGetError(schurFactor_, &err));
-  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet); out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure");
+  PetscInt failed = err != MAT_FACTOR_NOERROR ? (PetscInt)err : 0;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+  err = (MatFactorError)failed;
+  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs%s) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet); out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), local ? ", each rank its bodies" : "", err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure");
   PetscCall(MatDestroy(&schurS_));
-  PetscCall(MatFactorCreateSchurComplement(schurFactor_, &schurS_, &status));
+  if (schurRank_ > 0) PetscCall(MatFactorCreateSchurComplement(schurFactor_, &schurS_, &status));
   *done = true;
   PetscFunctionReturn(0);
 }
@@ -224,6 +279,7 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   if (!shared) {
     PetscCall(MatDestroy(&schurS_));
     PetscCall(MatDestroy(&schurFactor_));
+    schurLocal_ = false;
     PetscCall(KSPSetOperators(ksp, A, A));
     PetscCall(KSPSetUp(ksp));
     PetscCall(RefactorIfMumpsOutOfMemory(ksp, A));
@@ -297,7 +353,21 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(FOM_Solve, 0, 0, 0, 0));
-  if (schurFactor_) {
+  if (schurFactor_ && schurLocal_) {
+    // each rank its own block (no coupling between ranks): the local parts of rhs and x as sequential vectors
+    const PetscScalar *b;
+    PetscScalar       *xa;
+    PetscCall(VecGetArrayRead(rhs, &b));
+    PetscCall(VecGetArray(x, &xa));
+    PetscCall(VecPlaceArray(bLocal_, b));
+    PetscCall(VecPlaceArray(xLocal_, xa));
+    PetscCall(MatSolve(schurFactor_, bLocal_, xLocal_));
+    PetscCall(VecResetArray(bLocal_));
+    PetscCall(VecResetArray(xLocal_));
+    PetscCall(VecRestoreArray(x, &xa));
+    PetscCall(VecRestoreArrayRead(rhs, &b));
+    reason = KSP_CONVERGED_ITS;
+  } else if (schurFactor_) {
     // MUMPS: condensation, the Schur system (PETSc's dense factorization), expansion. Residuals
     // measured 2.9e-15 (ring_on_block) and 5e-15 (half_disks P2 refine 1), as the plain MUMPS solve.
     PetscCall(MatSolve(schurFactor_, rhs, x));
@@ -372,6 +442,7 @@ PetscErrorCode ElasticFOM::FillReport(Report *rep)
   rep->root["scene"]   = scene.name;
   rep->root["ndofs"]   = (long long)GlobalSize();
   rep->root["nranks"]  = (int)size;
+  rep->root["partition"] = MeshPartitionUsed(dm); // -mesh_partitioner as applied: none (1 rank), metis, bodies, petsc
   rep->root["degree"]  = (long long)elas.degree;
   rep->root["dim"]     = (long long)elas.dim;
   rep->root["energy"]  = (double)energy;
