@@ -7,7 +7,9 @@ Reads the /contact group that `rbcontact fom -fom_output f.h5` writes when conta
   /contact/weight    (R)  int psi_i over the slave surface (resultant = sum lambda_i weight_i n_i)
   /contact/x, /contact/y  reference coordinates of the slave vertices
 and plots lambda against the position along the slave surface (x by default, sorted), markers +
-line, with the active nodes (lambda > --active-tol) highlighted.
+line, with the active nodes (lambda > --active-tol) highlighted. 3D slave surfaces (/contact/z present):
+by default against r, the distance to the pressure centroid in the plane normal to the resultant (a
+point contact's profile), with a second panel showing the pressure on that plane.
 
 Hertz overlay: --hertz-a A --hertz-p0 P0, or --report r.json (a `rbcontact fom` report of a run
 with -hertz_radius: takes hertz.a_exact and hertz.p0_exact; explicit --hertz-a/--hertz-p0 win),
@@ -54,7 +56,7 @@ def read_contact(path, coord):
                  "(-contact 0, or a scene without -contact_slave/-contact_master). "
                  "Run `rbcontact fom` with contact to get the contact pressure." % path)
         g = f["contact"]
-        need = ["lambda", "weight", coord]
+        need = ["lambda", "weight"] + ([coord] if coord != "r" else ["x", "y", "z"])
         missing = ["/contact/" + n for n in need if n not in g]
         if missing:
             fail("'%s' lacks %s (it has: %s)" % (path, ", ".join(missing),
@@ -63,13 +65,30 @@ def read_contact(path, coord):
         dim = sum(1 for c in ("x", "y", "z") if c in g)
         # the master normals (files of rbcontact fom have them): the resultant is sum lambda_i w_i n_i
         normals = [np.asarray(g["normal_" + c][...], dtype=float).ravel() for c in ("x", "y", "z")[:dim] if "normal_" + c in g]
-    lam, w, s = data["lambda"], data["weight"], data[coord]
+    lam, w = data["lambda"], data["weight"]
+    s = data[coord] if coord != "r" else np.stack([data["x"], data["y"], data["z"]], axis=1)
     data["normals"] = normals if len(normals) == dim and dim > 0 else None
-    if not (lam.shape == w.shape == s.shape):
+    if not (lam.shape == w.shape == s.shape[:1]):
         fail("/contact datasets disagree in size: lambda %s, weight %s, %s %s" % (lam.shape, w.shape, coord, s.shape))
     if lam.size == 0:
         fail("'%s': the slave surface has no vertices (/contact/lambda is empty)" % path)
     return lam, w, s, dim, data["normals"]
+
+
+def radial(X, lam, w, normals):
+    """3D: the slave vertices in the plane normal to the resultant (in-plane coordinates e1, e2 about the
+    pressure centroid) and their distance r to the centroid."""
+    n = np.array([float((lam * w * c).sum()) for c in normals]) if normals is not None else np.zeros(3)
+    if not np.linalg.norm(n) > 0:
+        n = np.array([0.0, 0.0, 1.0])
+    n = n / np.linalg.norm(n)
+    e1 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    m = lam * w
+    c = (m[:, None] * X).sum(axis=0) / m.sum() if m.sum() > 0 else X.mean(axis=0)
+    p1, p2 = (X - c) @ e1, (X - c) @ e2
+    return np.hypot(p1, p2), p1, p2
 
 
 def hertz_from_report(path):
@@ -91,8 +110,10 @@ def main(argv=None):
     p.add_argument("h5", help="HDF5 file written by `rbcontact fom -fom_output <file.h5>` with contact on")
     p.add_argument("-o", "--output", help="PNG to write (default: <h5 without .h5>_pressure.png)")
     p.add_argument("--title", default=None, help="scene name shown in the title (default: file name)")
-    p.add_argument("--coord", choices=("x", "y"), default="x",
-                   help="reference coordinate of the slave vertices used as abscissa (default x)")
+    p.add_argument("--coord", choices=("x", "y", "r"), default=None,
+                   help="abscissa: a reference coordinate of the slave vertices (x, y; default x in 2D) or, in 3D, r "
+                        "(the default there): the distance to the pressure centroid in the plane normal to the "
+                        "resultant, with a second panel showing the pressure on that plane")
     p.add_argument("--hertz-a", type=float, default=None, help="Hertz contact half-width a (overlay)")
     p.add_argument("--hertz-p0", type=float, default=None, help="Hertz peak pressure p0 (overlay)")
     p.add_argument("--report", default=None,
@@ -103,9 +124,25 @@ def main(argv=None):
     a = p.parse_args(argv)
 
     out = a.output or (a.h5[:-3] if a.h5.endswith(".h5") else a.h5) + "_pressure.png"
-    lam, w, s, dim, normals = read_contact(a.h5, a.coord)
-    if dim == 3:
-        print("plot_contact.py: 3D slave surface: plotting the pressure against %s only (a projection)" % a.coord)
+    coord = a.coord
+    if coord is None:  # r for a 3D slave surface; a file that cannot be read is reported by read_contact
+        coord = "x"
+        try:
+            with h5py.File(a.h5, "r") as f:
+                if "contact" in f and isinstance(f["contact"], h5py.Group) and "z" in f["contact"]:
+                    coord = "r"
+        except OSError:
+            pass
+    lam, w, s, dim, normals = read_contact(a.h5, coord)
+    plane = None
+    if coord == "r":
+        if dim != 3:
+            fail("--coord r is for 3D slave surfaces ('%s' is %dD)" % (a.h5, dim))
+        s, p1, p2 = radial(s, lam, w, normals)
+        plane = (p1, p2)
+        print("plot_contact.py: 3D slave surface: the pressure against the distance r to its centroid, and on the contact plane")
+    elif dim == 3:
+        print("plot_contact.py: 3D slave surface: plotting the pressure against %s only (a projection)" % coord)
 
     ha, hp0 = None, None
     if a.report:
@@ -123,24 +160,32 @@ def main(argv=None):
     force_vec = [float((lam * w * n).sum()) for n in normals] if normals is not None else None
     order = np.argsort(s, kind="stable")
     s, lam, w = s[order], lam[order], w[order]
+    if plane is not None:
+        plane = (plane[0][order], plane[1][order])
     active = lam > a.active_tol
     nact = int(active.sum())
     force = float(np.hypot.reduce(force_vec)) if force_vec is not None else float((lam * w).sum())
     pmax = float(lam.max())
     mass = float((lam * w).sum())
     xc = float((lam * w * s).sum() / mass) if mass > 0 else float(s.mean())
+    if plane is not None:
+        xc = 0.0  # r is measured from the centroid already
 
-    fig, ax = plt.subplots(figsize=(8, 4.8), layout="constrained")
-    ax.plot(s, lam, "-", color="tab:blue", linewidth=1.0, zorder=2, label="FE nodal pressure $\\lambda_i$")
+    if plane is None:
+        fig, ax = plt.subplots(figsize=(8, 4.8), layout="constrained")
+    else:
+        fig, (ax, axp) = plt.subplots(1, 2, figsize=(12, 5), layout="constrained", gridspec_kw={"width_ratios": [1.4, 1]})
+    if plane is None:  # a line along the surface (in 3D, nodes at one r lie all around the centroid: markers only)
+        ax.plot(s, lam, "-", color="tab:blue", linewidth=1.0, zorder=2, label="FE nodal pressure $\\lambda_i$")
     ax.plot(s[~active], lam[~active], "o", markersize=3.5, markerfacecolor="white", markeredgecolor="tab:blue",
             zorder=3, label="inactive nodes (%d)" % int((~active).sum()))
     ax.plot(s[active], lam[active], "o", markersize=5, color="tab:red", zorder=4,
             label="active nodes (%d)" % nact)
     if ha is not None:
-        xh = np.linspace(xc - ha, xc + ha, 401)
+        xh = np.linspace(xc - ha, xc + ha, 401) if plane is None else np.linspace(0.0, ha, 201)
         ph = hp0 * np.sqrt(np.clip(1.0 - (xh - xc) ** 2 / ha ** 2, 0.0, None))
         ax.plot(xh, ph, "--", color="k", linewidth=1.2, zorder=5,
-                label="Hertz $p_0\\sqrt{1-(x-x_c)^2/a^2}$, a = %.4g, $p_0$ = %.4g" % (ha, hp0))
+                label=("Hertz $p_0\\sqrt{1-(x-x_c)^2/a^2}$" if plane is None else "Hertz $p_0\\sqrt{1-r^2/a^2}$") + ", a = %.4g, $p_0$ = %.4g" % (ha, hp0))
     if nact:
         # zoom on the contact zone (with margins), keeping some inactive nodes in view
         lo, hi = float(s[active].min()), float(s[active].max())
@@ -151,14 +196,30 @@ def main(argv=None):
         ax.set_xlim(max(lo, float(s.min()) - 0.02 * width), min(hi, float(s.max()) + 0.02 * width))
     ax.set_ylim(bottom=0.0, top=1.12 * max(pmax, hp0 or 0.0, 1e-300))
     ax.axhline(0.0, color="0.6", linewidth=0.6, zorder=1)
-    ax.set_xlabel("%s (reference position of the slave vertex)" % a.coord)
+    ax.set_xlabel("%s (reference position of the slave vertex)" % coord if plane is None else
+                  "r: distance to the pressure centroid in the contact plane (reference positions)")
+    if plane is not None:
+        sc = axp.scatter(plane[0], plane[1], c=lam, s=6, cmap="viridis", vmin=0.0)
+        if ha is not None:
+            t = np.linspace(0, 2 * np.pi, 200)
+            axp.plot(ha * np.cos(t), ha * np.sin(t), "--", color="k", linewidth=1.0, label="Hertz a")
+            axp.legend(fontsize=8, loc="upper right")
+        if nact:
+            rmax = 1.5 * max(float(s[active].max()), ha or 0.0)
+            axp.set_xlim(-rmax, rmax)
+            axp.set_ylim(-rmax, rmax)
+        axp.set_aspect("equal")
+        axp.set_xlabel("contact plane, e1")
+        axp.set_ylabel("contact plane, e2")
+        axp.set_title("pressure on the slave surface (seen along the resultant)", fontsize=9)
+        fig.colorbar(sc, ax=axp, label="contact pressure $\\lambda$")
     ax.set_ylabel("contact pressure $\\lambda$")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="lower center", framealpha=0.9)
+    ax.legend(fontsize=8, loc="lower center" if plane is None else "lower left", framealpha=0.9)
     title = a.title or os.path.basename(a.h5)
     sub = "%d slave nodes, %d active, max pressure %.4g, resultant %.4g" % (lam.size, nact, pmax, force)
     if nact:
-        sub += ", active %s in [%.4g, %.4g]" % (a.coord, float(s[active].min()), float(s[active].max()))
+        sub += ", active %s in [%.4g, %.4g]" % (coord, float(s[active].min()), float(s[active].max()))
     else:
         sub += " (no contact: all pressures are zero)"
     fig.suptitle("%s: contact pressure along the slave surface\n%s" % (title, sub), fontsize=10)
@@ -168,6 +229,7 @@ def main(argv=None):
         fail("output directory '%s' does not exist" % odir)
     fig.savefig(out, dpi=a.dpi)
     plt.close(fig)
+    print("plot_contact.py: %d slave nodes, %d active, max pressure %.12g, resultant %.12g" % (lam.size, nact, pmax, force))
     print("plot_contact.py: wrote %s" % out)
     return 0
 

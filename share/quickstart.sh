@@ -115,6 +115,11 @@ for tag, path in (("refine 0", "validate.json"), ("refine 0", "validate_eim.json
           % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], x["max_rel_err_u"], x["max_rel_err_lambda"]))
     print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
 PY
+  # 3D contact, the FOM only (no 3D reduced model yet): a hemisphere on a block against Hertz's point contact,
+  # the deformed bodies and the pressure on the slave surface (radial profile, contact plane)
+  rbc fom "results/hertz3d/fom.json" -options_file runs/hertz3d.opts -fom_output "results/hertz3d/fom.h5"
+  plot "results/hertz3d/fom.h5" "results/hertz3d/fom.png" "hertz3d"
+  plot_pressure "results/hertz3d/fom.h5" "results/hertz3d/pressure.png" "hertz3d" --report "results/hertz3d/fom.json"
 }
 # ============================ END MAIN JOB ============================
 
@@ -123,7 +128,7 @@ main_job
 step "done: outputs"
 for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
 echo "fields:  $ROOT/$OUT/fom.h5, $ROOT/$OUT/online_fields.h5 (ROM)"
-echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf (open them in ParaView)"
+echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf, $ROOT/results/hertz3d/fom.xmf (open them in ParaView)"
 echo "bases:   $ROOT/$OUT/basis_view.xmf (POD modes, supremizers and the dual basis on the mesh, for ParaView)"
 echo "ROM:     $ROOT/$OUT/rom.h5 (online data), rom.basis.h5, rom.snapshots.h5"
 echo "sweep:   $ROOT/$OUT/sweep.csv, sweep_eim.csv, refine2/sweep.csv, refine2/sweep_eim.csv"

@@ -153,9 +153,9 @@ def flat_punch3d(args):
 
 def hertz3d(args):
     print("3D Hertz: a hemisphere on a block, against Hertz's point contact at the computed force; 1 and 2 ranks")
-    rep = {}
+    rep, h5s = {}, {}
     for np_ in (1, 2):
-        r, _ = run(args, np_, "runs/hertz3d.opts", args.extra, "hertz3d_np%d" % np_)
+        r, h5s[np_] = run(args, np_, "runs/hertz3d.opts", args.extra, "hertz3d_np%d" % np_)
         h = r["hertz"]
         ea, ep = h["a"] / h["a_exact"] - 1, h["p0"] / h["p0_exact"] - 1
         print("  %d rank(s): P %.10f, a %.5f (Hertz %.5f, %+.2f %%), p0 %.3f (Hertz %.3f, %+.2f %%), %d Kacanov iterations"
@@ -165,6 +165,21 @@ def hertz3d(args):
         rep[np_] = r
     rel = abs(rep[1]["contact_force"] - rep[2]["contact_force"]) / rep[1]["contact_force"]
     check(rel <= 1e-8, "1 and 2 ranks: the same contact force to %.1e <= 1e-8" % rel)
+    # the 3D pressure picture (share/plot_contact.py: radial profile against Hertz, the pressure on the contact
+    # plane) from the 2-rank output: it draws, and the resultant it sums from the file is the report's force
+    out = workdir("rbc_plot3d_")
+    rj = os.path.join(out, "r.json")
+    with open(rj, "w") as f:
+        json.dump(rep[2], f)
+    png = os.path.join(out, "p.png")
+    p = subprocess.run(["/usr/bin/python3", "share/plot_contact.py", h5s[2], "-o", png, "--report", rj, "--title", "hertz3d"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    m = re.search(r"resultant ([0-9.eE+-]+)", p.stdout)
+    res = float(m.group(1)) if m else float("nan")
+    check(p.returncode == 0 and "distance r" in p.stdout and os.path.isfile(png) and os.path.getsize(png) > 20000,
+          "share/plot_contact.py draws the 3D pressure (radial profile and contact plane): exit %d, %s" % (p.returncode, p.stdout.strip().splitlines()[-1:] or "?"))
+    check(abs(res - rep[2]["contact_force"]) <= 1e-9 * rep[2]["contact_force"],
+          "the picture's resultant %.12g = the report's contact force %.12g" % (res, rep[2]["contact_force"]))
 
 
 def no_contact(args):
@@ -226,10 +241,15 @@ def dual_shell(args):
         # neither): the same Kacanov iterates
         rd, h5d = run(args, args.np, "runs/%s.opts" % s, opts + ["-kacanov_type", "fixed_point", "-kacanov_anderson", "0"] + args.extra, tag + "_dense")
         dense[tag] = (rd, h5d)
-        # auto with a tiny -fom_dual_dense_max must pick the shell (and shell must skip the compliance)
-        shell = ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"] if s == "flat_punch" else ["-fom_dual_matrix", "shell"]
+        # auto with a tiny -fom_dual_dense_max (multipliers) or -fom_dual_dense_max_dofs (contact dofs) must pick
+        # the shell (and shell must skip the compliance)
+        shell = {"flat_punch": ["-fom_dual_matrix", "auto", "-fom_dual_dense_max", "10"],
+                 "hertz": ["-fom_dual_matrix", "auto", "-fom_dual_dense_max_dofs", "50"]}.get(s, ["-fom_dual_matrix", "shell"])
         rs, h5s = run(args, args.np, "runs/%s.opts" % s, opts + shell + args.extra, tag + "_shell")
         check(rd["dual_matrix"] == "dense" and rs["dual_matrix"] == "shell", "%s: dual_matrix %s (default auto) / %s (%s)" % (tag, rd["dual_matrix"], rs["dual_matrix"], " ".join(shell)))
+        if s == "hertz":
+            check(rd["contact_dofs"] == rs["contact_dofs"] > 50 and rs["ncontact"] <= 3000,
+                  "%s: %d contact dofs > -fom_dual_dense_max_dofs 50 with R = %d: the shell by the dof count" % (tag, rs["contact_dofs"], rs["ncontact"]))
         (ld, xd), (ls, xs) = contact_fields(h5d), contact_fields(h5s)
         cg = rs["kacanov_history"].get("dual_cg", [])
         print("  %-22s R %4d active %3d  Kacanov its dense %d shell %d  CG its per Kacanov iterate %s"

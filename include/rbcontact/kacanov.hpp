@@ -70,6 +70,8 @@ public:
   // Before fom.AssembleAndFactor: when the dual matrix will be dense, hands the contact dofs to the FOM
   // so that one factorization serves the solves and the compliance (ElasticFOM::SetSchurDofs). Collective.
   PetscErrorCode ShareFactor(ElasticFOM &fom, const ContactMap &map) const;
+  // The -fom_dual_matrix choice (auto: by R and the number of contact dofs) and, when dense, the contact dofs D.
+  PetscErrorCode ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, bool *shell, std::vector<PetscInt> *D) const;
 
   Vec            lambda = nullptr;
   ContactSystem  sys;
@@ -92,7 +94,9 @@ public:
   SurfaceCompliance compliance;
   std::string    dualMatrixOption = "auto"; // -fom_dual_matrix
   PetscInt       dualDenseMax     = 3000;   // -fom_dual_dense_max: auto = dense up to this R
+  PetscInt       dualDenseMaxDofs = 8000;   // -fom_dual_dense_max_dofs: auto = dense up to this many contact dofs (G: 0.5 GB at 8000)
   std::string    dualMatrix;                // used by the last Solve: "dense" or "shell" (report key dual_matrix)
+  mutable PetscInt contactDofs = -1;        // the contact dofs D counted by the last choice (-1: -fom_dual_matrix shell, not counted)
   // Initial overlap, measured at the first iterate (u = 0: the reference configuration at mu, imposed
   // displacements of the contact surfaces included): the deepest penetration (weighted gap g_i / weight_i
   // < 0, length units, 0 if none), the rows that penetrate, and where the deepest is (ContactSurfaceWarnings).

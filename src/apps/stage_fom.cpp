@@ -67,6 +67,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
     rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
     if (kacanov.dualMatrix == "dense") rep.root["compliance"] = kacanov.compliance.method; // how G = (A^-1)_DD was computed (-contact_compliance)
+    if (kacanov.contactDofs >= 0) rep.root["contact_dofs"] = (long long)kacanov.contactDofs; // the dofs of the slave and master facets (the rows of the dense G)
     rep.root["initial_overlap"]["max_penetration"] = (double)kacanov.initialPenetration; // at u = 0 (0: none)
     rep.root["initial_overlap"]["nodes"]           = (long long)kacanov.initialPenetrating;
     rep.root["ncontact"]           = (long long)cs.R;
@@ -75,8 +76,10 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["max_pressure"]       = (double)cs.maxPressure;
     rep.root["contact_halfwidth"]  = (double)cs.halfwidth;
     rep.root["contact_halfwidth_moment"] = (double)cs.halfwidthMoment; // 2 sqrt(int p s^2 / int p - ...): Hertz's a; the ROM's online half-width
-    rep.root["pressure_spread"]    = (double)cs.pressureSpread;
-    rep.root["pressure_roughness"] = (double)cs.pressureRoughness;
+    if (fom.elas.dim == 2) { // along the surface: 2D only (in 3D they would read 0: absent instead)
+      rep.root["pressure_spread"]    = (double)cs.pressureSpread;
+      rep.root["pressure_roughness"] = (double)cs.pressureRoughness;
+    }
     JsonValue &k                   = rep.root["kkt"];
     k["primal_infeas"]             = (double)kacanov.kkt.primal;
     k["dual_infeas"]               = (double)kacanov.kkt.dual;

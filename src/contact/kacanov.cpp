@@ -69,6 +69,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
     dualMatrixOption = types[t];
   }
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, shell above", NULL, dualDenseMax, &dualDenseMax, NULL));
+  PetscCall(PetscOptionsInt("-dual_dense_max_dofs", "auto: dense S only while the compliance G (contact dofs squared) has at most this many rows (memory)", NULL, dualDenseMaxDofs, &dualDenseMaxDofs, NULL));
   PetscOptionsEnd();
   PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(RenameTaoOptions(comm));
@@ -253,14 +254,30 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
   PetscFunctionReturn(0);
 }
 
+// -fom_dual_matrix auto: dense while R <= -fom_dual_dense_max and the contact dofs (the rows of the dense
+// compliance G and of the Schur complement behind it) <= -fom_dual_dense_max_dofs; D: the contact dofs
+// (empty with shell). Collective.
+PetscErrorCode KacanovSolver::ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, bool *shell, std::vector<PetscInt> *D) const
+{
+  PetscFunctionBeginUser;
+  D->clear();
+  *shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && map.NumMultipliers() > dualDenseMax);
+  if (!*shell) PetscCall(map.SurfaceDofs(comm, D));
+  contactDofs = *shell ? -1 : (PetscInt)D->size();
+  if (!*shell && dualMatrixOption == "auto" && (PetscInt)D->size() > dualDenseMaxDofs) {
+    *shell = true;
+    D->clear();
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode KacanovSolver::ShareFactor(ElasticFOM &fom, const ContactMap &map) const
 {
   std::vector<PetscInt> D;
+  bool                  shell;
 
   PetscFunctionBeginUser;
-  const PetscInt R0    = map.NumMultipliers();
-  const bool     shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && R0 > dualDenseMax);
-  if (!shell) PetscCall(map.SurfaceDofs(PetscObjectComm((PetscObject)fom.dm), &D));
+  PetscCall(ChooseDualMatrix(PetscObjectComm((PetscObject)fom.dm), map, &shell, &D));
   fom.SetSchurDofs(D);
   PetscFunctionReturn(0);
 }
@@ -292,13 +309,13 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   // Dual Hessian: dense S through the compliance of the contact dofs (once per parameter: every
   // iterate's S = K_D G K_D^T costs dense operations only), or a MATSHELL with no compliance at all.
   const PetscInt R0 = map.NumMultipliers();
-  const bool     shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && R0 > dualDenseMax);
-  dualMatrix           = shell ? "shell" : "dense";
   PetscCall(PetscTime(&t0));
   std::vector<PetscInt> D;
   std::vector<PetscReal> u0D;
+  bool                   shell;
+  PetscCall(ChooseDualMatrix(comm, map, &shell, &D));
+  dualMatrix = shell ? "shell" : "dense";
   if (!shell) {
-    PetscCall(map.SurfaceDofs(comm, &D));
     PetscCall(compliance.Compute(fom, D));
     PetscCall(GatherAt(u0, D, &u0D));
   }
@@ -326,7 +343,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscFunctionReturn(0);
   };
   if (loop.monitor) {
-    if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ")\n", R0, dualMatrixOption.c_str(), dualDenseMax));
+    if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %" PetscInt_FMT " contact dofs (-1: not counted), dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ", -fom_dual_dense_max_dofs %" PetscInt_FMT ")\n", R0, contactDofs, dualMatrixOption.c_str(), dualDenseMax, dualDenseMaxDofs));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
   }
 

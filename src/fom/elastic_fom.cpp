@@ -3,6 +3,8 @@
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/partition.hpp"
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -452,6 +454,24 @@ PetscErrorCode ElasticFOM::FillReport(Report *rep)
   t["contact"]         = (double)times.contact;
   t["solve"]           = (double)times.solve;
   t["total"]           = (double)times.total;
+  // peak resident memory (VmHWM of /proc/self/status, Linux; absent elsewhere): the largest rank's and the sum
+  {
+    double kb = -1;
+    if (FILE *fp = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      while (std::fgets(line, sizeof line, fp))
+        if (!std::strncmp(line, "VmHWM:", 6)) kb = std::atof(line + 6);
+      std::fclose(fp);
+    }
+    double mx = kb, sum = kb, mn = kb;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &mx, 1, MPI_DOUBLE, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &mn, 1, MPI_DOUBLE, MPI_MIN, PetscObjectComm((PetscObject)dm)));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+    if (mn >= 0) {
+      rep->root["memory"]["peak_rss_mb_max"] = mx / 1024.0; // the largest rank's peak resident set
+      rep->root["memory"]["peak_rss_mb_sum"] = sum / 1024.0; // over the ranks
+    }
+  }
   JsonValue &w         = rep->root["warnings"];
   w                    = std::vector<double>{}; // an array, empty when all is well
   for (const auto &s : warnings) w.Push(JsonValue::String(s));

@@ -1,0 +1,116 @@
+#!/usr/bin/python3
+"""contact3d.py: benchmark (not a test) of the 3D contact FOM against the targets of the 3D-contact issue.
+
+Tables:
+  1. hertz3d (a hemisphere on a block, runs/hertz3d.opts) at the refinement levels of --refine: dofs,
+     multipliers, Kacanov iterations, force P, contact radius a and peak pressure p0 against Hertz's point
+     contact at the computed force (targets: refine 0 within 3 % / 5 %, refine 1 within 1.5 % / 3 %), total
+     time and peak resident memory (report key memory: the largest rank's and the sum over ranks).
+  2. flat_punch3d (runs/flat_punch3d.opts, non-matching interface meshes, two mesh ratios): the nodal
+     pressures of the -fom_output file, their spread (max - min) / mean and max |p - 1|, and the force, against
+     the exact uniform p = E d / H = 1 on the unit area (target 1e-6).
+  3. 1 and 2 ranks: contact force relative difference (target 1e-8).
+
+Extra options for every fom run: --extra "...". Runs that fail are reported as such and the script goes on.
+It exits 0 unless the executable is missing. Timings depend on the machine's load.
+Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_dual_matrix shell"]
+"""
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def fom(args, np_, opts, extra, timeout):
+    out = tempfile.mkdtemp(prefix="rbc_c3d_")
+    rep = os.path.join(out, "r.json")
+    cmd = (["mpirun", "-n", str(np_)] if np_ > 1 else []) + [args.exe, "fom", "-options_file", opts] + extra + ["-report", rep,
+                                                                                                             "-fom_output", os.path.join(out, "f.h5")]
+    t0 = time.time()
+    try:
+        p = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, "timeout after %d s" % timeout
+    if p.returncode != 0 or not os.path.exists(rep):
+        last = [l for l in p.stdout.splitlines() if l.strip()][-1:] or ["?"]
+        return None, "exit %d: %s" % (p.returncode, last[0][:160])
+    with open(rep) as f:
+        r = json.load(f)
+    r["_wall"] = time.time() - t0
+    r["_h5"] = os.path.join(out, "f.h5")
+    return r, ""
+
+
+def mem(r):
+    m = r.get("memory", {})
+    return "%.0f / %.0f" % (m.get("peak_rss_mb_max", float("nan")), m.get("peak_rss_mb_sum", float("nan")))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--exe", default=os.path.join(ROOT, "build", "bin", "rbcontact"))
+    ap.add_argument("--refine", type=int, nargs="+", default=[0])
+    ap.add_argument("--np", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--extra", default="")
+    ap.add_argument("--timeout", type=int, default=1800)
+    args = ap.parse_args()
+    if not os.path.exists(args.exe):
+        sys.exit("contact3d.py: %s not found (build first)" % args.exe)
+    extra = shlex.split(args.extra)
+    forces = {}
+
+    print("## 1. hertz3d against Hertz's point contact\n")
+    print("| refine | ranks | ndofs | R | Kacanov | P | a (err) | p0 (err) | target a / p0 | total [s] | peak RSS [MB] max / sum |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    for ref in args.refine:
+        tgt = (0.03, 0.05) if ref == 0 else (0.015, 0.03)
+        for np_ in args.np:
+            r, why = fom(args, np_, "runs/hertz3d.opts", ["-mesh_refine", str(ref)] + extra, args.timeout)
+            if r is None:
+                print("| %d | %d | failed: %s |||||||||" % (ref, np_, why))
+                continue
+            h = r["hertz"]
+            ea, ep = h["a"] / h["a_exact"] - 1, h["p0"] / h["p0_exact"] - 1
+            ok = abs(ea) <= tgt[0] and abs(ep) <= tgt[1]
+            print("| %d | %d | %d | %d | %d | %.8f | %.5f (%+.2f %%) | %.3f (%+.2f %%) | %g %% / %g %%: %s | %.1f | %s |"
+                  % (ref, np_, r["ndofs"], r["ncontact"], r["kacanov_iterations"], h["P"], h["a"], 100 * ea, h["p0"], 100 * ep,
+                     100 * tgt[0], 100 * tgt[1], "met" if ok else "MISSED", r["time_s"]["total"], mem(r)))
+            forces[("hertz3d refine %d" % ref, np_)] = r["contact_force"]
+
+    print("\n## 2. flat_punch3d: non-matching interface meshes, exact p = 1\n")
+    print("| meshes | ranks | R | active | spread (max - min) / mean | max abs(p - 1) | force (exact 1) | target 1e-6 |")
+    print("|---|---|---|---|---|---|---|---|")
+    for tag, mesh in (("slave 4x4, master 7x7", []), ("slave 6x6, master 4x4", ["-mesh_geo_set", "n_punch=6,n_base=4"])):
+        for np_ in args.np:
+            r, why = fom(args, np_, "runs/flat_punch3d.opts", mesh + extra, args.timeout)
+            if r is None:
+                print("| %s | %d | failed: %s ||||||" % (tag, np_, why))
+                continue
+            import h5py
+            with h5py.File(r["_h5"], "r") as f:
+                lam = f["contact/lambda"][()]
+            spread = (lam.max() - lam.min()) / lam.mean()
+            err = max(abs(lam.max() - 1.0), abs(lam.min() - 1.0), abs(r["contact_force"] - 1.0))
+            print("| %s | %d | %d | %d | %.1e | %.1e | %.14f | %s |" % (tag, np_, r["ncontact"], r["nactive"], spread, err, r["contact_force"],
+                                                                  "met" if spread <= 1e-6 and err <= 1e-6 else "MISSED"))
+            forces[("flat_punch3d " + tag, np_)] = r["contact_force"]
+
+    if 1 in args.np and 2 in args.np:
+        print("\n## 3. 1 and 2 ranks: contact force\n")
+        print("| case | 1 rank | 2 ranks | rel diff | target 1e-8 |")
+        print("|---|---|---|---|---|")
+        for case in sorted({k[0] for k in forces}):
+            if (case, 1) in forces and (case, 2) in forces:
+                a, b = forces[(case, 1)], forces[(case, 2)]
+                d = abs(a - b) / abs(a)
+                print("| %s | %.14f | %.14f | %.1e | %s |" % (case, a, b, d, "met" if d <= 1e-8 else "MISSED"))
+
+
+if __name__ == "__main__":
+    main()
