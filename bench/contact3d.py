@@ -10,10 +10,15 @@ Tables:
      pressures of the -fom_output file, their spread (max - min) / mean and max |p - 1|, and the force, against
      the exact uniform p = E d / H = 1 on the unit area (target 1e-6).
   3. 1 and 2 ranks: contact force relative difference (target 1e-8).
+  4. The 3D reduced model (runs/sphere_block3d.opts, --rom-meshes: the scene's mesh and hertz3d's): offline on the
+     ranks of --rom-np, validate on 20 random parameters: N, R, Mc, max relative errors u, lambda, force (targets
+     1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median, speedup (target 1e4 at the finest level).
+     --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of ~10 s).
 
 Extra options for every fom run: --extra "...". Runs that fail are reported as such and the script goes on.
 It exits 0 unless the executable is missing. Timings depend on the machine's load.
 Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_dual_matrix shell"]
+       [--no-rom] [--rom-meshes scene hertz3d] [--rom-np 2]
 """
 import argparse
 import json
@@ -59,6 +64,9 @@ def main():
     ap.add_argument("--np", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--extra", default="")
     ap.add_argument("--timeout", type=int, default=1800)
+    ap.add_argument("--no-rom", action="store_true")
+    ap.add_argument("--rom-meshes", nargs="+", default=["scene", "hertz3d"], choices=["scene", "hertz3d"])
+    ap.add_argument("--rom-np", type=int, default=2)
     args = ap.parse_args()
     if not os.path.exists(args.exe):
         sys.exit("contact3d.py: %s not found (build first)" % args.exe)
@@ -110,6 +118,41 @@ def main():
                 a, b = forces[(case, 1)], forces[(case, 2)]
                 d = abs(a - b) / abs(a)
                 print("| %s | %.14f | %.14f | %.1e | %s |" % (case, a, b, d, "met" if d <= 1e-8 else "MISSED"))
+
+    if not args.no_rom:
+        rom3d(args, extra)
+
+
+def rom3d(args, extra):
+    print("\n## 4. The 3D reduced model: sphere_block3d (radius 0.8..1.2, displacement 0.03..0.05), 20 random test parameters\n")
+    print("| mesh | ndofs | FOM solves | N | R | Mc | u | lambda | force | online force | online median | FOM median | speedup | offline [s] | targets |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    meshes = {"scene": [], "hertz3d": ["-mesh_geo_set", "h_fine=0.035,h_far=0.8"]}
+    for tag in args.rom_meshes:
+        out = tempfile.mkdtemp(prefix="rbc_rom3d_")
+        base = ["-options_file", "runs/sphere_block3d.opts"] + meshes[tag] + extra
+        mpi = ["mpirun", "-n", str(args.rom_np)] if args.rom_np > 1 else []
+        ok = True
+        for stage, more in (("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-report", out + "/off.json"]),
+                            ("validate", ["-rom", out + "/rom.h5", "-report", out + "/val.json"])):
+            p = subprocess.run(mpi + [args.exe, stage] + base + more, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            if p.returncode != 0:
+                print("| %s | failed in %s: %s |||||||||||||" % (tag, stage, p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "?"))
+                ok = False
+                break
+        if not ok:
+            continue
+        with open(out + "/off.json") as f:
+            off = json.load(f)
+        with open(out + "/val.json") as f:
+            v = json.load(f)
+        t, ro = v["test"], v["rom"]
+        met = t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3
+        fast = v["online_time_s"]["median"] <= 200e-6
+        print("| %s | %d | %d | %d | %d | %d | %.2e | %.2e | %.2e | %.2e | %.0f us | %.2f s | %.0f | %.1f | accuracy %s, online %s |"
+              % (tag, off.get("ndofs", 0), off.get("ntrain", 0), ro["N"], ro["R"], ro["Mc"], t["max_rel_err_u"], t["max_rel_err_lambda"],
+                 t["max_rel_err_force"], t["max_rel_err_force_online"], 1e6 * v["online_time_s"]["median"], v["fom_time_s"]["median"],
+                 v["speedup_median"], off["time_s"]["total"], "met" if met else "MISSED", "met" if fast else "MISSED"))
 
 
 if __name__ == "__main__":

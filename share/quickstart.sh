@@ -115,11 +115,25 @@ for tag, path in (("refine 0", "validate.json"), ("refine 0", "validate_eim.json
           % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], x["max_rel_err_u"], x["max_rel_err_lambda"]))
     print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
 PY
-  # 3D contact, the FOM only (no 3D reduced model yet): a hemisphere on a block against Hertz's point contact,
-  # the deformed bodies and the pressure on the slave surface (radial profile, contact plane)
+  # 3D contact: a hemisphere on a block against Hertz's point contact, the deformed bodies in section and the
+  # pressure on the slave surface (3D picture; radial profile against Hertz, contact plane)
   rbc fom "results/hertz3d/fom.json" -options_file runs/hertz3d.opts -fom_output "results/hertz3d/fom.h5"
   plot "results/hertz3d/fom.h5" "results/hertz3d/fom.png" "hertz3d"
+  echo "+ $PYTHON share/plot_bodies3d.py results/hertz3d/fom.h5 -o results/hertz3d/bodies.png --title hertz3d"
+  "$PYTHON" share/plot_bodies3d.py "results/hertz3d/fom.h5" -o "results/hertz3d/bodies.png" --title hertz3d || die "plotting the 3D bodies failed"
+  PICTURES+=("results/hertz3d/bodies.png")
   plot_pressure "results/hertz3d/fom.h5" "results/hertz3d/pressure.png" "hertz3d" --report "results/hertz3d/fom.json"
+  # the 3D reduced model (docs/rom3d.md): sphere radius and imposed displacement, 81 training solves, 20 test points
+  rbc offline "results/sphere_block3d/offline.json" -options_file runs/sphere_block3d.opts -rom "results/sphere_block3d/rom.h5"
+  rbc validate "results/sphere_block3d/validate.json" -options_file runs/sphere_block3d.opts -rom "results/sphere_block3d/rom.h5"
+  "$PYTHON" - "results/sphere_block3d/validate.json" <<'PY' || die "reading the 3D validation report failed"
+import json, sys
+r = json.load(open(sys.argv[1]))
+t, ro = r["test"], r["rom"]
+print("3D ROM sphere_block3d (%d random points, %d dofs): N %d R %d Mc %d" % (t["n"], ro["ndofs"], ro["N"], ro["R"], ro["Mc"]))
+print("  max rel err u %.2e (target 1e-3), lambda %.2e (target 2e-2), force %.2e (target 1e-3); online median %.2e s, FOM median %.2e s, speedup %.0f"
+      % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
+PY
 }
 # ============================ END MAIN JOB ============================
 

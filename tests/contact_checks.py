@@ -180,6 +180,18 @@ def hertz3d(args):
           "share/plot_contact.py draws the 3D pressure (radial profile and contact plane): exit %d, %s" % (p.returncode, p.stdout.strip().splitlines()[-1:] or "?"))
     check(abs(res - rep[2]["contact_force"]) <= 1e-9 * rep[2]["contact_force"],
           "the picture's resultant %.12g = the report's contact force %.12g" % (res, rep[2]["contact_force"]))
+    # the 3D picture of the deformed bodies (share/plot_bodies3d.py): its boundary extraction gives a closed surface
+    # of the area of the geometry (block 6 x 6 x 3: 144; hemisphere of radius 1: 3 pi; the mesh's facets cut the
+    # sphere's curvature: slightly less)
+    png = os.path.join(out, "b.png")
+    p = subprocess.run(["/usr/bin/python3", "share/plot_bodies3d.py", h5s[2], "-o", png, "--title", "hertz3d"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    m = re.search(r"boundary area ([0-9.eE+-]+), closed (\w+)", p.stdout)
+    area, closed = (float(m.group(1)), m.group(2)) if m else (float("nan"), "?")
+    exact = 144 + 3 * np.pi
+    check(p.returncode == 0 and os.path.isfile(png) and os.path.getsize(png) > 20000 and closed == "yes" and abs(area / exact - 1) <= 5e-3,
+          "share/plot_bodies3d.py draws the deformed bodies: exit %d, closed boundary %s, area %.6g against %.6g (rel %.1e <= 5e-3)"
+          % (p.returncode, closed, area, exact, abs(area / exact - 1)))
 
 
 def no_contact(args):

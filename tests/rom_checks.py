@@ -377,6 +377,31 @@ def half_disks(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def sphere_block3d(args):
+    """The 3D reduced model (issue #14, docs/rom3d.md): offline on 2 ranks for runs/sphere_block3d.opts with a 3 x 3
+    training grid, validated at the training parameters (what the bases were built from: only the truncations and
+    the cubature separate the ROM from the FOM there) on 1 and 2 ranks."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_3d_")
+    rom, off = offline(args, d, opts="runs/sphere_block3d.opts", extra=["-train_size", "3"])
+    ro = off["rom"]
+    print("  sphere_block3d ROM: N %d R %d Mc %d (9 training points)" % (ro["N"], ro["R"], ro["Mc"]))
+    check(off["dual"]["gram_cond"][-1] <= 1e12, "dual basis Gram condition %.2e <= -dual_max_cond 1e12" % off["dual"]["gram_cond"][-1])
+    vals = {}
+    for np_ in (1, 2):
+        run(args, np_, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-test_type", "grid", "-test_size", "3",
+                                    "-validate_repeat", "3", "-report", "%s/val%d.json" % (d, np_)])
+        vals[np_] = report("%s/val%d.json" % (d, np_))["test"]
+    t = vals[2]
+    print("  at the 9 training parameters: max rel err u %.2e lambda %.2e force %.2e (online force %.2e)"
+          % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], t["max_rel_err_force_online"]))
+    check(t["n"] == 9 and t["failed"] == 0, "the 3D ROM converges at the 9 training parameters")
+    check(t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3 and t["max_rel_err_force_online"] <= 1e-3,
+          "3D ROM at its training parameters within the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)")
+    dmax = max(abs(a - b) / max(abs(b), 1e-300) for k in ("rel_err_u", "rel_err_lambda", "rel_err_force") for a, b in zip(vals[1][k], vals[2][k]))
+    check(dmax <= 1e-6, "1 and 2 ranks: the same errors to %.1e relative (<= 1e-6)" % dmax)
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def files(args):
     """Files that belong together are checked together: the ROM against the scene as configured now
     (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
@@ -435,7 +460,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

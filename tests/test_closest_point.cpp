@@ -91,6 +91,30 @@ int main(int argc, char **argv)
       worst = std::max(worst, d - best); // d must not exceed any sampled distance
     }
     Check(worst <= 1e-14, "3D: binned distance <= every sampled facet distance", worst);
+    // FindAmong (pruned by the candidates' bounding spheres in 3D) against a plain scan of DistToFacet2 over
+    // random candidate subsets: the same facet and barycentric coordinates, bit for bit
+    int mismatch = 0;
+    for (int k = 0; k < 2000; ++k) {
+      const PetscReal       p[3] = {U(gen), U(gen), 0.5 * U(gen)};
+      std::vector<PetscInt> cand;
+      for (PetscInt j = 0; j < cp.NumFacets(); ++j)
+        if (U(gen) < (k % 2 ? 0.05 : 0.5)) cand.push_back(j);
+      if (cand.empty()) continue;
+      PetscInt  m, mref = -1;
+      PetscReal b[3], d, bref[3] = {0, 0, 0}, best = PETSC_MAX_REAL;
+      cp.FindAmong(p, cand.data(), (PetscInt)cand.size(), &m, b, &d);
+      for (PetscInt j : cand) {
+        PetscReal       bb[3];
+        const PetscReal dd = cp.DistToFacet2(j, p, bb);
+        if (dd < best || (dd == best && j < mref)) {
+          best = dd;
+          mref = j;
+          for (int e = 0; e < 3; ++e) bref[e] = bb[e];
+        }
+      }
+      if (m != mref || b[0] != bref[0] || b[1] != bref[1] || b[2] != bref[2] || d != std::sqrt(best)) ++mismatch;
+    }
+    Check(mismatch == 0, "3D: FindAmong (bounding-sphere pruning) equals the plain scan on 2000 random candidate sets (mismatches)", mismatch);
   }
   // Facet basis: P2 segment nodes (v0, v1, edge) interpolate x^2 exactly; partition of unity.
   {

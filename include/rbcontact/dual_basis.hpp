@@ -11,6 +11,8 @@
 //          (absolute; relative to the largest snapshot norm with -dual_tol_relative)
 //   mcpg:  modified CPG (Niakh, Drouet, Ehrlacher, Ern 2022): adds the normalized nonnegative remainder
 //          theta - Upsilon, Upsilon = argmin over the cone intersected with {Upsilon <= theta}
+//   -dual_max_cond (1e12): a greedy pick that would make cond(W^T W) exceed it (a vector in, or nearly in, the
+//          span of the basis but outside its cone: seen on the 3D sphere_block3d) is skipped, W^T W stays invertible
 //   -dual_max_r caps the size; -dual_monitor prints step, selected snapshot, largest error, cond(Gram).
 //   Implementation: src/reduction/nnls.cpp (NNLS), src/reduction/dual_basis.cpp (the four bases);
 //   algorithms, options and measured numbers: docs/dual_basis.md.
@@ -107,6 +109,7 @@ struct DualBasisResult {
   std::string           type;
   DenseMatrix           W;          // R x r, every entry >= 0
   std::vector<PetscInt> selected;   // greedy: snapshot index chosen at each step (nmf: empty)
+  std::vector<PetscInt> skipped;    // greedy: snapshots whose pick would have made cond(W^T W) > -dual_max_cond (not added)
   std::vector<PetscReal> history;   // largest training projection error after each step (greedy), objective per iteration (nmf)
   std::vector<PetscReal> gramCond;  // condition number of W^T W after each step (cpg, mcpg, angle); nmf: of the final W
   PetscReal             trainMaxErr = 0, trainMaxRelErr = 0; // projection of every snapshot onto the final cone (NNLS), in the chosen norm

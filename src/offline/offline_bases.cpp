@@ -35,6 +35,7 @@ PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Repor
   d["norm"]              = dual.norm;
   d["gram_cond"]         = Finite(dual.gramCond);
   d["selected"]          = std::vector<double>(dual.selected.begin(), dual.selected.end());
+  d["skipped_dependent"] = std::vector<double>(dual.skipped.begin(), dual.skipped.end());
   d["min_entry"]         = (double)wmin;
   JsonValue &n           = rep->root["nnls"];
   n["solves"]            = (long long)dual.nnls.solves;

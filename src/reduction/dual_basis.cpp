@@ -355,7 +355,7 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
   const char *types[] = {"nmf", "angle", "cpg", "mcpg"};
   const char *norms[] = {"linf", "l2"};
   PetscInt    type = 2, norm = 0, r = 5, seed = 1, nmfMaxIt = 2000, maxR = L.cols;
-  PetscReal   tol = 1e-3, nmfRtol = 1e-6, feasTol = 1e-12;
+  PetscReal   tol = 1e-3, nmfRtol = 1e-6, feasTol = 1e-12, maxCond = 1e12;
   PetscBool   tolRelative = PETSC_FALSE, monitor = PETSC_FALSE;
   const PetscInt R = L.rows, m = L.cols;
 
@@ -372,10 +372,12 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
   PetscCall(PetscOptionsReal("-nmf_rtol", "NMF: stop when the relative change of ||L - W H||_F is below", "BuildDualBasis", nmfRtol, &nmfRtol, NULL));
   PetscCall(PetscOptionsInt("-nmf_max_it", "NMF: maximum multiplicative updates", "BuildDualBasis", nmfMaxIt, &nmfMaxIt, NULL));
   PetscCall(PetscOptionsReal("-mcpg_feas_tol", "mcpg: accepted violation of theta - Upsilon >= 0, relative to ||theta||", "BuildDualBasis", feasTol, &feasTol, NULL));
+  PetscCall(PetscOptionsReal("-max_cond", "Greedy: a pick that would make cond(W^T W) exceed this is skipped (a vector in the span of W but outside its cone)", "BuildDualBasis", maxCond, &maxCond, NULL));
   PetscCall(PetscOptionsBool("-monitor", "Print step, selected snapshot, largest error, cond(W^T W)", "BuildDualBasis", monitor, &monitor, NULL));
   PetscOptionsEnd();
   PetscCheck(R > 0 && m > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Dual basis: empty snapshot matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", R, m);
   PetscCheck(tol >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be >= 0", (double)tol);
+  PetscCheck(maxCond >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_cond %g must be >= 1", (double)maxCond);
   PetscCheck(maxR >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_r %" PetscInt_FMT " must be >= 1", maxR);
   PetscCheck(type != 0 || (r >= 1 && r <= std::min(R, m)), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_r %" PetscInt_FMT " must lie in [1, min(R, m)] = [1, %" PetscInt_FMT "]", r, std::min(R, m));
   PetscCheck(nmfRtol >= 0 && nmfMaxIt >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_nmf_rtol %g must be >= 0 and -dual_nmf_max_it %" PetscInt_FMT " >= 1", (double)nmfRtol, nmfMaxIt);
@@ -434,11 +436,18 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
       for (PetscReal &x : v) x /= vn;
       AppendColumn(&res->W, v);
       picked[j] = 1;
+      PetscReal c;
+      PetscCall(GramConditionNumber(res->W, &c));
+      if (!(c <= maxCond)) { // (nearly) in the span of W but outside its cone: W^T W would be singular
+        res->W.cols -= 1;
+        res->W.a.resize((size_t)R * res->W.cols);
+        res->skipped.push_back(j);
+        if (monitor) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  dual %s: snapshot %4" PetscInt_FMT " skipped: it would make cond(W^T W) %.3e > -dual_max_cond %.3e\n", types[type], j, (double)c, (double)maxCond));
+        continue;
+      }
       res->selected.push_back(j);
       if (type == 1) PetscCall(SpanProjectionErrors(res->W, L, linf, &err));
       else PetscCall(ConeProjectionErrors(res->W, L, linf, &err, &res->nnls, &nnls, &warmX)); // warm: the previous step's projections
-      PetscReal c;
-      PetscCall(GramConditionNumber(res->W, &c));
       res->history.push_back(*std::max_element(err.begin(), err.end()));
       res->gramCond.push_back(c);
       if (monitor) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  dual %s: step %3" PetscInt_FMT "  snapshot %4" PetscInt_FMT "  largest error %.6e  cond(W^T W) %.3e\n", types[type], res->W.cols, j, (double)res->history.back(), (double)c));
