@@ -165,6 +165,11 @@ int main(int argc, char **argv)
     GG.insert(GG.end(), GF.begin(), GF.end());
     const PetscReal dF = GramMismatch(GG, Q, HF);
     Check(dF <= 1e-13, "CubatureActionGram with the force rows (F(lam_j) per component) = G'G of the explicit rows", dF, 1e-13);
+    // the states in blocks (2 blocks of 2 states): the same Gram matrix to rounding
+    std::vector<PetscReal> HB;
+    CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HB, Sw, dim, 2);
+    const PetscReal dB = GramMismatch(GG, Q, HB);
+    Check(ms > 2 && dB <= 1e-13, "CubatureActionGram with the states in blocks of 2 = G'G of the explicit rows", dB, 1e-13);
   }
 
   { // 2. moments 0..4 of a 60-point rule: a nonnegative rule on <= 5 of its points

@@ -61,7 +61,9 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
 // ContactPatch::Evaluate's wn), a third term fits the resultant contact force F_s(lam_j) = sum_p
 // (P' lam_j)(p) w_p n2(x_p), the output of interest the online stage computes from the cubature (docs/online.md):
 //   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0);
+// Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
+// they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding.
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);

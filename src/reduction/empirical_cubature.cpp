@@ -4,6 +4,7 @@
 #include "rbcontact/empirical_cubature.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
+#include <functional>
 #include <cmath>
 
 namespace rbc {
@@ -71,6 +72,34 @@ void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscRea
   BLASgemm_("N", "T", &q, &q, &b, &one, B, &q, B, &q, &zero, GB.data(), &q);
   for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
+
+// H += (A A') o (sum_b B_b B_b'), the columns B_b produced a block at a time by fill(first, count, B_b) (column-major
+// Q x (count * per)): the same Gram matrix as AddHadamardGram on all the columns at once (to rounding) without
+// holding them: the states' columns are the offline stage's largest objects in 3D (docs/rom3d.md).
+void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H)
+{
+  if (ka <= 0 || per <= 0 || ms <= 0) return;
+  std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q, 0.0), B;
+  const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka;
+  const PetscReal        one = 1, zero = 0;
+  BLASgemm_("N", "T", &q, &q, &a, &one, A, &q, A, &q, &zero, GA.data(), &q);
+  for (PetscInt s0 = 0; s0 < ms; s0 += block) {
+    const PetscInt cnt = std::min(block, ms - s0);
+    B.assign((size_t)Q * cnt * per, 0.0);
+    fill(s0, cnt, B.data());
+    const PetscBLASInt b = (PetscBLASInt)(cnt * per);
+    BLASgemm_("N", "T", &q, &q, &b, &one, B.data(), &q, B.data(), &q, &one, GB.data(), &q);
+  }
+  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
+}
+
+// States per block: the block's columns within about 64 MB (at least one state), or all when block > 0 says so.
+PetscInt StatesPerBlock(PetscInt Q, PetscInt per, PetscInt ms, PetscInt block)
+{
+  if (block > 0) return std::min(block, std::max<PetscInt>(ms, 1));
+  const size_t bytes = (size_t)Q * std::max<PetscInt>(per, 1) * sizeof(PetscReal);
+  return std::max<PetscInt>(1, std::min<PetscInt>(std::max<PetscInt>(ms, 1), (PetscInt)((64u << 20) / std::max<size_t>(bytes, 1))));
+}
 } // namespace
 
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
@@ -111,16 +140,17 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
-  std::vector<PetscReal> LP((size_t)nt * Q, 0.0), Zk((size_t)Q * ms * N, 0.0), Y((size_t)Q * ms * nt, 0.0), Kh, gh;
+  std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh;
   for (PetscInt j = 0; j < nt; ++j)
     for (PetscInt r = 0; r < R; ++r) {
       const PetscReal l = Lam[(size_t)j * R + r];
       if (l == 0.0) continue;
       for (PetscInt p = 0; p < Q; ++p) LP[(size_t)j * Q + p] += l * P[(size_t)r * Q + p];
     }
+  // each state's scalings: its terms to unit norm over the training solutions
   for (PetscInt s = 0; s < ms; ++s) {
     const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
     ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh);
@@ -138,24 +168,34 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
       }
       n2 += gg;
     }
-    const PetscReal s1 = n1 > 0 ? 1 / std::sqrt(n1) : 0, s2 = n2 > 0 ? 1 / std::sqrt(n2) : 0;
-    for (PetscInt n = 0; n < N; ++n) {
-      PetscReal *z = &Zk[(size_t)(s * N + n) * Q];
-      for (PetscInt p = 0; p < Q; ++p) z[p] = s1 * kap[(size_t)p * N + n];
-    }
-    for (PetscInt j = 0; j < nt; ++j) {
-      PetscReal *y = &Y[(size_t)(s * nt + j) * Q];
-      for (PetscInt p = 0; p < Q; ++p) {
-        PetscReal t = -gam[p];
-        for (PetscInt n = 0; n < N; ++n) t += kap[(size_t)p * N + n] * Vs[(size_t)j * N + n];
-        y[p] = s2 * t;
+    s1[s] = n1 > 0 ? 1 / std::sqrt(n1) : 0;
+    s2[s] = n2 > 0 ? 1 / std::sqrt(n2) : 0;
+  }
+  // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y', Zk (the scaled kappa columns) and Y(p, (s, j)) = s2 (kappa_s(p, :) v_j -
+  // gamma_s(p)) formed a block of states at a time
+  H->assign((size_t)Q * Q, 0.0);
+  AddHadamardGramBlocks(Q, LP.data(), nt, ms, N, StatesPerBlock(Q, N, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Z) {
+    for (PetscInt s = s0; s < s0 + cnt; ++s) {
+      const PetscReal *kap = &Sk[(size_t)s * Q * N];
+      for (PetscInt n = 0; n < N; ++n) {
+        PetscReal *z = &Z[(size_t)((s - s0) * N + n) * Q];
+        for (PetscInt p = 0; p < Q; ++p) z[p] = s1[s] * kap[(size_t)p * N + n];
       }
     }
-  }
-  // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y'
-  H->assign((size_t)Q * Q, 0.0);
-  AddHadamardGram(Q, LP.data(), nt, Zk.data(), ms * N, H);
-  AddHadamardGram(Q, P.data(), R, Y.data(), ms * nt, H);
+  }, H);
+  AddHadamardGramBlocks(Q, P.data(), R, ms, nt, StatesPerBlock(Q, nt, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
+    for (PetscInt s = s0; s < s0 + cnt; ++s) {
+      const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+      for (PetscInt j = 0; j < nt; ++j) {
+        PetscReal *y = &Y[(size_t)((s - s0) * nt + j) * Q];
+        for (PetscInt p = 0; p < Q; ++p) {
+          PetscReal t = -gam[p];
+          for (PetscInt n = 0; n < N; ++n) t += kap[(size_t)p * N + n] * Vs[(size_t)j * N + n];
+          y[p] = s2[s] * t;
+        }
+      }
+    }
+  }, H);
   // the resultant force: F_s(lam_j)_d = sum_p LP(j, p) Sw_s(p, d), scaled to unit norm per state
   if (dim > 0 && Sw.size() == (size_t)ms * Q * dim) {
     std::vector<PetscReal> Zf((size_t)Q * ms * dim, 0.0);
