@@ -395,6 +395,7 @@ def sphere_block3d(args):
     print("  at the 9 training parameters: max rel err u %.2e lambda %.2e force %.2e (online force %.2e)"
           % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], t["max_rel_err_force_online"]))
     check(t["n"] == 9 and t["failed"] == 0, "the 3D ROM converges at the 9 training parameters")
+    check(t["max_out_of_range"] == 0 and len(t["out_of_range"]) == 9, "no contact projection out of the stored patch (-eim_patch_rings 1): max %g" % t["max_out_of_range"])
     check(t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3 and t["max_rel_err_force_online"] <= 1e-3,
           "3D ROM at its training parameters within the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)")
     dmax = max(abs(a - b) / max(abs(b), 1e-300) for k in ("rel_err_u", "rel_err_lambda", "rel_err_force") for a, b in zip(vals[1][k], vals[2][k]))

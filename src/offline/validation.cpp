@@ -54,6 +54,7 @@ struct Errors {
   std::vector<double> u, lambda, force;
   std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
   std::vector<double> pmaxOnline, halfwidthOnline; // the online max pressure and half-width (surface_outputs.hpp)
+  std::vector<double> outOfRange; // contact projections at the edge of the stored contact patch, per parameter
   PetscInt            failed = 0;
   std::string         firstFailure;
   void Fill(JsonValue *j) const
@@ -89,6 +90,8 @@ struct Errors {
     };
     online("max_pressure", pmaxOnline);
     online("halfwidth", halfwidthOnline);
+    (*j)["out_of_range"]        = outOfRange; // > 0: the patch kept offline (-eim_patch_rings) was too small there
+    (*j)["max_out_of_range"]    = mx(outOfRange);
     (*j)["failed"]              = (long long)failed;
     if (failed) (*j)["first_failure"] = firstFailure;
   }
@@ -288,6 +291,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         continue;
       }
       if (its) its->push_back(sol.iterations);
+      E->outOfRange.push_back((double)sol.outOfRange);
       double eu, el, ef;
       PetscCall(Compare(m, bases, order, *sysAt[j], dim, fom.affine, F[j], sol, work, work2, lwork, &eu, &el, &ef));
       E->u.push_back(eu);
