@@ -180,8 +180,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   // --- snapshots of kappa (Q x N per evaluation) and gamma (Q): training solutions and the iterates
   // of the reduced Kacanov loop with the exact reduced contact terms. First the reduced solves (they list the
   // states), then the evaluations into storage reserved once: kappa's Q x N x states doubles are the offline
-  // stage's largest object in 3D (2.9 GB at 41k dofs, docs/rom3d.md), and grown by appending they took up to
-  // 3x that while reallocating.
+  // stage's largest object in 3D (2.9 GB at 41k dofs, docs/rom3d.md), and appending reallocated them as they grew.
   struct State {
     std::vector<PetscReal> mu, v; // v empty: the FOM training solution j
     PetscInt               j = -1;
