@@ -192,6 +192,8 @@ def hertz3d(args):
     check(p.returncode == 0 and os.path.isfile(png) and os.path.getsize(png) > 20000 and closed == "yes" and abs(area / exact - 1) <= 5e-3,
           "share/plot_bodies3d.py draws the deformed bodies: exit %d, closed boundary %s, area %.6g against %.6g (rel %.1e <= 5e-3)"
           % (p.returncode, closed, area, exact, abs(area / exact - 1)))
+    p = subprocess.run(["/usr/bin/python3", "share/plot_bodies3d.py", os.path.join(out, "nosuch.h5")], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode == 1 and "cannot open" in p.stdout and "nosuch.h5" in p.stdout, "share/plot_bodies3d.py on a missing file: exit 1 naming it")
 
 
 def no_contact(args):

@@ -218,6 +218,16 @@ int main(int argc, char **argv)
         Check(r.skipped.size() == 1, tag + "skipped snapshots (must be 1)", (double)r.skipped.size(), 1);
       }
     }
+    // an out-of-range -dual_max_cond is refused with a message naming it
+    PetscCall(PetscOptionsSetValue(NULL, "-dual_max_cond", "0.5"));
+    DualBasisResult bad;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    const PetscErrorCode code = BuildDualBasis(T, &bad);
+    PetscCall(PetscPopErrorHandler());
+    char *msg = NULL;
+    if (code) PetscCall(PetscErrorMessage(code, NULL, &msg));
+    Check(code != 0 && msg && std::strstr(msg, "-dual_max_cond 0.5"), std::string("-dual_max_cond 0.5 refused: ") + (msg ? msg : "(no error)"), code ? 0 : 1, 0);
+    PetscCall(PetscOptionsClearValue(NULL, "-dual_max_cond"));
     PetscCall(PetscOptionsSetValue(NULL, "-dual_tol", "1e-3"));
   }
   {
