@@ -403,6 +403,29 @@ def sphere_block3d(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def residual(args):
+    """validate -validate_residual (docs/error_estimate.md): the residual indicator of every reduced solution on the mesh
+    and its effectivity against the energy error, on 1 and 2 ranks."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_res_")
+    rom, _ = offline(args, d)
+    eff = {}
+    for np_ in (1, 2):
+        run(args, np_, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "2", "-validate_residual",
+                                    "-report", "%s/v%d.json" % (d, np_)])
+        v = report("%s/v%d.json" % (d, np_))
+        r, t = v["residual"], v["test"]
+        ind, err, e = np.array(r["indicator"]), np.array(r["rel_err_u_energy"]), np.array(r["effectivity"])
+        print("  %d rank(s): residual indicator %.2e..%.2e, effectivity %.2f..%.2f" % (np_, ind.min(), ind.max(), e.min(), e.max()))
+        check(len(ind) == t["n"] == 20 and np.allclose(err, t["rel_err_u"], rtol=0, atol=0) and np.allclose(e, ind / err, rtol=1e-14),
+              "%d rank(s): one indicator per test parameter, effectivity = indicator / energy error" % np_)
+        # a wrong reconstruction (sign or layout of the multipliers, the lifting) leaves an O(1) residual: effectivity ~ 1e4
+        check(0.05 <= e.min() and e.max() <= 20, "%d rank(s): effectivity within [0.05, 20] (measured 0.22-1.37 on 100 radii)" % np_)
+        eff[np_] = e
+    dmax = float(np.max(np.abs(eff[1] - eff[2]) / eff[1]))
+    check(dmax <= 1e-6, "1 and 2 ranks: the same effectivities to %.1e (<= 1e-6)" % dmax)
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def files(args):
     """Files that belong together are checked together: the ROM against the scene as configured now
     (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
@@ -461,7 +484,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

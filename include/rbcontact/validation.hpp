@@ -16,6 +16,7 @@ struct ValidationSettings {
   bool                   sweep  = false;                      // -validate_sweep: the speed-against-error table
   std::vector<PetscReal> fractions{0.2, 0.4, 0.6, 0.8, 1.0};  // -validate_sweep_fractions of N, R (and the EIM sizes)
   std::string            sweepOutput;                         // -validate_sweep_output stem (default: the report's + _sweep)
+  bool                   residual = false;                    // -validate_residual: the residual indicator and its effectivity
 };
 
 // Reads and checks the settings (one PetscOptionsBegin block); reportPath gives the sweep's default stem.
@@ -26,7 +27,10 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 // mean_rel_err_u, max_rel_err_lambda, mean_rel_err_lambda, max_rel_err_force, rel_err_*, max_rel_err_force_online,
 // failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat}, fom_time_s {median, all},
 // speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}; with the sweep
-// also sweep [rows] and sweep_files. An error if the ROM fails on a test parameter. Collective on comm.
+// also sweep [rows] and sweep_files; with -validate_residual also residual {indicator, rel_err_u_energy,
+// effectivity, min_effectivity, max_effectivity, share_above_1, share_within_20} (docs/error_estimate.md: the
+// residual of the reduced solution assembled on the mesh, not an online quantity). An error if the ROM fails on a
+// test parameter. Collective on comm.
 PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::string &romPath, const ParameterSet &test, const ValidationSettings &s, Report *rep);
 
 // The validate stage from the options database alone, as `rbcontact validate` and the Python module run it: -rom

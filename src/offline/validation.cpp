@@ -7,6 +7,7 @@
 // against max error (CSV and JSON); share/plot_speed_error.py draws it. The FOM is distributed over the
 // ranks, the ROM runs redundantly on every rank (identical data, identical answers).
 #include "rbcontact/validation.hpp"
+#include "rbcontact/greedy_indicator.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/reduced_model.hpp"
@@ -23,7 +24,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 {
   PetscInt  nf = 32;
   PetscReal fbuf[32];
-  PetscBool fset = PETSC_FALSE, sweep = s->sweep ? PETSC_TRUE : PETSC_FALSE;
+  PetscBool fset = PETSC_FALSE, sweep = s->sweep ? PETSC_TRUE : PETSC_FALSE, residual = s->residual ? PETSC_TRUE : PETSC_FALSE;
   char      sweepOut[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
@@ -37,7 +38,9 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCall(PetscOptionsBool("-validate_sweep", "also the speed-against-error sweep over truncated sizes", "", sweep, &sweep, NULL));
   PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
   PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
+  PetscCall(PetscOptionsBool("-validate_residual", "also the residual of each reduced solution on the mesh (the greedy indicator) and its effectivity against the energy error", "", residual, &residual, NULL));
   PetscOptionsEnd();
+  s->residual = residual;
   PetscCheck(s->repeat >= 1 && s->repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", s->repeat);
   if (fset) s->fractions.assign(fbuf, fbuf + nf);
   for (PetscReal f : s->fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
@@ -317,6 +320,25 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   std::vector<PetscInt> romIts;
   PetscCall(evaluate(model, true, &E, &medians, &romIts));
   PetscCall(evaluate(exact, false, &E0, nullptr, nullptr));
+  // the residual indicator of each reduced solution (the greedy's, on the mesh: docs/error_estimate.md) against its
+  // energy error: the effectivity an online estimate built on this residual would start from
+  std::vector<double> indicator, effectivity;
+  if (settings.residual && !E.failed) {
+    GreedyIndicator ind;
+    ind.criterion = GreedyCriterion::Residual;
+    PetscCall(ind.Setup(fom));
+    for (PetscInt j = 0; j < nt; ++j) {
+      ReducedSolution sol;
+      PetscCall(model.Solve(F[j].mu, &sol));
+      PetscCall(bases.Displacement(model, order, sol.v, work));
+      std::vector<PetscReal> lam;
+      bases.Multipliers(model, sol.lambda, &lam);
+      GreedyEstimate est;
+      PetscCall(ind.Evaluate(fom, cmap, order, F[j].mu, work, lam, &est));
+      indicator.push_back(est.residual);
+      effectivity.push_back(E.u[j] > 0 ? est.residual / E.u[j] : PETSC_INFINITY);
+    }
+  }
   PetscCheck(!E.failed, comm, PETSC_ERR_NOT_CONVERGED, "validate: the ROM failed on %" PetscInt_FMT " of %" PetscInt_FMT " test parameters; first: %s", E.failed, nt, E.firstFailure.c_str());
 
   rep.root["stage"] = "validate";
@@ -326,6 +348,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   E.Fill(&rep.root["test"]);
   E0.Fill(&rep.root["test_no_eim"]); // the ROM with exact contact terms (no hyper-reduction); key kept from the EIM-only releases
   E0.Fill(&rep.root["test_exact"]);
+  if (!indicator.empty()) {
+    JsonValue &r = rep.root["residual"];
+    r["indicator"]        = indicator;
+    r["rel_err_u_energy"] = E.u;
+    r["effectivity"]      = effectivity;
+    r["min_effectivity"]  = *std::min_element(effectivity.begin(), effectivity.end());
+    r["max_effectivity"]  = *std::max_element(effectivity.begin(), effectivity.end());
+    r["share_above_1"]    = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1; }) / effectivity.size();
+    r["share_within_20"]  = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1 && x <= 20; }) / effectivity.size();
+  }
   {
     std::vector<double> mus;
     for (const auto &mu : test.points) mus.insert(mus.end(), mu.begin(), mu.end());
