@@ -87,7 +87,7 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
       for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
     }
   };
-  if (dim_ == 3 && nc > 1 && (PetscInt)sphere_.size() == 4 * NumFacets()) {
+  if (dim_ == 3 && nc > 1) { // sphere_ is set with the vertices
     d2c_.resize(nc);
     PetscInt first = 0;
     for (PetscInt i = 0; i < nc; ++i) {

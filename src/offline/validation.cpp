@@ -270,7 +270,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   PetscCall(VecDuplicate(kac.lambda, &lwork));
 
   // ROM (timed) and ROM without EIM on the test set, for one truncation of the model
-  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its) -> PetscErrorCode {
+  // sols (may be null): the converged reduced solutions, in the order of the test parameters
+  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols) -> PetscErrorCode {
     PetscFunctionBeginUser;
     for (PetscInt j = 0; j < nt; ++j) {
       ReducedSolution sol;
@@ -294,6 +295,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         continue;
       }
       if (its) its->push_back(sol.iterations);
+      if (sols) sols->push_back(sol);
       E->outOfRange.push_back((double)sol.outOfRange);
       double eu, el, ef;
       PetscCall(Compare(m, bases, order, *sysAt[j], dim, fom.affine, F[j], sol, work, work2, lwork, &eu, &el, &ef));
@@ -318,8 +320,9 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   Errors                E, E0;
   std::vector<double>   medians;
   std::vector<PetscInt> romIts;
-  PetscCall(evaluate(model, true, &E, &medians, &romIts));
-  PetscCall(evaluate(exact, false, &E0, nullptr, nullptr));
+  std::vector<ReducedSolution> sols;
+  PetscCall(evaluate(model, true, &E, &medians, &romIts, settings.residual ? &sols : nullptr));
+  PetscCall(evaluate(exact, false, &E0, nullptr, nullptr, nullptr));
   // the residual indicator of each reduced solution (the greedy's, on the mesh: docs/error_estimate.md) against its
   // energy error: the effectivity an online estimate built on this residual would start from
   std::vector<double> indicator, effectivity;
@@ -328,8 +331,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     ind.criterion = GreedyCriterion::Residual;
     PetscCall(ind.Setup(fom));
     for (PetscInt j = 0; j < nt; ++j) {
-      ReducedSolution sol;
-      PetscCall(model.Solve(F[j].mu, &sol));
+      const ReducedSolution &sol = sols[j];
       PetscCall(bases.Displacement(model, order, sol.v, work));
       std::vector<PetscReal> lam;
       bases.Multipliers(model, sol.lambda, &lam);
@@ -394,7 +396,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       PetscCall(model.Truncate(n, r, mk, mg));
       Errors              Es;
       std::vector<double> meds;
-      PetscCall(evaluate(model, true, &Es, &meds, nullptr));
+      PetscCall(evaluate(model, true, &Es, &meds, nullptr, nullptr));
       JsonValue row;
       auto      mx = [](const std::vector<double> &v) { return v.empty() ? NAN : *std::max_element(v.begin(), v.end()); };
       row["N"] = (long long)model.N();
