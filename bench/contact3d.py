@@ -14,11 +14,14 @@ Tables:
      ranks of --rom-np, validate on 20 random parameters: N, R, Mc, max relative errors u, lambda, force (targets
      1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median, speedup (target 1e4 at the finest level).
      --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of ~10 s).
+  5. --large (printed before table 4): one FOM at about 5e5 dofs on 2 ranks (hertz3d h_fine 0.028 refined once) with the
+     iterative saddle-point preset, against refine 1 with the same settings: time, peak resident memory, and the
+     memory growth against the dof growth between the two levels (target: no faster than linear).
 
 Extra options for every fom run: --extra "...". Runs that fail are reported as such and the script goes on.
 It exits 0 unless the executable is missing. Timings depend on the machine's load.
-Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_dual_matrix shell"]
-       [--no-rom] [--rom-meshes scene hertz3d] [--rom-np 2]
+Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_saddle_solver gamg"]
+       [--large] [--no-rom] [--rom-meshes scene hertz3d] [--rom-np 2]
 """
 import argparse
 import json
@@ -64,6 +67,9 @@ def main():
     ap.add_argument("--np", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--extra", default="")
     ap.add_argument("--timeout", type=int, default=1800)
+    ap.add_argument("--large", action="store_true",
+                    help="table 5: one FOM at ~5e5 dofs on 2 ranks (hertz3d h_fine 0.028 refined once, -fom_saddle_solver gamg, "
+                         "-mesh_partitioner metis) against refine 1 with the same settings: time, peak RSS, memory growth / dof growth")
     ap.add_argument("--no-rom", action="store_true")
     ap.add_argument("--rom-meshes", nargs="+", default=["scene", "hertz3d"], choices=["scene", "hertz3d"])
     ap.add_argument("--rom-np", type=int, default=2)
@@ -74,20 +80,20 @@ def main():
     forces = {}
 
     print("## 1. hertz3d against Hertz's point contact\n")
-    print("| refine | ranks | ndofs | R | Kacanov | P | a (err) | p0 (err) | target a / p0 | total [s] | peak RSS [MB] max / sum |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| refine | ranks | ndofs | R | contact QP | Kacanov | P | a (err) | p0 (err) | target a / p0 | total [s] | peak RSS [MB] max / sum |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for ref in args.refine:
         tgt = (0.03, 0.05) if ref == 0 else (0.015, 0.03)
         for np_ in args.np:
             r, why = fom(args, np_, "runs/hertz3d.opts", ["-mesh_refine", str(ref)] + extra, args.timeout)
             if r is None:
-                print("| %d | %d | failed: %s |||||||||" % (ref, np_, why))
+                print("| %d | %d | failed: %s ||||||||||" % (ref, np_, why))
                 continue
             h = r["hertz"]
             ea, ep = h["a"] / h["a_exact"] - 1, h["p0"] / h["p0_exact"] - 1
             ok = abs(ea) <= tgt[0] and abs(ep) <= tgt[1]
-            print("| %d | %d | %d | %d | %d | %.8f | %.5f (%+.2f %%) | %.3f (%+.2f %%) | %g %% / %g %%: %s | %.1f | %s |"
-                  % (ref, np_, r["ndofs"], r["ncontact"], r["kacanov_iterations"], h["P"], h["a"], 100 * ea, h["p0"], 100 * ep,
+            print("| %d | %d | %d | %d | %s | %d | %.8f | %.5f (%+.2f %%) | %.3f (%+.2f %%) | %g %% / %g %%: %s | %.1f | %s |"
+                  % (ref, np_, r["ndofs"], r["ncontact"], r["dual_matrix"], r["kacanov_iterations"], h["P"], h["a"], 100 * ea, h["p0"], 100 * ep,
                      100 * tgt[0], 100 * tgt[1], "met" if ok else "MISSED", r["time_s"]["total"], mem(r)))
             forces[("hertz3d refine %d" % ref, np_)] = r["contact_force"]
 
@@ -119,8 +125,35 @@ def main():
                 d = abs(a - b) / abs(a)
                 print("| %s | %.14f | %.14f | %.1e | %s |" % (case, a, b, d, "met" if d <= 1e-8 else "MISSED"))
 
+    if args.large:
+        large(args, extra)
     if not args.no_rom:
         rom3d(args, extra)
+
+
+def large(args, extra):
+    print("\n## 5. ~5e5 dofs on 2 ranks: the saddle-point contact solve with the iterative preset (no dense contact object)\n")
+    print("| level | ndofs | R | contact QP | solver | Kacanov | steps / set-ups / FGMRES its | a (err) | p0 (err) | total [s] | peak RSS [MB] max / sum | MB per 1e3 dofs (sum) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    opts = ["-fom_saddle_solver", "gamg", "-mesh_partitioner", "metis", "-mesh_refine", "1"]
+    rows = []
+    for tag, geo in (("refine 1", []), ("h_fine 0.028, refine 1", ["-mesh_geo_set", "h_fine=0.028"])):
+        r, why = fom(args, 2, "runs/hertz3d.opts", geo + opts + extra, args.timeout)
+        if r is None:
+            print("| %s | failed: %s |||||||||||" % (tag, why))
+            continue
+        h, sd, m = r["hertz"], r.get("saddle", {}), r.get("memory", {})
+        ea, ep = h["a"] / h["a_exact"] - 1, h["p0"] / h["p0_exact"] - 1
+        per = m.get("peak_rss_mb_sum", float("nan")) / (r["ndofs"] / 1e3)
+        rows.append((r["ndofs"], m.get("peak_rss_mb_sum", float("nan")), r["time_s"]["total"]))
+        print("| %s | %d | %d | %s | %s + %s | %d | %d / %d / %d | %.5f (%+.2f %%) | %.3f (%+.2f %%) | %.1f | %s | %.2f |"
+              % (tag, r["ndofs"], r["ncontact"], r["dual_matrix"], sd.get("ksp_type", "-"), sd.get("pc_type", "-"), r["kacanov_iterations"],
+                 sd.get("steps", 0), sd.get("factorizations", 0), sd.get("krylov", 0), h["a"], 100 * ea, h["p0"], 100 * ep,
+                 r["time_s"]["total"], mem(r), per))
+    if len(rows) == 2:
+        gd, gm, gt = rows[1][0] / rows[0][0], rows[1][1] / rows[0][1], rows[1][2] / rows[0][2]
+        print("\nFrom the first level to the second: dofs x %.2f, peak memory (sum) x %.2f (%s: no faster than linear), time x %.2f"
+              % (gd, gm, "met" if gm <= gd else "MISSED", gt))
 
 
 def rom3d(args, extra):

@@ -1,6 +1,6 @@
 # tests/contact.cmake -- the contact full-order model: Hertz, flat-punch patch test (2D and 3D), no-contact gap,
 # ring on block (convergence, 1 vs 2 ranks), KKT on every scene, the dense QP solvers, the matrix-free
-# dual (-fom_dual_matrix shell) against the dense one, the fast FOM path against the reference settings,
+# dual (-fom_dual_matrix shell) and the saddle-point active set (-fom_dual_matrix saddle) against the dense one, the fast FOM path against the reference settings,
 # the compliance methods against each other, the mortar segment search against the full search, the Newton
 # Kacanov step against the fixed point (test_kacanov_newton).
 find_program(RBC_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
@@ -11,6 +11,7 @@ foreach(np 1 2)
   add_test(NAME contact_no_contact_np${np} COMMAND ${RBC_CC} no_contact --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_kkt_all_np${np} COMMAND ${RBC_CC} kkt_all --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_dual_shell_np${np} COMMAND ${RBC_CC} dual_shell --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  add_test(NAME contact_saddle_np${np} COMMAND ${RBC_CC} saddle --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_smooth_np${np} COMMAND ${RBC_CC} smooth --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_nan_input_np${np} COMMAND ${RBC_CC} nan_input --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_floating_np${np} COMMAND ${RBC_CC} floating --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
@@ -19,7 +20,7 @@ foreach(np 1 2)
   add_test(NAME contact_compliance_np${np} COMMAND ${RBC_CC} compliance --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_segments_np${np} COMMAND ${RBC_CC} segments --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_flat_punch3d_np${np} COMMAND ${RBC_CC} flat_punch3d --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np} contact_flat_punch3d_np${np}
+  set_tests_properties(contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_saddle_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np} contact_flat_punch3d_np${np}
     PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
 endforeach()
 # runs both rank counts itself and compares them

@@ -40,6 +40,9 @@ public:
   // several ranks when A has no coupling between them (-mesh_partitioner bodies): each rank factors its
   // own block with the Schur complement on its dofs of D (SchurIsLocal).
   void SetSchurDofs(const std::vector<PetscInt> &D) { schurDofs_ = D; }
+  // Factorless: AssembleAndFactor only assembles, and A is factored on the first ApplyInverse (the contact
+  // solve on the saddle point, -fom_dual_matrix saddle, factors its own matrix and never needs A's factor).
+  void SetFactorless(bool on) { factorless_ = on; }
   const std::vector<PetscInt> &SchurDofs() const { return schurDofs_; }
   // The Schur complement S_A = A_DD - A_DI A_II^{-1} A_ID of the last factorization (a sequential
   // dense copy), or null when A was factored by the KSP alone (or this rank holds no dof of D).
@@ -84,6 +87,8 @@ public:
 
 private:
   PetscErrorCode FactorWithSchur(bool *done);
+  PetscErrorCode Factor();
+  bool                  factorless_ = false, factorPending_ = false;
   bool                  residualChecked_ = false; // the first solve after a factorization checks ||A x - rhs||
   std::vector<PetscInt> schurDofs_;
   Mat                   schurFactor_ = nullptr, schurS_ = nullptr; // MUMPS factor with the Schur on D, S copy

@@ -6,9 +6,11 @@
 // Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
 // -kacanov_monitor, -kacanov_type fixed_point|newton (kacanov_newton.cpp); the dual QP takes the fom_qp_ prefix (-fom_qp_tao_type, its
 // TAO's -fom_qp_ksp_*; -fom_qp_polish; the former -fom_tao_* warn); -fom_kkt_tol.
-// -fom_dual_matrix dense|shell|auto (-fom_dual_dense_max R): dense S through the surface compliance
-// (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), or S as a MATSHELL with the matrix-free
-// primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*).
+// -fom_dual_matrix dense|shell|saddle|auto (-fom_dual_dense_max R, -fom_dual_dense_max_dofs): dense S through
+// the surface compliance (compliance.hpp, then TAO + active-set polish, bound_qp.hpp), S as a MATSHELL with
+// the matrix-free primal-dual active-set solver (dual_shell.hpp, options -fom_dual_*), or the primal-dual
+// active set on the sparse saddle point, no factorization of A alone (saddle_active_set.hpp, -fom_saddle_*;
+// auto's choice above the dense limits).
 #pragma once
 #include "rbcontact/anderson.hpp"
 #include "rbcontact/bound_qp.hpp"
@@ -17,6 +19,7 @@
 #include "rbcontact/dual_shell.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov_loop.hpp"
+#include "rbcontact/saddle_active_set.hpp"
 
 namespace rbc {
 
@@ -52,7 +55,8 @@ PetscErrorCode KacanovNewtonStep(const KacanovNewtonData &in, PetscReal maxRatio
 struct KacanovHistory {
   std::vector<PetscReal> du, dl;
   std::vector<PetscInt>  nactive;
-  std::vector<PetscInt>  dualSteps, dualCG; // shell dual: active-set steps and CG iterations per iterate
+  std::vector<PetscInt>  dualSteps, dualCG; // shell dual: active-set steps and CG iterations per iterate (saddle: its steps)
+  std::vector<PetscInt>  factorizations, krylov; // saddle: numeric factorizations and GMRES iterations per iterate
   std::vector<PetscInt>  newton; // -kacanov_type newton: 1 if the next input is a Newton step, 0 a plain one
 };
 
@@ -71,7 +75,7 @@ public:
   // so that one factorization serves the solves and the compliance (ElasticFOM::SetSchurDofs). Collective.
   PetscErrorCode ShareFactor(ElasticFOM &fom, const ContactMap &map) const;
   // The -fom_dual_matrix choice (auto: by R and the number of contact dofs) and, when dense, the contact dofs D.
-  PetscErrorCode ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, bool *shell, std::vector<PetscInt> *D) const;
+  PetscErrorCode ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, std::string *mode, std::vector<PetscInt> *D) const;
 
   Vec            lambda = nullptr;
   ContactSystem  sys;
@@ -91,11 +95,12 @@ public:
   PetscReal      kktTol = 1e-8;
   DualQPInfo     lastQP;
   DualShellInfo  lastShell;
+  SaddleInfo     lastSaddle;
   SurfaceCompliance compliance;
   std::string    dualMatrixOption = "auto"; // -fom_dual_matrix
   PetscInt       dualDenseMax     = 3000;   // -fom_dual_dense_max: auto = dense up to this R
   PetscInt       dualDenseMaxDofs = 8000;   // -fom_dual_dense_max_dofs: auto = dense up to this many contact dofs (G: 0.5 GB at 8000)
-  std::string    dualMatrix;                // used by the last Solve: "dense" or "shell" (report key dual_matrix)
+  std::string    dualMatrix;                // used by the last Solve: "dense", "shell" or "saddle" (report key dual_matrix)
   mutable PetscInt contactDofs = -1;        // the contact dofs D counted by the last choice (-1: -fom_dual_matrix shell, not counted)
   // Initial overlap, measured at the first iterate (u = 0: the reference configuration at mu, imposed
   // displacements of the contact surfaces included): the deepest penetration (weighted gap g_i / weight_i
@@ -108,6 +113,7 @@ private:
   PetscErrorCode MeasureInitialOverlap(MPI_Comm comm);
   DualQPSolver    qp_;
   DualShellSolver shell_;
+  SaddleActiveSetSolver saddle_;
 };
 
 // Contact quantities for reports: resultant normal force, max pressure, active count, half-width (2D).

@@ -67,6 +67,18 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
     rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
     if (kacanov.dualMatrix == "dense") rep.root["compliance"] = kacanov.compliance.method; // how G = (A^-1)_DD was computed (-contact_compliance)
+    if (kacanov.dualMatrix == "saddle") { // the saddle-point solve (-fom_saddle_*): its solver and totals over the iterates
+      JsonValue &sd = rep.root["saddle"];
+      PetscInt   nf = 0, nk = 0, ns = 0;
+      for (PetscInt v : kacanov.history.factorizations) nf += v;
+      for (PetscInt v : kacanov.history.krylov) nk += v;
+      for (PetscInt v : kacanov.history.dualSteps) ns += v;
+      sd["ksp_type"]       = kacanov.lastSaddle.kspType;
+      sd["pc_type"]        = kacanov.lastSaddle.pcType;
+      sd["steps"]          = (long long)ns;
+      sd["factorizations"] = (long long)nf; // numeric factorizations, or preconditioner set-ups with an iterative solver
+      sd["krylov"]         = (long long)nk;
+    }
     if (kacanov.contactDofs >= 0) rep.root["contact_dofs"] = (long long)kacanov.contactDofs; // the dofs of the slave and master facets (the rows of the dense G)
     rep.root["initial_overlap"]["max_penetration"] = (double)kacanov.initialPenetration; // at u = 0 (0: none)
     rep.root["initial_overlap"]["nodes"]           = (long long)kacanov.initialPenetrating;
@@ -93,6 +105,12 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["kacanov_type"] = kacanov.type; // -kacanov_type (newton: plain Kacanov on the shell path and in 3D)
     if (!kacanov.history.newton.empty()) h["newton"] = std::vector<double>(kacanov.history.newton.begin(), kacanov.history.newton.end()); // 1: the next input was a Newton step
     if (!kacanov.history.dualCG.empty()) h["dual_cg"] = std::vector<double>(kacanov.history.dualCG.begin(), kacanov.history.dualCG.end());
+    auto asDoubles = [](const std::vector<PetscInt> &v) { return std::vector<double>(v.begin(), v.end()); };
+    if (!kacanov.history.dualSteps.empty()) h["dual_steps"] = asDoubles(kacanov.history.dualSteps); // active-set steps per iterate (shell, saddle)
+    if (!kacanov.history.factorizations.empty()) { // saddle: numeric factorizations and GMRES iterations per iterate
+      h["factorizations"] = asDoubles(kacanov.history.factorizations);
+      h["krylov"]         = asDoubles(kacanov.history.krylov);
+    }
     if (hertz) {
       PetscReal a, p0;
       if (fom.elas.dim == 3) HertzPointContact(scene, hertzRadius, cs.force, &a, &p0); // a sphere of radius -hertz_radius

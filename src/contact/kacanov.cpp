@@ -63,18 +63,19 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
   {
-    const char *types[] = {"dense", "shell", "auto"};
-    PetscInt    t       = dualMatrixOption == "dense" ? 0 : dualMatrixOption == "shell" ? 1 : 2;
-    PetscCall(PetscOptionsEList("-dual_matrix", "Dual Hessian S = K A^-1 K^T: dense (via the surface compliance), shell (matrix-free), auto", NULL, types, 3, types[t], &t, NULL));
+    const char *types[] = {"dense", "shell", "saddle", "auto"};
+    PetscInt    t       = dualMatrixOption == "dense" ? 0 : dualMatrixOption == "shell" ? 1 : dualMatrixOption == "saddle" ? 2 : 3;
+    PetscCall(PetscOptionsEList("-dual_matrix", "Contact QP: dense (S = K A^-1 K^T via the surface compliance), shell (S matrix-free), saddle (active set on the sparse saddle point), auto (dense while small, else saddle)", "docs/contact.md", types, 4, types[t], &t, NULL));
     dualMatrixOption = types[t];
   }
-  PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, shell above", NULL, dualDenseMax, &dualDenseMax, NULL));
+  PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, saddle above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscCall(PetscOptionsInt("-dual_dense_max_dofs", "auto: dense S only while the compliance G (contact dofs squared) has at most this many rows (memory)", NULL, dualDenseMaxDofs, &dualDenseMaxDofs, NULL));
   PetscOptionsEnd();
   PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(RenameTaoOptions(comm));
   PetscCall(qp_.Setup("fom_"));
   PetscCall(shell_.SetFromOptions(comm, "fom_"));
+  PetscCall(saddle_.SetFromOptions(comm, "fom_"));
   PetscFunctionReturn(0);
 }
 
@@ -255,30 +256,30 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
 }
 
 // -fom_dual_matrix auto: dense while R <= -fom_dual_dense_max and the contact dofs (the rows of the dense
-// compliance G and of the Schur complement behind it) <= -fom_dual_dense_max_dofs; D: the contact dofs
-// (empty with shell). Collective.
-PetscErrorCode KacanovSolver::ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, bool *shell, std::vector<PetscInt> *D) const
+// compliance G and of the Schur complement behind it) <= -fom_dual_dense_max_dofs, else saddle; D: the
+// contact dofs (empty unless dense). Collective.
+PetscErrorCode KacanovSolver::ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, std::string *mode, std::vector<PetscInt> *D) const
 {
   PetscFunctionBeginUser;
   D->clear();
-  *shell = dualMatrixOption == "shell" || (dualMatrixOption == "auto" && map.NumMultipliers() > dualDenseMax);
-  if (!*shell) PetscCall(map.SurfaceDofs(comm, D));
-  contactDofs = *shell ? -1 : (PetscInt)D->size();
-  if (!*shell && dualMatrixOption == "auto" && (PetscInt)D->size() > dualDenseMaxDofs) {
-    *shell = true;
-    D->clear();
-  }
+  *mode = dualMatrixOption;
+  if (*mode == "auto" && map.NumMultipliers() > dualDenseMax) *mode = "saddle";
+  if (*mode == "auto" || *mode == "dense") PetscCall(map.SurfaceDofs(comm, D));
+  contactDofs = D->empty() ? -1 : (PetscInt)D->size();
+  if (*mode == "auto") *mode = (PetscInt)D->size() > dualDenseMaxDofs ? "saddle" : "dense";
+  if (*mode != "dense") D->clear();
   PetscFunctionReturn(0);
 }
 
 PetscErrorCode KacanovSolver::ShareFactor(ElasticFOM &fom, const ContactMap &map) const
 {
   std::vector<PetscInt> D;
-  bool                  shell;
+  std::string           mode;
 
   PetscFunctionBeginUser;
-  PetscCall(ChooseDualMatrix(PetscObjectComm((PetscObject)fom.dm), map, &shell, &D));
+  PetscCall(ChooseDualMatrix(PetscObjectComm((PetscObject)fom.dm), map, &mode, &D));
   fom.SetSchurDofs(D);
+  fom.SetFactorless(mode == "saddle");
   PetscFunctionReturn(0);
 }
 
@@ -293,8 +294,12 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   converged = PETSC_FALSE;
   // Elastic solution u0 = A^{-1} f (solve time)
   PetscCall(PetscTime(&t0));
+  std::vector<PetscInt> D;
+  std::string           mode;
+  PetscCall(ChooseDualMatrix(comm, map, &mode, &D));
+  const bool saddle = mode == "saddle", shell = mode == "shell", distributed = saddle || shell;
   PetscCall(VecDuplicate(fom.f, &u0));
-  PetscCall(fom.ApplyInverse(fom.f, u0));
+  if (!saddle) PetscCall(fom.ApplyInverse(fom.f, u0)); // the saddle point needs no A^{-1} f (nor A's factor)
   PetscCall(PetscTime(&t1));
   fom.times.solve += t1 - t0;
   PetscCall(VecDuplicate(u0, &uprev));
@@ -310,22 +315,26 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   // iterate's S = K_D G K_D^T costs dense operations only), or a MATSHELL with no compliance at all.
   const PetscInt R0 = map.NumMultipliers();
   PetscCall(PetscTime(&t0));
-  std::vector<PetscInt> D;
   std::vector<PetscReal> u0D;
-  bool                   shell;
-  PetscCall(ChooseDualMatrix(comm, map, &shell, &D));
-  dualMatrix = shell ? "shell" : "dense";
-  if (!shell) {
+  dualMatrix = mode;
+  if (saddle) {
+    MatNullSpace nsp;
+    saddle_.NewOperator();
+    PetscCall(fom.elas.NearNullSpace(&nsp)); // used only by a PCFIELDSPLIT's u block (GAMG)
+    PetscCall(saddle_.SetNearNullSpace(nsp));
+    PetscCall(MatNullSpaceDestroy(&nsp));
+  }
+  if (!distributed) {
     PetscCall(compliance.Compute(fom, D));
     PetscCall(GatherAt(u0, D, &u0D));
   }
   PetscCall(PetscTime(&t1));
   fom.times.contact += t1 - t0;
   const PetscBLASInt nD = (PetscBLASInt)D.size();
-  loop.Begin(shell ? 0 : (PetscInt)nD); // the shell path keeps its state distributed: it records its own changes
+  loop.Begin(distributed ? 0 : (PetscInt)nD); // the shell and saddle paths keep their state distributed: they record their own changes
   mixed.assign(nD, 0.0);
   // -kacanov_type newton: dense dual matrix and 2D (the contact geometry's derivative); plain Kacanov otherwise
-  const bool             newton = type == "newton" && !shell && fom.elas.dim == 2;
+  const bool             newton = type == "newton" && !distributed && fom.elas.dim == 2;
   std::vector<PetscReal> image, relaxed, newtonNext; // F(x), the relaxed image, the Newton step's input
   PetscReal              duPrev = kInf;             // the previous iterate's change (Newton: a step that made it grow is not repeated)
   bool                   lastNewton = false;
@@ -343,7 +352,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscFunctionReturn(0);
   };
   if (loop.monitor) {
-    if (shell) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %" PetscInt_FMT " contact dofs (-1: not counted), dual matrix shell (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ", -fom_dual_dense_max_dofs %" PetscInt_FMT ")\n", R0, contactDofs, dualMatrixOption.c_str(), dualDenseMax, dualDenseMaxDofs));
+    if (distributed) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %" PetscInt_FMT " contact dofs (-1: not counted), dual matrix %s (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ", -fom_dual_dense_max_dofs %" PetscInt_FMT ")\n", R0, contactDofs, mode.c_str(), dualMatrixOption.c_str(), dualDenseMax, dualDenseMaxDofs));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
   }
 
@@ -361,7 +370,17 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
       PetscCall(VecSet(lambda, 0.0));
     }
-    if (shell) {
+    if (saddle) {
+      // the QP on the saddle point: to convergence of the active set on the first iterate, then one
+      // active-set step per iterate (the set and the geometry converge together; docs/contact.md)
+      PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
+      PetscCall(saddle_.Solve(fom.A, fom.f, sys.K, sys.g, warm, k == 1 ? PETSC_TRUE : PETSC_FALSE, fom.u, lambda, &lastSaddle));
+      PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
+      nact = lastSaddle.nactive;
+      history.dualSteps.push_back(lastSaddle.steps);
+      history.factorizations.push_back(lastSaddle.factorizations);
+      history.krylov.push_back(lastSaddle.krylov);
+    } else if (shell) {
       // b = K u0 - g; lambda (the previous iterate's multipliers) is the warm start
       Vec b;
       PetscCall(VecDuplicate(sys.g, &b));
@@ -438,9 +457,9 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(MatMultTranspose(sys.K, lambda, rhs));
     PetscCall(VecAYPX(rhs, -1.0, fom.f));
     PetscReal du, nl, nlp = 0, ndl;
-    if (shell) {
+    if (distributed) {
       PetscReal nu, nup, ndu;
-      PetscCall(fom.ApplyInverse(rhs, fom.u));
+      if (shell) PetscCall(fom.ApplyInverse(rhs, fom.u)); // saddle: u came with lambda
       if (loop.relaxation < 1) PetscCall(VecAXPBY(fom.u, 1 - loop.relaxation, loop.relaxation, uprev));
       PetscCall(VecNorm(fom.u, NORM_2, &nu));
       PetscCall(VecNorm(uprev, NORM_2, &nup));
@@ -491,14 +510,17 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     const PetscReal dl = lamPrev ? KacanovLoop::RelChange(ndl, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
     iterations = k;
     char detail[320] = "";
-    if (loop.monitor && shell)
+    if (loop.monitor && saddle)
+      std::snprintf(detail, sizeof detail, "saddle: active-set steps %" PetscInt_FMT "%s, %" PetscInt_FMT " rows to change, %.2f s", lastSaddle.steps, lastSaddle.symbolic ? " (new pattern)" : "", lastSaddle.changed, (double)lastSaddle.seconds);
+    else if (loop.monitor && shell)
       std::snprintf(detail, sizeof detail, "dual shell: TAO its %" PetscInt_FMT " (%" PetscInt_FMT " products), active-set steps %" PetscInt_FMT ", CG its %" PetscInt_FMT ", S products %" PetscInt_FMT ", free-set residual %.2e, kkt %.2e", lastShell.taoIterations, lastShell.taoProducts, lastShell.pdasIterations, lastShell.cgIterations, lastShell.products, (double)lastShell.residual, (double)lastShell.kkt);
     else if (loop.monitor) std::snprintf(detail, sizeof detail, "QP: tao its %" PetscInt_FMT ", polish %" PetscInt_FMT ", kkt %.2e", lastQP.taoIterations, lastQP.polishIterations, (double)lastQP.kkt);
     bool done = false;
     PetscCall(loop.Record(comm, k, du, dl, nact, sys.R, detail, &done));
+    if (saddle && lastSaddle.changed) done = false; // the set moved: this K, g's QP is not solved yet
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
-    if (shell) PetscCall(VecCopy(fom.u, uprev));
+    if (distributed) PetscCall(VecCopy(fom.u, uprev));
     if (done) {
       converged = PETSC_TRUE;
       break;
@@ -541,9 +563,9 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       PetscCall(setSurface(uDprev));
     }
     duPrev = du;
-    PetscCall(fom.elas.GlobalToLocalWithBC(shell ? fom.u : usurf, uloc));
+    PetscCall(fom.elas.GlobalToLocalWithBC(distributed ? fom.u : usurf, uloc));
   }
-  if (!shell) { // the whole field at the last multipliers: u = A^{-1} (f - K^T lambda)
+  if (!distributed) { // the whole field at the last multipliers: u = A^{-1} (f - K^T lambda)
     PetscCall(PetscTime(&t0));
     PetscCall(fom.ApplyInverse(rhs, fom.u));
     PetscCall(PetscTime(&t1));

@@ -275,6 +275,20 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
     PetscCall(MatNullSpaceDestroy(&nsp));
   }
   residualChecked_ = false;
+  factorPending_   = true;
+  if (!factorless_) PetscCall(Factor());
+  if (!u) PetscCall(VecDuplicate(f, &u));
+  PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
+  PetscFunctionReturn(0);
+}
+
+// Factors the assembled A (with the Schur complement on the contact dofs when they are set)
+PetscErrorCode ElasticFOM::Factor()
+{
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t1));
   PetscCall(PetscLogEventBegin(FOM_Factor, 0, 0, 0, 0));
   bool shared = false;
   PetscCall(FactorWithSchur(&shared));
@@ -289,8 +303,7 @@ PetscErrorCode ElasticFOM::AssembleAndFactor()
   PetscCall(PetscLogEventEnd(FOM_Factor, 0, 0, 0, 0));
   PetscCall(PetscTime(&t0));
   times.factorization += t0 - t1;
-  if (!u) PetscCall(VecDuplicate(f, &u));
-  PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
+  factorPending_ = false;
   PetscFunctionReturn(0);
 }
 
@@ -354,6 +367,7 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
   KSPConvergedReason reason;
 
   PetscFunctionBeginUser;
+  if (factorPending_) PetscCall(Factor()); // factorless (the saddle-point contact solve): on first use only
   PetscCall(PetscLogEventBegin(FOM_Solve, 0, 0, 0, 0));
   if (schurFactor_ && schurLocal_) {
     // each rank its own block (no coupling between ranks): the local parts of rhs and x as sequential vectors

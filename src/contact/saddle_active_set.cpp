@@ -1,0 +1,432 @@
+// src/contact/saddle_active_set.cpp: the contact QP of a Kacanov iterate on the sparse primal-dual saddle
+// point, by a primal-dual active-set method (see rbcontact/saddle_active_set.hpp, docs/contact.md).
+// Owns the saddle-point matrix (its layout: each rank's u rows, then its lambda rows), its KSP and the set.
+#include "rbcontact/saddle_active_set.hpp"
+#include <algorithm>
+#include <cmath>
+
+namespace rbc {
+
+static PetscLogEvent SAS_Build = 0, SAS_Solve = 0;
+
+SaddleActiveSetSolver::~SaddleActiveSetSolver() { (void)Reset(); }
+
+PetscErrorCode SaddleActiveSetSolver::Reset()
+{
+  PetscFunctionBeginUser;
+  PetscCall(KSPDestroy(&ksp_));
+  PetscCall(MatDestroy(&M_));
+  PetscCall(VecDestroy(&x_));
+  PetscCall(VecDestroy(&b_));
+  PetscCall(MatNullSpaceDestroy(&nearNull_));
+  lastA_ = nullptr;
+  factored_ = false;
+  kPattern_.clear();
+  active_.clear();
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::string &prefix)
+{
+  PetscFunctionBeginUser;
+  if (!SAS_Build) {
+    PetscCall(PetscLogEventRegister("RBCSaddleBuild", MAT_CLASSID, &SAS_Build));
+    PetscCall(PetscLogEventRegister("RBCSaddleSolve", MAT_CLASSID, &SAS_Solve));
+  }
+  prefix_ = prefix + "saddle_";
+  PetscOptionsBegin(comm, prefix_.c_str(), "Contact QP on the saddle point (primal-dual active set, -fom_dual_matrix saddle)", "SaddleActiveSetSolver");
+  PetscCall(PetscOptionsInt("-pdas_max_it", "Most active-set steps of one Kacanov iterate (cold start or -pdas_inner)", "docs/contact.md", maxIt, &maxIt, NULL));
+  PetscCall(PetscOptionsReal("-pdas_tol", "A row joins the set when its penetration exceeds this times the constraint scale", "docs/contact.md", setTol, &setTol, NULL));
+  PetscCall(PetscOptionsBool("-pdas_inner", "Active-set steps to convergence on every Kacanov iterate (else one step per iterate after the first)", "docs/contact.md", inner, &inner, NULL));
+  PetscCall(PetscOptionsBool("-pdas_monitor", "One line per active-set step", NULL, monitor, &monitor, NULL));
+  {
+    const char *types[] = {"direct", "gamg"};
+    PetscInt    t       = solver == "gamg" ? 1 : 0;
+    PetscCall(PetscOptionsEList("-solver", "Preset of the solver: direct (MUMPS LDL^T) or gamg (FGMRES + Schur-complement fieldsplit, GAMG on u: memory linear in the dofs); -fom_saddle_ksp_*/-pc_* refine either", "docs/contact.md", types, 2, types[t], &t, NULL));
+    solver = types[t];
+  }
+  PetscCall(PetscOptionsInt("-reuse_max_changes", "Solve with the last factorization (GMRES) while at most this many rows changed status since it (-1: factor every step)", "docs/contact.md", reuseMaxChanges, &reuseMaxChanges, NULL));
+  PetscOptionsEnd();
+  if (solver == "gamg") { // defaults of the preset; options given on the command line win
+    const char *preset[][2] = {{"ksp_type", "fgmres"}, {"ksp_max_it", "2000"}, {"ksp_gmres_restart", "200"}, {"pc_type", "fieldsplit"},
+                               {"pc_fieldsplit_type", "schur"}, {"pc_fieldsplit_schur_fact_type", "full"}, {"pc_fieldsplit_schur_precondition", "selfp"},
+                               {"fieldsplit_u_ksp_type", "preonly"}, {"fieldsplit_u_pc_type", "gamg"}, {"fieldsplit_lambda_ksp_type", "preonly"},
+                               {"fieldsplit_lambda_pc_type", "lu"}, {"fieldsplit_lambda_pc_factor_mat_solver_type", "mumps"}};
+    for (const auto &kv : preset) {
+      const std::string name = "-" + prefix_ + kv[0];
+      PetscBool         given;
+      PetscCall(PetscOptionsHasName(NULL, NULL, name.c_str(), &given));
+      if (!given) PetscCall(PetscOptionsSetValue(NULL, name.c_str(), kv[1]));
+    }
+  }
+  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
+  PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SaddleActiveSetSolver::SetNearNullSpace(MatNullSpace nsp)
+{
+  PetscFunctionBeginUser;
+  if (nsp) PetscCall(PetscObjectReference((PetscObject)nsp));
+  PetscCall(MatNullSpaceDestroy(&nearNull_));
+  nearNull_ = nsp;
+  PetscFunctionReturn(0);
+}
+
+// Owner of global index j in the ranges r (size + 1 entries)
+static PetscMPIInt Owner(const PetscInt *r, PetscMPIInt size, PetscInt j)
+{
+  return (PetscMPIInt)(std::upper_bound(r, r + size + 1, j) - r - 1);
+}
+
+// K's local pattern (row lengths, then the columns), to tell whether the last matrix's pattern still fits
+static PetscErrorCode Pattern(Mat K, std::vector<PetscInt> *p)
+{
+  PetscInt lo, hi;
+
+  PetscFunctionBeginUser;
+  p->clear();
+  PetscCall(MatGetOwnershipRange(K, &lo, &hi));
+  for (PetscInt i = lo; i < hi; ++i) {
+    PetscInt        nc;
+    const PetscInt *cols;
+    PetscCall(MatGetRow(K, i, &nc, &cols, NULL));
+    p->push_back(nc);
+    p->insert(p->end(), cols, cols + nc);
+    PetscCall(MatRestoreRow(K, i, &nc, &cols, NULL));
+  }
+  PetscFunctionReturn(0);
+}
+
+// The KSP of the saddle point on M_ (defaults: GMRES on a MUMPS LDL^T factor; -fom_saddle_solver gamg's preset
+// or the user's options), with the fields u and lambda when its PC is a PCFIELDSPLIT
+PetscErrorCode SaddleActiveSetSolver::CreateKSP()
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)M_);
+  PC       pc;
+  PetscInt start;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPDestroy(&ksp_));
+  PetscCall(KSPCreate(comm, &ksp_));
+  PetscCall(KSPSetOptionsPrefix(ksp_, prefix_.c_str()));
+  // GMRES on the factor: one iteration on a fresh factorization, a few on the factor of an earlier
+  // matrix (the next Kacanov iterate's K, or a few rows' status changed), which saves a factorization
+  PetscCall(KSPSetType(ksp_, KSPGMRES));
+  PetscCall(KSPSetPCSide(ksp_, PC_RIGHT));
+  PetscCall(KSPSetNormType(ksp_, KSP_NORM_UNPRECONDITIONED));
+  PetscCall(KSPSetTolerances(ksp_, 1e-12, 1e-300, PETSC_DEFAULT, 30));
+  PetscCall(KSPGetPC(ksp_, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(KSPSetFromOptions(ksp_));
+  PetscBool pre;
+  PetscCall(PetscObjectTypeCompare((PetscObject)ksp_, KSPPREONLY, &pre));
+  canReuse_   = !pre; // preonly cannot tell a stale factor from a fresh one
+  factored_   = false;
+  newPattern_ = false;
+  PetscCall(KSPSetOperators(ksp_, M_, M_));
+  PetscCall(KSPGetPC(ksp_, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &fieldsplit_));
+  PetscCall(MatGetOwnershipRange(M_, &start, NULL));
+  if (fieldsplit_) {
+    IS isu, isl;
+    PetscCall(ISCreateStride(comm, nu_, start, 1, &isu));
+    PetscCall(ISCreateStride(comm, nl_, start + nu_, 1, &isl));
+    if (nearNull_) PetscCall(PetscObjectCompose((PetscObject)isu, "nearnullspace", (PetscObject)nearNull_)); // for GAMG on the u block
+    PetscCall(PCFieldSplitSetIS(pc, "u", isu));
+    PetscCall(PCFieldSplitSetIS(pc, "lambda", isl));
+    PetscCall(ISDestroy(&isu));
+    PetscCall(ISDestroy(&isl));
+  }
+  PetscFunctionReturn(0);
+}
+
+// The saddle-point matrix with the pattern of A and K (all rows of K, explicit zeros where inactive),
+// preallocated exactly, and its KSP.
+PetscErrorCode SaddleActiveSetSolver::Build(Mat A, Mat K)
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)A);
+  PetscMPIInt     size, rank;
+  const PetscInt *ur, *lr;
+  Mat             Kt;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(SAS_Build, 0, 0, 0, 0));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(MatGetOwnershipRanges(A, &ur));
+  PetscCall(MatGetOwnershipRanges(K, &lr));
+  nu_ = ur[rank + 1] - ur[rank];
+  nl_ = lr[rank + 1] - lr[rank];
+  const PetscInt start = ur[rank] + lr[rank], n = nu_ + nl_;
+  auto mapU = [&](PetscInt j) { return j + lr[Owner(ur, size, j)]; };
+  auto mapL = [&](PetscInt i) { return i + ur[Owner(lr, size, i) + 1]; };
+  auto local = [&](PetscInt c) { return c >= start && c < start + n; };
+  PetscCall(MatTranspose(K, MAT_INITIAL_MATRIX, &Kt));
+  std::vector<PetscInt> dnz(n, 0), onz(n, 0);
+  for (PetscInt j = ur[rank]; j < ur[rank + 1]; ++j) {
+    PetscInt        nc;
+    const PetscInt *cols;
+    const PetscInt  row = j - ur[rank];
+    PetscCall(MatGetRow(A, j, &nc, &cols, NULL));
+    for (PetscInt k = 0; k < nc; ++k) ++(local(mapU(cols[k])) ? dnz : onz)[row];
+    PetscCall(MatRestoreRow(A, j, &nc, &cols, NULL));
+    PetscCall(MatGetRow(Kt, j, &nc, &cols, NULL));
+    for (PetscInt k = 0; k < nc; ++k) ++(local(mapL(cols[k])) ? dnz : onz)[row];
+    PetscCall(MatRestoreRow(Kt, j, &nc, &cols, NULL));
+  }
+  for (PetscInt i = lr[rank]; i < lr[rank + 1]; ++i) {
+    PetscInt        nc;
+    const PetscInt *cols;
+    const PetscInt  row = nu_ + i - lr[rank];
+    PetscCall(MatGetRow(K, i, &nc, &cols, NULL));
+    for (PetscInt k = 0; k < nc; ++k) ++(local(mapU(cols[k])) ? dnz : onz)[row];
+    PetscCall(MatRestoreRow(K, i, &nc, &cols, NULL));
+    ++dnz[row]; // the diagonal
+  }
+  PetscCall(MatDestroy(&Kt));
+  PetscCall(MatDestroy(&M_));
+  PetscCall(MatCreate(comm, &M_));
+  PetscCall(MatSetSizes(M_, n, n, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetType(M_, MATAIJ));
+  PetscCall(MatSeqAIJSetPreallocation(M_, 0, dnz.data()));
+  PetscCall(MatMPIAIJSetPreallocation(M_, 0, dnz.data(), 0, onz.data()));
+  PetscCall(MatSetOption(M_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(MatSetOption(M_, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(M_, MAT_SPD, PETSC_FALSE));
+  PetscCall(VecDestroy(&x_));
+  PetscCall(VecDestroy(&b_));
+  PetscCall(MatCreateVecs(M_, &x_, &b_));
+  // Balance: the multiplier rows scaled by c = max diag(A) / |K|_inf (entries of c K of A's size; lambda =
+  // c lambda~), the inactive rows' pivot -s = -max diag(A) (c^2 times the size of a diagonal entry of
+  // K A^{-1} K^T). Unscaled, a row that changed status left GMRES on an earlier factor stagnating near 1e-11.
+  {
+    Vec       d;
+    PetscReal kinf, amax;
+    PetscCall(MatCreateVecs(A, &d, NULL));
+    PetscCall(MatGetDiagonal(A, d));
+    PetscCall(VecMax(d, NULL, &amax));
+    PetscCall(VecDestroy(&d));
+    PetscCall(MatNorm(K, NORM_INFINITY, &kinf));
+    diagScale_ = amax > 0 ? amax : 1.0;
+    kScale_    = amax > 0 && kinf > 0 ? amax / kinf : 1.0;
+  }
+  if (!ksp_) PetscCall(CreateKSP());
+  else {
+    PetscCall(KSPSetOperators(ksp_, M_, M_));
+    newPattern_ = true;
+  }
+  PetscCall(PetscLogEventEnd(SAS_Build, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+// The values for the current set: A; K and K^T on the active rows (zeros elsewhere); -s on the inactive
+// rows' diagonal. Every entry of the pattern is written, so no zeroing is needed.
+PetscErrorCode SaddleActiveSetSolver::Fill(Mat A, Mat K)
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)A);
+  PetscMPIInt     size, rank;
+  const PetscInt *ur, *lr;
+  std::vector<PetscInt>    mapped;
+  std::vector<PetscScalar> vals;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(SAS_Build, 0, 0, 0, 0));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(MatGetOwnershipRanges(A, &ur));
+  PetscCall(MatGetOwnershipRanges(K, &lr));
+  auto mapU = [&](PetscInt j) { return j + lr[Owner(ur, size, j)]; };
+  for (PetscInt j = ur[rank]; j < ur[rank + 1]; ++j) {
+    PetscInt           nc;
+    const PetscInt    *cols;
+    const PetscScalar *v;
+    const PetscInt     row = mapU(j);
+    PetscCall(MatGetRow(A, j, &nc, &cols, &v));
+    mapped.resize(nc);
+    for (PetscInt k = 0; k < nc; ++k) mapped[k] = mapU(cols[k]);
+    PetscCall(MatSetValues(M_, 1, &row, nc, mapped.data(), v, INSERT_VALUES));
+    PetscCall(MatRestoreRow(A, j, &nc, &cols, &v));
+  }
+  for (PetscInt i = lr[rank]; i < lr[rank + 1]; ++i) {
+    PetscInt           nc;
+    const PetscInt    *cols;
+    const PetscScalar *v;
+    const PetscInt     row = i + ur[rank + 1];
+    const bool         on  = active_[i - lr[rank]] != 0;
+    PetscCall(MatGetRow(K, i, &nc, &cols, &v));
+    mapped.resize(nc);
+    vals.resize(nc);
+    for (PetscInt k = 0; k < nc; ++k) {
+      mapped[k] = mapU(cols[k]);
+      vals[k]   = on ? kScale_ * v[k] : 0.0;
+    }
+    PetscCall(MatSetValues(M_, 1, &row, nc, mapped.data(), vals.data(), INSERT_VALUES));
+    PetscCall(MatSetValues(M_, nc, mapped.data(), 1, &row, vals.data(), INSERT_VALUES));
+    PetscCall(MatRestoreRow(K, i, &nc, &cols, &v));
+    const PetscScalar dv = on ? 0.0 : -diagScale_;
+    PetscCall(MatSetValues(M_, 1, &row, 1, &row, &dv, INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(M_, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(M_, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscLogEventEnd(SAS_Build, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+// One step: factor and solve with the current set, then the next set from lambda and K u - g
+PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, Vec u, Vec lambda, SaddleInfo *info)
+{
+  MPI_Comm           comm = PetscObjectComm((PetscObject)A);
+  const PetscScalar *fa, *ga, *xa;
+  PetscScalar       *ba, *ua, *la;
+  KSPConvergedReason reason;
+  PetscLogDouble     t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(Fill(A, K));
+  PetscCall(VecGetArrayRead(f, &fa));
+  PetscCall(VecGetArrayRead(g, &ga));
+  PetscCall(VecGetArray(b_, &ba));
+  for (PetscInt j = 0; j < nu_; ++j) ba[j] = fa[j];
+  for (PetscInt i = 0; i < nl_; ++i) ba[nu_ + i] = active_[i] ? kScale_ * ga[i] : 0.0;
+  PetscCall(VecRestoreArray(b_, &ba));
+  PetscCall(VecRestoreArrayRead(g, &ga));
+  PetscCall(VecRestoreArrayRead(f, &fa));
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
+  bool     fresh = !(factored_ && canReuse_ && changedSinceFactor_ <= reuseMaxChanges);
+  PetscInt its   = 0;
+  bool stale = false; // the earlier factor cost more than a new one: factor at the next step
+  if (!fresh) { // the factor of an earlier matrix as GMRES's preconditioner
+    PetscLogDouble r0, r1;
+    PetscCall(PetscTime(&r0));
+    PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+    PetscCall(KSPSolve(ksp_, b_, x_));
+    PetscCall(KSPGetConvergedReason(ksp_, &reason));
+    PetscCall(KSPGetIterationNumber(ksp_, &its));
+    PetscCall(PetscTime(&r1));
+    info->krylov += its;
+    if (reason <= 0) fresh = true;
+    stale = r1 - r0 > freshSeconds_;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &stale, 1, MPI_CXX_BOOL, MPI_LOR, comm)); // the same decision on every rank
+  }
+  if (fresh) {
+    PetscLogDouble r0, r1;
+    PetscCall(PetscTime(&r0));
+    // a PCFIELDSPLIT set up on an earlier pattern does not rebuild its blocks correctly (measured: 480 FGMRES
+    // iterations instead of 60): a new KSP; a factorization handles the new pattern itself
+    if (fieldsplit_ && newPattern_) PetscCall(CreateKSP());
+    newPattern_ = false;
+    PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));
+    PetscCall(KSPSolve(ksp_, b_, x_));
+    PetscCall(KSPGetIterationNumber(ksp_, &its));
+    PetscCall(PetscTime(&r1));
+    info->krylov += its;
+    ++info->factorizations;
+    factored_           = true;
+    changedSinceFactor_ = 0;
+    freshSeconds_       = r1 - r0;
+  } else if (stale) factored_ = false;
+  PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
+  PetscCall(PetscTime(&t1));
+  PetscCall(KSPGetConvergedReason(ksp_, &reason));
+  PetscCheck(reason > 0, comm, PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve failed (%s) at active-set step %" PetscInt_FMT ": a failed factorization (-%spc_type, -%spc_factor_mat_solver_type; MUMPS workspace: -%smat_mumps_icntl_14) or the iterative solver's -%sksp_* settings",
+             KSPConvergedReasons[reason], info->steps + 1, prefix_.c_str(), prefix_.c_str(), prefix_.c_str(), prefix_.c_str());
+  PetscCall(VecGetArrayRead(x_, &xa));
+  PetscCall(VecGetArray(u, &ua));
+  PetscCall(VecGetArray(lambda, &la));
+  for (PetscInt j = 0; j < nu_; ++j) ua[j] = xa[j];
+  for (PetscInt i = 0; i < nl_; ++i) la[i] = active_[i] ? kScale_ * xa[nu_ + i] : 0.0;
+  PetscCall(VecRestoreArray(lambda, &la));
+  PetscCall(VecRestoreArray(u, &ua));
+  PetscCall(VecRestoreArrayRead(x_, &xa));
+  PetscReal nx;
+  PetscCall(VecNorm(x_, NORM_INFINITY, &nx));
+  PetscCheck(std::isfinite(nx), comm, PETSC_ERR_FP, "Contact saddle-point solve gave non-finite values at active-set step %" PetscInt_FMT " (-%spc_type)", info->steps + 1, prefix_.c_str());
+  // the penetration K u - g and its scale max(|K|_inf |u|_inf, |K u|_inf) + |g|_inf (the KKT check's)
+  Vec       pen;
+  PetscReal nK, nuinf, nKu, ng;
+  PetscCall(VecDuplicate(g, &pen));
+  PetscCall(MatMult(K, u, pen));
+  PetscCall(VecNorm(pen, NORM_INFINITY, &nKu));
+  PetscCall(VecAXPY(pen, -1.0, g));
+  PetscCall(MatNorm(K, NORM_INFINITY, &nK));
+  PetscCall(VecNorm(u, NORM_INFINITY, &nuinf));
+  PetscCall(VecNorm(g, NORM_INFINITY, &ng));
+  const PetscReal    scale = std::max(nK * nuinf, nKu) + ng;
+  const PetscScalar *pa, *lam;
+  PetscInt           changed = 0, nact = 0;
+  PetscCall(VecGetArrayRead(pen, &pa));
+  PetscCall(VecGetArrayRead(lambda, &lam));
+  for (PetscInt i = 0; i < nl_; ++i) {
+    const char next = active_[i] ? PetscRealPart(lam[i]) > 0 : PetscRealPart(pa[i]) > setTol * scale;
+    changed += next != active_[i];
+    nact += active_[i];
+    active_[i] = next;
+  }
+  PetscCall(VecRestoreArrayRead(lambda, &lam));
+  PetscCall(VecRestoreArrayRead(pen, &pa));
+  PetscCall(VecDestroy(&pen));
+  PetscInt c[2] = {changed, nact};
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, c, 2, MPIU_INT, MPI_SUM, comm));
+  info->changed = c[0];
+  info->nactive = c[1];
+  changedSinceFactor_ += c[0];
+  ++info->steps;
+  if (monitor) PetscCall(PetscPrintf(comm, "      saddle step %" PetscInt_FMT ": %" PetscInt_FMT " active rows, %" PetscInt_FMT " change, %s, %" PetscInt_FMT " Krylov its, %.3f s\n", info->steps, c[1], c[0], fresh ? "new factorization (preconditioner)" : "earlier one", its, (double)(t1 - t0)));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info)
+{
+  MPI_Comm              comm = PetscObjectComm((PetscObject)A);
+  PetscLogDouble        t0, t1;
+  std::vector<PetscInt> pat;
+  PetscInt              lo, hi;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  *info = SaddleInfo();
+  PetscCall(MatGetOwnershipRange(K, &lo, &hi));
+  PetscBool kept = warm && (PetscInt)active_.size() == hi - lo ? PETSC_TRUE : PETSC_FALSE;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &kept, 1, MPIU_BOOL, MPI_LAND, comm));
+  if (!kept) active_.assign(hi - lo, 0);
+  const bool toEnd = converge || inner || !kept;
+  // a new matrix (symbolic analysis) unless A and K's pattern are the last ones
+  PetscCall(Pattern(K, &pat));
+  PetscBool same = (M_ && A == lastA_ && pat == kPattern_) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPIU_BOOL, MPI_LAND, comm));
+  if (!same) {
+    PetscCall(Build(A, K));
+    kPattern_.swap(pat);
+    lastA_ = A;
+    info->symbolic = 1;
+  }
+  std::vector<std::vector<char>> seen; // the sets of this call's steps (a set that comes back on every rank is a cycle)
+  for (;;) {
+    seen.push_back(active_);
+    PetscCall(Step(A, f, K, g, u, lambda, info));
+    if (!info->changed || !toEnd) break;
+    std::vector<PetscMPIInt> back(seen.size());
+    for (size_t s = 0; s < seen.size(); ++s) back[s] = seen[s] == active_;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, back.data(), (int)back.size(), MPI_INT, MPI_LAND, comm));
+    PetscCheck(std::find(back.begin(), back.end(), 1) == back.end(), comm, PETSC_ERR_NOT_CONVERGED, "Contact active set cycles after %" PetscInt_FMT " steps (-%spdas_*: a set came back; %" PetscInt_FMT " rows change): raise -%spdas_tol", info->steps, prefix_.c_str(), info->changed, prefix_.c_str());
+    PetscCheck(info->steps < maxIt, comm, PETSC_ERR_NOT_CONVERGED, "Contact active set not settled in -%spdas_max_it %" PetscInt_FMT " steps (%" PetscInt_FMT " rows still change)", prefix_.c_str(), maxIt, info->changed);
+  }
+  PetscCall(PetscTime(&t1));
+  info->seconds = t1 - t0;
+  {
+    KSPType kt;
+    PCType  pt;
+    PC      pc;
+    PetscCall(KSPGetType(ksp_, &kt));
+    PetscCall(KSPGetPC(ksp_, &pc));
+    PetscCall(PCGetType(pc, &pt));
+    info->kspType = kt;
+    info->pcType  = pt;
+  }
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc
