@@ -14,6 +14,7 @@
 // always on a cold start), or one step per Kacanov iterate (the default: the active set and the geometry
 // converge together; the loop stops only on an unchanged set, SetChanged()).
 // Options (prefix fom_saddle_): -pdas_max_it (100), -pdas_tol (1e-10), -pdas_inner, -pdas_monitor,
+// -pdas_rtol_loose (1e-4: the solves of a cold start while the set changes; its last set is solved again exactly),
 // -reuse_max_changes (10), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
 // fieldsplit with GAMG on the u block and LU on the selfp Schur complement), -ksp_* / -pc_* of the solver
 // (the u and lambda blocks are the fields "u" and "lambda" of a PCFIELDSPLIT).
@@ -59,6 +60,7 @@ public:
 
   PetscInt  maxIt   = 100;
   PetscReal setTol  = 1e-10;
+  PetscReal looseRtol = 1e-4; // -pdas_rtol_loose
   PetscBool inner   = PETSC_FALSE; // -pdas_inner: to convergence on every Kacanov iterate
   PetscBool monitor = PETSC_FALSE;
   PetscInt  reuseMaxChanges = 10; // -reuse_max_changes
@@ -68,7 +70,7 @@ private:
   PetscErrorCode Build(Mat A, Mat K);
   PetscErrorCode CreateKSP();
   PetscErrorCode Fill(Mat A, Mat K);
-  PetscErrorCode Step(Mat A, Vec f, Mat K, Vec g, Vec u, Vec lambda, SaddleInfo *info);
+  PetscErrorCode Step(Mat A, Vec f, Mat K, Vec g, PetscReal rtol, Vec u, Vec lambda, SaddleInfo *info);
   std::string            prefix_;
   KSP                    ksp_ = nullptr;
   Mat                    M_   = nullptr; // the saddle-point matrix
@@ -83,6 +85,7 @@ private:
   PetscBool              fieldsplit_ = PETSC_FALSE;
   PetscInt               changedSinceFactor_ = 0; // rows whose status changed since the last factorization
   PetscReal              freshSeconds_ = 0;       // wall time of the last solve with a new factorization
+  PetscReal              exactRtol_ = 1e-12;      // the KSP's rtol after its options (-fom_saddle_ksp_rtol)
 };
 
 } // namespace rbc

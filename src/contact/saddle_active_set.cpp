@@ -45,6 +45,7 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     PetscCall(PetscOptionsEList("-solver", "Preset of the solver: direct (MUMPS LDL^T) or gamg (FGMRES + Schur-complement fieldsplit, GAMG on u: memory linear in the dofs); -fom_saddle_ksp_*/-pc_* refine either", "docs/contact.md", types, 2, types[t], &t, NULL));
     solver = types[t];
   }
+  PetscCall(PetscOptionsReal("-pdas_rtol_loose", "Relative tolerance of the solves while the set still changes on a cold start (the last set is solved to -fom_saddle_ksp_rtol)", "docs/contact.md", looseRtol, &looseRtol, NULL));
   PetscCall(PetscOptionsInt("-reuse_max_changes", "Solve with the last factorization (GMRES) while at most this many rows changed status since it (-1: factor every step)", "docs/contact.md", reuseMaxChanges, &reuseMaxChanges, NULL));
   PetscOptionsEnd();
   if (solver == "gamg") { // defaults of the preset; options given on the command line win
@@ -120,6 +121,7 @@ PetscErrorCode SaddleActiveSetSolver::CreateKSP()
   PetscCall(PCSetType(pc, PCCHOLESKY));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(KSPSetFromOptions(ksp_));
+  PetscCall(KSPGetTolerances(ksp_, &exactRtol_, NULL, NULL, NULL));
   PetscBool pre;
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp_, KSPPREONLY, &pre));
   canReuse_   = !pre; // preonly cannot tell a stale factor from a fresh one
@@ -275,7 +277,7 @@ PetscErrorCode SaddleActiveSetSolver::Fill(Mat A, Mat K)
 }
 
 // One step: factor and solve with the current set, then the next set from lambda and K u - g
-PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, Vec u, Vec lambda, SaddleInfo *info)
+PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal rtol, Vec u, Vec lambda, SaddleInfo *info)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)A);
   const PetscScalar *fa, *ga, *xa;
@@ -296,6 +298,8 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, Vec u, Ve
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
   bool     fresh = !(factored_ && canReuse_ && changedSinceFactor_ <= reuseMaxChanges);
+  PetscCall(KSPSetTolerances(ksp_, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  const PetscReal addTol = std::max(setTol, rtol > exactRtol_ ? rtol : 0.0); // a loose solve: a loose threshold for adding rows
   PetscInt its   = 0;
   bool stale = false; // the earlier factor cost more than a new one: factor at the next step
   if (!fresh) { // the factor of an earlier matrix as GMRES's preconditioner
@@ -360,7 +364,7 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, Vec u, Ve
   PetscCall(VecGetArrayRead(pen, &pa));
   PetscCall(VecGetArrayRead(lambda, &lam));
   for (PetscInt i = 0; i < nl_; ++i) {
-    const char next = active_[i] ? PetscRealPart(lam[i]) > 0 : PetscRealPart(pa[i]) > setTol * scale;
+    const char next = active_[i] ? PetscRealPart(lam[i]) > 0 : PetscRealPart(pa[i]) > addTol * scale;
     changed += next != active_[i];
     nact += active_[i];
     active_[i] = next;
@@ -404,9 +408,15 @@ PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBoo
     info->symbolic = 1;
   }
   std::vector<std::vector<char>> seen; // the sets of this call's steps (a set that comes back on every rank is a cycle)
+  bool loose = toEnd && canReuse_ && looseRtol > exactRtol_; // loose solves while the set changes, then the last set exactly
   for (;;) {
     seen.push_back(active_);
-    PetscCall(Step(A, f, K, g, u, lambda, info));
+    PetscCall(Step(A, f, K, g, loose ? looseRtol : exactRtol_, u, lambda, info));
+    if (!info->changed && loose) { // the set settled under loose solves: the same set once more, exactly
+      loose = false;
+      seen.clear();
+      continue;
+    }
     if (!info->changed || !toEnd) break;
     std::vector<PetscMPIInt> back(seen.size());
     for (size_t s = 0; s < seen.size(); ++s) back[s] = seen[s] == active_;
