@@ -80,6 +80,24 @@ static PetscMPIInt Owner(const PetscInt *r, PetscMPIInt size, PetscInt j)
   return (PetscMPIInt)(std::upper_bound(r, r + size + 1, j) - r - 1);
 }
 
+// The saddle point's numbering: each rank's u rows (A's ownership range), then its lambda rows (K's)
+struct SaddleLayout {
+  PetscMPIInt     size = 0, rank = 0;
+  const PetscInt *ur = nullptr, *lr = nullptr; // ownership ranges of u and lambda (size + 1 entries)
+  PetscErrorCode  Init(Mat A, Mat K)
+  {
+    MPI_Comm comm = PetscObjectComm((PetscObject)A);
+    PetscFunctionBeginUser;
+    PetscCallMPI(MPI_Comm_size(comm, &size));
+    PetscCallMPI(MPI_Comm_rank(comm, &rank));
+    PetscCall(MatGetOwnershipRanges(A, &ur));
+    PetscCall(MatGetOwnershipRanges(K, &lr));
+    PetscFunctionReturn(0);
+  }
+  PetscInt U(PetscInt j) const { return j + lr[Owner(ur, size, j)]; }     // the row of u dof j
+  PetscInt L(PetscInt i) const { return i + ur[Owner(lr, size, i) + 1]; } // the row of multiplier i
+};
+
 // K's local pattern (row lengths, then the columns), to tell whether the last matrix's pattern still fits
 static PetscErrorCode Pattern(Mat K, std::vector<PetscInt> *p)
 {
@@ -148,22 +166,19 @@ PetscErrorCode SaddleActiveSetSolver::CreateKSP()
 // preallocated exactly, and its KSP.
 PetscErrorCode SaddleActiveSetSolver::Build(Mat A, Mat K)
 {
-  MPI_Comm        comm = PetscObjectComm((PetscObject)A);
-  PetscMPIInt     size, rank;
-  const PetscInt *ur, *lr;
-  Mat             Kt;
+  MPI_Comm     comm = PetscObjectComm((PetscObject)A);
+  SaddleLayout lay;
+  Mat          Kt;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(SAS_Build, 0, 0, 0, 0));
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(MatGetOwnershipRanges(A, &ur));
-  PetscCall(MatGetOwnershipRanges(K, &lr));
+  PetscCall(lay.Init(A, K));
+  const PetscInt *ur = lay.ur, *lr = lay.lr, rank = lay.rank;
   nu_ = ur[rank + 1] - ur[rank];
   nl_ = lr[rank + 1] - lr[rank];
   const PetscInt start = ur[rank] + lr[rank], n = nu_ + nl_;
-  auto mapU = [&](PetscInt j) { return j + lr[Owner(ur, size, j)]; };
-  auto mapL = [&](PetscInt i) { return i + ur[Owner(lr, size, i) + 1]; };
+  auto mapU = [&](PetscInt j) { return lay.U(j); };
+  auto mapL = [&](PetscInt i) { return lay.L(i); };
   auto local = [&](PetscInt c) { return c >= start && c < start + n; };
   PetscCall(MatTranspose(K, MAT_INITIAL_MATRIX, &Kt));
   std::vector<PetscInt> dnz(n, 0), onz(n, 0);
@@ -227,19 +242,15 @@ PetscErrorCode SaddleActiveSetSolver::Build(Mat A, Mat K)
 // rows' diagonal. Every entry of the pattern is written, so no zeroing is needed.
 PetscErrorCode SaddleActiveSetSolver::Fill(Mat A, Mat K)
 {
-  MPI_Comm        comm = PetscObjectComm((PetscObject)A);
-  PetscMPIInt     size, rank;
-  const PetscInt *ur, *lr;
+  SaddleLayout             lay;
   std::vector<PetscInt>    mapped;
   std::vector<PetscScalar> vals;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(SAS_Build, 0, 0, 0, 0));
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(MatGetOwnershipRanges(A, &ur));
-  PetscCall(MatGetOwnershipRanges(K, &lr));
-  auto mapU = [&](PetscInt j) { return j + lr[Owner(ur, size, j)]; };
+  PetscCall(lay.Init(A, K));
+  const PetscInt *ur = lay.ur, *lr = lay.lr, rank = lay.rank;
+  auto mapU = [&](PetscInt j) { return lay.U(j); };
   for (PetscInt j = ur[rank]; j < ur[rank + 1]; ++j) {
     PetscInt           nc;
     const PetscInt    *cols;
