@@ -1,7 +1,8 @@
 // rbcontact/kacanov.hpp: the contact full-order solve. KacanovSolver runs the fixed-point iterations of
 // the seed: iterate k solves the QP  min 1/2 v'Av - f'v  s.t.  K(u^{k-1}) v <= g(u^{k-1})  through its
 // dual  min_{lambda >= 0} 1/2 lambda'S lambda - lambda'(K u0 - g),  S = K A^{-1} K^T, u0 = A^{-1} f,
-// with A factored once (ElasticFOM) and reused for every back-solve; then u = u0 - A^{-1} K^T lambda.
+// with A factored once (ElasticFOM) and reused for every back-solve; then u = u0 - A^{-1} K^T lambda
+// (dense and shell); or on the sparse saddle point with no factorization of A alone (saddle).
 // Stops on the relative changes of u and lambda; non-convergence is an error with the history.
 // Options: -kacanov_max_it, -kacanov_rtol_primal, -kacanov_rtol_dual, -kacanov_relaxation,
 // -kacanov_monitor, -kacanov_type fixed_point|newton (kacanov_newton.cpp); the dual QP takes the fom_qp_ prefix (-fom_qp_tao_type, its

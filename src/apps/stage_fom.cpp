@@ -65,7 +65,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     PetscCall(SummarizeContact(kacanov.sys, kacanov.lambda, fom.elas.dim, &cs));
     rep.root["converged"]          = (bool)kacanov.converged;
     rep.root["kacanov_iterations"] = (long long)kacanov.iterations;
-    rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense or shell (-fom_dual_matrix)
+    rep.root["dual_matrix"]        = kacanov.dualMatrix; // dense, shell or saddle (-fom_dual_matrix)
     if (kacanov.dualMatrix == "dense") rep.root["compliance"] = kacanov.compliance.method; // how G = (A^-1)_DD was computed (-contact_compliance)
     if (kacanov.dualMatrix == "saddle") { // the saddle-point solve (-fom_saddle_*): its solver and totals over the iterates
       JsonValue &sd = rep.root["saddle"];
