@@ -76,7 +76,8 @@ private:
   Mat                    M_   = nullptr; // the saddle-point matrix
   MatNullSpace           nearNull_ = nullptr;
   Vec                    x_ = nullptr, b_ = nullptr;
-  Mat                    lastA_ = nullptr; // the A M_ was built for (pattern check)
+  Mat                    lastA_ = nullptr; // the A M_ was built for, and its nonzero state (pattern check)
+  PetscObjectState       lastANonzero_ = -1;
   std::vector<PetscInt>  kPattern_;        // K's local rows: row lengths then columns (pattern check)
   std::vector<char>      active_;          // the set, on this rank's rows of K
   PetscReal              diagScale_ = 1, kScale_ = 1; // s, c (Build)

@@ -409,13 +409,16 @@ PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBoo
   if (!kept) active_.assign(hi - lo, 0);
   const bool toEnd = converge || inner || !kept;
   // a new matrix (symbolic analysis) unless A and K's pattern are the last ones
+  PetscObjectState anz;
   PetscCall(Pattern(K, &pat));
-  PetscBool same = (M_ && A == lastA_ && pat == kPattern_) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(MatGetNonzeroState(A, &anz));
+  PetscBool same = (M_ && A == lastA_ && anz == lastANonzero_ && pat == kPattern_) ? PETSC_TRUE : PETSC_FALSE;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPIU_BOOL, MPI_LAND, comm));
   if (!same) {
     PetscCall(Build(A, K));
     kPattern_.swap(pat);
-    lastA_ = A;
+    lastA_         = A;
+    lastANonzero_  = anz;
     info->symbolic = 1;
   }
   std::vector<std::vector<char>> seen; // the sets of this call's steps (a set that comes back on every rank is a cycle)
