@@ -18,27 +18,17 @@ Usage: /usr/bin/python3 share/plot_bodies3d.py results/hertz3d/fom.h5 -o bodies.
 Run it with Debian's /usr/bin/python3 (python3-matplotlib, python3-h5py, python3-numpy).
 """
 import argparse
-import sys
 
 
-def fail(msg):
-    sys.stderr.write("plot_bodies3d.py: error: %s\n" % msg)
-    sys.exit(1)
+from plot_common import fail, require_plotting
 
-
-try:
-    import numpy as np
-    import h5py
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib import cm, colors
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-    from matplotlib.tri import Triangulation
-except ImportError as e:  # pragma: no cover
-    fail("%s (interpreter %s). Run with /usr/bin/python3 after share/setup.sh "
-         "(python3-numpy python3-h5py python3-matplotlib)" % (e, sys.executable))
+require_plotting()
+import numpy as np
+import h5py
+import matplotlib.pyplot as plt
+from matplotlib import cm, colors
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from matplotlib.tri import Triangulation
 
 
 def read(path):

@@ -26,21 +26,12 @@ import os
 import sys
 
 
-def fail(msg):
-    sys.stderr.write("plot_contact.py: error: %s\n" % msg)
-    sys.exit(1)
+from plot_common import fail, require_plotting
 
-
-try:
-    import numpy as np
-    import h5py
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError as e:  # pragma: no cover
-    fail("%s (interpreter %s). Run with /usr/bin/python3 after share/setup.sh "
-         "(python3-numpy python3-h5py python3-matplotlib)" % (e, sys.executable))
+require_plotting()
+import numpy as np
+import h5py
+import matplotlib.pyplot as plt
 
 
 def read_contact(path, coord):

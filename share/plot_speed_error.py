@@ -28,22 +28,14 @@ import os
 import sys
 
 
-def fail(msg):
-    sys.stderr.write("plot_speed_error.py: error: %s\n" % msg)
-    sys.exit(1)
+from plot_common import fail, require_plotting
 
-
-try:
-    import numpy as np
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.transforms as mtransforms
-    import matplotlib.ticker as mticker
-except ImportError as e:  # pragma: no cover
-    fail("%s (interpreter %s). Run with /usr/bin/python3 after share/setup.sh "
-         "(python3-numpy python3-matplotlib)" % (e, sys.executable))
+require_plotting(h5py=False)
+import numpy as np
+import matplotlib
+import matplotlib.pyplot as plt
+import matplotlib.transforms as mtransforms
+import matplotlib.ticker as mticker
 
 SIZES = ("N", "R", "Mk", "Mg")
 VALUES = ("online_median_s", "max_rel_err_u", "max_rel_err_lambda")
