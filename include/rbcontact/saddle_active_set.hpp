@@ -53,8 +53,10 @@ public:
   PetscErrorCode Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info);
   // Forget the set and the factorization.
   PetscErrorCode Reset();
-  // The rigid-body modes of A (for a PCFIELDSPLIT's GAMG on the u block; kept by reference).
+  // The rigid-body modes of A (for a PCFIELDSPLIT's GAMG on the u block; kept by reference), wanted only when
+  // the options ask for a PCFIELDSPLIT (-fom_saddle_solver gamg or -fom_saddle_pc_type fieldsplit).
   PetscErrorCode SetNearNullSpace(MatNullSpace nsp);
+  bool WantsNearNullSpace() const { return wantsNearNull_; }
   // A has new values (a new parameter): the next step factors afresh (the set is kept as a start).
   void NewOperator() { factored_ = false; }
 
@@ -75,6 +77,7 @@ private:
   KSP                    ksp_ = nullptr;
   Mat                    M_   = nullptr; // the saddle-point matrix
   MatNullSpace           nearNull_ = nullptr;
+  bool                   wantsNearNull_ = false;
   Vec                    x_ = nullptr, b_ = nullptr;
   Mat                    lastA_ = nullptr; // the A M_ was built for, and its nonzero state (pattern check)
   PetscObjectState       lastANonzero_ = -1;

@@ -317,10 +317,10 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscCall(PetscTime(&t0));
   std::vector<PetscReal> u0D;
   dualMatrix = mode;
-  if (saddle) {
+  if (saddle) saddle_.NewOperator();
+  if (saddle && saddle_.WantsNearNullSpace()) { // for GAMG on a PCFIELDSPLIT's u block
     MatNullSpace nsp;
-    saddle_.NewOperator();
-    PetscCall(fom.elas.NearNullSpace(&nsp)); // used only by a PCFIELDSPLIT's u block (GAMG)
+    PetscCall(fom.elas.NearNullSpace(&nsp));
     PetscCall(saddle_.SetNearNullSpace(nsp));
     PetscCall(MatNullSpaceDestroy(&nsp));
   }

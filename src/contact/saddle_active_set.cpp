@@ -60,6 +60,12 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
       if (!given) PetscCall(PetscOptionsSetValue(NULL, name.c_str(), kv[1]));
     }
   }
+  {
+    char      pc[64] = "";
+    PetscBool set    = PETSC_FALSE;
+    PetscCall(PetscOptionsGetString(NULL, prefix_.c_str(), "-pc_type", pc, sizeof pc, &set));
+    wantsNearNull_ = set && std::string(pc) == PCFIELDSPLIT;
+  }
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
   PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
   PetscFunctionReturn(0);
