@@ -81,6 +81,8 @@ struct Solution {
   PetscInt            iterations = 0;
   double              contactForce = std::numeric_limits<double>::quiet_NaN();
   double              maxPressure = std::numeric_limits<double>::quiet_NaN(), halfwidth = std::numeric_limits<double>::quiet_NaN(), contactLength = std::numeric_limits<double>::quiet_NaN();
+  // the online error estimate (docs/error_estimate.md): estimated relative errors, nan when the ROM file has none
+  double              estU = std::numeric_limits<double>::quiet_NaN(), estLambda = std::numeric_limits<double>::quiet_NaN(), estForce = std::numeric_limits<double>::quiet_NaN();
   std::string         message;
 };
 
@@ -133,6 +135,11 @@ public:
       s.maxPressure   = so.maxPressure;
       s.halfwidth     = so.halfwidth;
       s.contactLength = so.contactLength;
+      if (sol.estimate.available) {
+        s.estU      = sol.estimate.u;
+        s.estLambda = sol.estimate.lambda;
+        s.estForce  = sol.estimate.force;
+      }
     }
     s.message = sol.message;
     return s;
@@ -242,6 +249,9 @@ PYBIND11_MODULE(_rbcontact, m)
     .def_readonly("max_pressure", &Solution::maxPressure, "max nodal contact pressure (the FOM report's max_pressure; nan without the ROM file's surface data)")
     .def_readonly("contact_halfwidth", &Solution::halfwidth, "2D: the moment half-width of the pressure (the FOM report's contact_halfwidth_moment)")
     .def_readonly("contact_length", &Solution::contactLength, "2D: twice the half-width")
+    .def_readonly("error_u", &Solution::estU, "estimated relative error of u in the energy norm (nan: the ROM file has no error estimate, offline -estimate)")
+    .def_readonly("error_lambda", &Solution::estLambda, "estimated relative error of the multipliers (slave-mass weighted l2)")
+    .def_readonly("error_force", &Solution::estForce, "estimated relative error of the contact force")
     .def_readonly("converged", &Solution::converged)
     .def_readonly("iterations", &Solution::iterations, "reduced Kacanov iterations")
     .def_readonly("message", &Solution::message, "why the solve failed (empty on success)")

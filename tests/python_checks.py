@@ -4,6 +4,7 @@
   - 100 radii through ReducedModel.contact_forces: every force equals the `rbcontact online` report's
     outputs.contact_force at 5 of them (the same code: relative difference <= 1e-12), and the FOM's at one
     radius to 1e-3 (an independent reference);
+  - solve(): error_u, error_lambda, error_force (nan without offline -estimate, the online report's with it);
   - solve(): converged, reduced coordinates of the report's sizes, force vector whose norm is contact_force;
   - bad input raises RuntimeError naming the cause: a missing ROM file (its path), a radius outside the box
     (the parameter), an array of the wrong shape; nan_on_failure keeps going past no failure here;
@@ -52,6 +53,9 @@ def main():
     try:
         rom = os.path.join(d, "rom.h5")
         run(args.exe, 2, ["offline", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-report", d + "/off.json"])
+        # (mpiexec before the first model initializes MPI in this process)
+        rome = os.path.join(d, "rom_e.h5")
+        run(args.exe, 2, ["offline", "-options_file", "runs/ring_on_block.opts", "-rom", rome, "-estimate", "-report", d + "/off_e.json"])
         m = rbcontact.ReducedModel(rom)
         (name, lo, hi), = m.parameters
         check(name == "radius" and abs(lo - 0.95) < 1e-14 and abs(hi - 1.15) < 1e-14, "parameter box from the file: %s in [%g, %g]" % (name, lo, hi))
@@ -80,6 +84,13 @@ def main():
         check(abs(s.max_pressure - pm) <= 1e-2 * pm and abs(s.contact_halfwidth - hw) <= 1e-2 * hw and s.contact_length == 2 * s.contact_halfwidth,
               "max pressure %.6f and half-width %.6f vs the FOM's %.6f, %.6f (rel %.1e, %.1e <= 1e-2)" % (s.max_pressure, s.contact_halfwidth, pm, hw, abs(s.max_pressure - pm) / pm, abs(s.contact_halfwidth - hw) / hw))
         check(np.array_equal(m.contact_forces(np.array([[r]])), np.array([s.contact_force])), "contact_forces on an (n, 1) array = solve")
+        # the online error estimate (docs/error_estimate.md): nan without it in the file, the online report's with it
+        check(np.isnan(s.error_u) and np.isnan(s.error_lambda) and np.isnan(s.error_force), "a ROM without -estimate: error_u, error_lambda, error_force are nan")
+        se = rbcontact.ReducedModel(rome).solve([r])
+        run(args.exe, 1, ["online", "-rom", rome, "-mu", repr(r), "-report", d + "/on_e.json"])
+        ee = json.load(open(d + "/on_e.json"))["error_estimate"]
+        check(ee["available"] and all(abs(getattr(se, "error_" + k) - ee[k]) <= 1e-12 * ee[k] for k in ("u", "lambda", "force")),
+              "offline -estimate: solve() gives the online report's error estimate (u %.2e, lambda %.2e, force %.2e)" % (se.error_u, se.error_lambda, se.error_force))
 
         def raises(f, words, what):
             try:

@@ -12,6 +12,10 @@
   eim_train   extra EIM training radii (no FOM solves) shrink the EIM's share of the error.
   half_disks  two parameters (radius, imposed displacement): the whole pipeline runs, the ROM converges
               and its errors are reported.
+  estimate    offline -estimate (docs/error_estimate.md): the enrichment and calibration in the ROM file, the same on
+              1 and 2 ranks; online reports the estimate (and why not with -rom_error_estimate false or without an
+              enrichment); its raw changes against a separate solve with every stored basis function; validate's
+              effectivities on 20 random radii.
 """
 import argparse
 import json
@@ -426,6 +430,76 @@ def residual(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def estimate(args):
+    """offline -estimate: enrichment, calibration, the online estimate and its effectivity (docs/error_estimate.md)."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_est_")
+    roms, offs = {}, {}
+    for np_ in (1, 2):
+        os.makedirs("%s/%d" % (d, np_))
+        roms[np_], offs[np_] = offline(args, "%s/%d" % (d, np_), np_=np_, extra=["-estimate"])
+    o, rom = offs[2], roms[2]
+    ro, e = o["rom"], o["estimate"]
+    print("  stored N %d R %d, in use N %d R %d, Mc %d; calibration scale %s floor %s" % (ro["N"], ro["R"], ro["N_in_use"], ro["R_in_use"], ro["Mc"], e["scale"], e["floor"]))
+    check(ro["estimate_enrichment"] and ro["R_in_use"] < ro["R"] and ro["N_in_use"] < ro["N"], "the ROM stores more basis functions than the answer uses")
+    ds = datasets(rom)
+    check(ds.get("online/estimate/default_sizes") == (2,) and ds.get("online/estimate/calibration") == (2, 3) and ds.get("online/estimate/mass_gram") == (ro["R"], ro["R"]),
+          "/online/estimate holds the answer's sizes, the calibration (2 x 3) and the mass Gram matrix (R x R)")
+    check(e["calibration_points"] == 20 and min(e["calibration_min_effectivity"]) >= e["safety"] * (1 - 1e-9),
+          "the calibration covers its 20 points with the safety factor (min effectivity %s)" % e["calibration_min_effectivity"])
+    with h5py.File(roms[1], "r") as f1, h5py.File(roms[2], "r") as f2:
+        c1, c2 = np.array(f1["online/estimate/calibration"]), np.array(f2["online/estimate/calibration"])
+        same_sizes = np.array_equal(np.array(f1["online/estimate/default_sizes"]), np.array(f2["online/estimate/default_sizes"]))
+    dc = float(np.max(np.abs(c1 - c2) / np.maximum(np.abs(c2), 1e-300)))
+    check(same_sizes and dc <= 0.05, "1 and 2 ranks: the same answer sizes and calibration to %.1e (<= 5 %%: FOM solver tolerance, scale grid)" % dc)
+    # online: the estimate, and its raw changes against a separate solve with every stored basis function at the reference radius
+    # (A(1.0) = X: the basis is X-orthonormal, so energy norms are Euclidean norms of the coordinates); tight Kacanov tolerances
+    tight = ["-rom_kacanov_rtol_primal", "1e-13", "-rom_kacanov_rtol_dual", "1e-13"]
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.0", "-report", d + "/on.json"] + tight)
+    on = report(d + "/on.json")
+    ee = on["error_estimate"]
+    check(ee["available"] and all(np.isfinite(ee[k]) and ee[k] > 0 for k in ("u", "lambda", "force")) and on["rom"]["N"] == ro["N_in_use"] and on["rom"]["R"] == ro["R_in_use"],
+          "online: the answer's sizes and a positive error estimate u %.2e lambda %.2e force %.2e" % (ee.get("u", 0), ee.get("lambda", 0), ee.get("force", 0)))
+    with h5py.File(rom, "r") as f:
+        npod, rfull = int(f["online/sizes"][2]), int(f["online/sizes"][4])
+        G = np.array(f["online/estimate/mass_gram"])
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.0", "-rom_N", str(npod), "-rom_R", str(rfull), "-report", d + "/full.json"] + tight)
+    full = report(d + "/full.json")
+    check(not full["error_estimate"]["available"] and "no enrichment" in full["error_estimate"]["why"], "online with every stored basis function: no estimate, and why")
+    va, vf = np.array(on["u_hat"]), np.array(full["u_hat"])
+    la, lf = np.zeros(rfull), np.array(full["lambda_hat"])
+    la[:len(on["lambda_hat"])] = on["lambda_hat"]
+    nA, rA = ro["N_in_use"], ro["R_in_use"]
+    pad = np.zeros(len(vf))  # the answer's columns: its POD modes, then the supremizers of its dual vectors
+    npodA = nA - min(rA, len(vf) - npod)
+    pad[:npodA] = va[:npodA]
+    pad[npod:npod + nA - npodA] = va[npodA:]
+    du = np.linalg.norm(vf - pad) / np.linalg.norm(vf)
+    dl = np.sqrt((lf - la) @ G @ (lf - la) / (lf @ G @ lf))
+    ru, rl = ee["raw"]["u"], ee["raw"]["lambda"]
+    print("  raw changes u %.3e lambda %.3e; full solve differs by u %.3e lambda %.3e (orthonormality error %.1e)" % (ru, rl, du, dl, o["pod"]["orthonormality_error"]))
+    check(abs(ru - du) <= 0.1 * du and abs(rl - dl) <= 0.1 * dl, "the raw changes are the difference to the solve with every basis function (within 10 %: frozen vs converged geometry)")
+    # bad input: a tampered calibration or answer size, an enrichment tolerance looser than the answer's
+    for name, value, words in (("online/estimate/calibration", -1.0, ["/online/estimate/calibration"]), ("online/estimate/default_sizes", 99.0, ["/online/estimate/default_sizes"])):
+        shutil.copy(rom, d + "/tamper.h5")
+        with h5py.File(d + "/tamper.h5", "a") as f:
+            x = np.array(f[name])
+            x.flat[0] = value
+            f[name][...] = x
+        expect_error(args, ["-rom", d + "/tamper.h5", "-mu", "1.0"], ["tamper.h5"] + words, "a ROM file with a bad %s" % name)
+    p = run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-rom", d + "/bad.h5", "-estimate", "-estimate_dual_tol", "1"], expect_ok=False)
+    check(p.returncode != 0 and "-estimate_dual_tol" in p.stdout, "offline -estimate_dual_tol above -dual_tol: an error naming the option")
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.0", "-rom_error_estimate", "false", "-report", d + "/off_est.json"])
+    check(not report(d + "/off_est.json")["error_estimate"]["available"], "-rom_error_estimate false: no estimate")
+    # validate: the effectivities on 20 random radii (the issue's measure on 100: bench/error_estimate.py)
+    run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "2", "-report", d + "/val.json"])
+    v = report(d + "/val.json")
+    for k in ("u", "lambda"):
+        b = v["estimate"][k]
+        print("  %s: effectivity %.2f..%.2f, >= 1 on %.0f %%, within [1, 20] on %.0f %%" % (k, b["min_effectivity"], b["max_effectivity"], 100 * b["share_above_1"], 100 * b["share_within_20"]))
+        check(b["share_above_1"] >= 0.95 and b["share_within_20"] >= 0.9, "%s: the estimate >= the error on >= 95 %% of the radii, within 20x on >= 90 %%" % k)
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def files(args):
     """Files that belong together are checked together: the ROM against the scene as configured now
     (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
@@ -484,7 +558,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -35,3 +35,8 @@ set_property(TEST test_dense_kernels_portable_np1 APPEND PROPERTY ENVIRONMENT RB
 #                          surfaces, the penetration of 1.2 u; GreedyPick's order and separation
 rbc_test_exe(test_greedy_indicator)
 rbc_add_mpi_test(NAME test_greedy_indicator RANKS 1 2 TIMEOUT 120 COMMAND $<TARGET_FILE:test_greedy_indicator> -options_file runs/ring_on_block.opts LABELS rom)
+#   test_error_estimate    the calibration of the online error estimate (CalibrateEstimate): proportional data give
+#                          their factor, uninformative data the floor, every point covered, the best scale of a
+#                          brute-force search
+rbc_test_exe(test_error_estimate)
+rbc_add_mpi_test(NAME test_error_estimate RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_error_estimate> LABELS rom)

@@ -51,6 +51,9 @@ const char    *PODInnerName(PODInner inner);
 //   -pod_view                 prints a summary on the snapshots' communicator
 // Collective on the snapshots' communicator. Replaces any previous content of *res.
 PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res);
+// The N that -pod_tol tol would have chosen from res's singular values (smallest N with the energy left out
+// <= tol, within [1, rank]): the answer's size inside a POD computed to a smaller tolerance (offline -estimate).
+PetscInt PODSizeForTolerance(const PODResult &res, PetscReal tol);
 
 // M-norm projection error of each snapshot onto span(modes): ||x - V V^T M x||_M, M the modes' BV
 // matrix (l2 if none). sum_j err_j^2 = sum_{i >= N} s_i^2 (the left-out energy).

@@ -49,6 +49,19 @@ private:
   std::shared_ptr<Elasticity> light_;
 };
 
+// The online error estimate of one reduced solution (docs/error_estimate.md): the change of the answer when
+// the last Kacanov iterate's reduced QP is solved again in the enriched spaces the ROM file stores (all its
+// POD modes, dual vectors and supremizers; the answer uses the leading NDefault / RDefault of them), at the
+// same contact geometry and cubature points, calibrated offline (scale * change + floor). Relative errors
+// in the norms validate reports: u in the energy norm of A(mu), lambda in the slave-mass weighted l2 norm,
+// the resultant contact force in the Euclidean norm.
+struct ErrorEstimate {
+  bool        available = false;
+  PetscReal   u = 0, lambda = 0, force = 0;          // calibrated estimates
+  PetscReal   uRaw = 0, lambdaRaw = 0, forceRaw = 0; // the enriched-space changes themselves
+  std::string why;                                   // why there is none (available = false)
+};
+
 struct ReducedSolution {
   std::vector<PetscReal> v, lambda; // reduced coordinates: u ~ sum_n v_n theta_n, lambda ~ sum_r lambda_r xi_r
   PetscInt               iterations = 0;
@@ -64,6 +77,7 @@ struct ReducedSolution {
   // last Kacanov iterate: no mesh. Empty with the EIM (which interpolates K^ and g^, not the normals) and
   // when the solve failed. docs/online.md, "Outputs of interest".
   std::vector<PetscReal> force;
+  ErrorEstimate          estimate; // with ReducedModel::errorEstimate and a ROM file that stores an enrichment
   PetscReal ForceMagnitude() const
   {
     PetscReal s = 0;
@@ -81,10 +95,12 @@ public:
   // Reads a ROM file (any rank; no collective call). Errors name the file and the dataset.
   PetscErrorCode Open(const std::string &file);
   // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation),
-  // -rom_hyper eim|ecsw (the hyper-reduction among those stored; default: the offline stage's first choice).
+  // -rom_hyper eim|ecsw (the hyper-reduction among those stored; default: the offline stage's first choice),
+  // -rom_error_estimate <bool> (default true: every solve estimates its error when the file allows it).
   PetscErrorCode SetFromOptions();
   // Uses the leading n POD modes (and the supremizers of the leading r dual vectors), r dual vectors,
-  // mk and mg EIM terms (-1: all for n and r, MkDefault/MgDefault for mk and mg). Rebuilds the active operators.
+  // mk and mg EIM terms (-1: NDefault/RDefault, i.e. all without an enrichment, for n and r; MkDefault/MgDefault
+  // for mk and mg). Rebuilds the active operators.
   PetscErrorCode Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg);
   // The reduced solution at mu (inside the box). Never throws on a numerical failure: converged =
   // false and message set (the stages turn that into an error); PETSc errors only for bad input.
@@ -125,6 +141,13 @@ public:
   bool                   kappaConst = false, gapConst = false;
   PetscInt               MkFull = 0, MgFull = 0;
   PetscInt               MkDefault = -1, MgDefault = -1; // sizes used unless -rom_Mk/-rom_Mg (-1: all; chosen offline on held-out parameters, eim_selection.hpp)
+  PetscInt               NDefault = -1, RDefault = -1;   // POD modes and dual vectors of the answer unless -rom_N/-rom_R (-1: all); fewer
+                                                         // than stored: the rest is the error estimate's enrichment (/online/estimate)
+  std::vector<PetscReal> massGram;                       // W' M W (Rfull x Rfull, M the reference slave mass): the estimate's lambda norm
+  PetscReal              estimateScale[3] = {1, 1, 1};   // calibration of the estimate (u, lambda, force), fitted offline:
+  PetscReal              estimateFloor[3] = {0, 0, 0};   // estimate = scale * raw + floor (error_estimate.hpp)
+  PetscBool              errorEstimate = PETSC_TRUE;     // -rom_error_estimate
+  bool HasEnrichment() const { return (NDefault >= 0 && NDefault < Npod) || (RDefault >= 0 && RDefault < Rfull); }
   std::vector<PetscInt>  kPoint, kMode, gPoint;      // EIM points: patch point (and mode for kappa)
   std::vector<PetscReal> kB, kC, gB, gC;             // B (M x M, column-major); C_j: Mk x Nfull x Rfull, Mg x Rfull
   std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull
@@ -159,6 +182,11 @@ public:
 
 private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  // The error estimate of a converged sol (ErrorEstimate), from the contact terms' last evaluation.
+  PetscErrorCode EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  ReducedQP              qpEst_;                      // the enriched QP (all stored sizes)
+  std::vector<PetscReal> eA_, ef_, eK_, eKp_, eg_, ev_, el_, eTh_, eQ_, eX_; // enriched operators and scratch
+  std::vector<PetscReal> ePwT_, eThetaT_;             // cubature weights of every stored row (M x padded, point-major); theta' of every column
   void           ResultantForce(const std::vector<PetscReal> &lambda, std::vector<PetscReal> *F) const;
   std::vector<PetscReal> wn_;                         // w_p n2(x_p) of the contact terms' last evaluation (points x dim)
   ContactMode            wnMode_ = ContactMode::EIM;  // the mode of that evaluation (EIM: none)

@@ -13,7 +13,7 @@ namespace rbc {
 class RomWriter {
 public:
   void Attr(const std::string &name, const std::string &value) { attrs_.emplace_back(name, value); }
-  // path like "/pod/modes"; dims row-major (the last index fastest), data.size() = prod(dims)
+  // path like "/pod/modes"; dims row-major (the last index fastest), data.size() = prod(dims); a path given again replaces it
   void Dataset(const std::string &path, const std::vector<unsigned long long> &dims, const std::vector<double> &data);
   // Largest dataset written so far: its path and number of entries.
   std::pair<std::string, unsigned long long> Largest() const;

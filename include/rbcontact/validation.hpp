@@ -17,6 +17,10 @@ struct ValidationSettings {
   std::vector<PetscReal> fractions{0.2, 0.4, 0.6, 0.8, 1.0};  // -validate_sweep_fractions of N, R (and the EIM sizes)
   std::string            sweepOutput;                         // -validate_sweep_output stem (default: the report's + _sweep)
   bool                   residual = false;                    // -validate_residual: the residual indicator and its effectivity
+  bool                   print    = true;                     // the summary line (off for offline -estimate's calibration run)
+  // when not null: the error estimate's raw changes and the true errors per test parameter (u, lambda, force), as in
+  // the report's estimate block (empty when the ROM gives no estimate)
+  std::vector<double>   *estimateRaw = nullptr, *estimateErr = nullptr; // arrays of 3
 };
 
 // Reads and checks the settings (one PetscOptionsBegin block); reportPath gives the sweep's default stem.

@@ -7,6 +7,7 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
+#include <cstring>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -95,6 +96,17 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   o["max_pressure"]      = (double)so.maxPressure;
   o["contact_halfwidth"] = (double)so.halfwidth;
   o["contact_length"]    = (double)so.contactLength;
+  // the online error estimate (docs/error_estimate.md): relative errors of u (energy), lambda (slave-mass l2), force
+  JsonValue &ee = rep.root["error_estimate"];
+  ee["available"] = sol.estimate.available;
+  if (sol.estimate.available) {
+    ee["u"]          = (double)sol.estimate.u;
+    ee["lambda"]     = (double)sol.estimate.lambda;
+    ee["force"]      = (double)sol.estimate.force;
+    ee["raw"]["u"]      = (double)sol.estimate.uRaw;
+    ee["raw"]["lambda"] = (double)sol.estimate.lambdaRaw;
+    ee["raw"]["force"]  = (double)sol.estimate.forceRaw;
+  } else ee["why"] = sol.estimate.why;
   JsonValue &k                   = rep.root["kkt"];
   k["primal_infeas"]             = (double)sol.qp.primal;
   k["dual_infeas"]               = (double)sol.qp.dual;
@@ -112,8 +124,9 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     PetscCall(ReconstructFields(comm, model, sol, mu, recPath, &rep));
     rep.root["reconstruct"] = recPath;
   }
-  char forceText[64] = "";
+  char forceText[160] = "";
   if (!sol.force.empty()) std::snprintf(forceText, sizeof forceText, ", contact force %.6g", (double)sol.ForceMagnitude());
+  if (sol.estimate.available) std::snprintf(forceText + strlen(forceText), sizeof forceText - strlen(forceText), ", estimated rel errors u %.2e lambda %.2e force %.2e", (double)sol.estimate.u, (double)sol.estimate.lambda, (double)sol.estimate.force);
   PetscCall(PetscPrintf(comm, "rbcontact online: %s, N %" PetscInt_FMT " R %" PetscInt_FMT " %s, %" PetscInt_FMT " Kacanov iterations%s, solve %.3g s (median of %" PetscInt_FMT ")\n", romPath, model.N(), model.R(), model.HyperSizes().c_str(), sol.iterations, forceText, times[times.size() / 2], repeat));
   PetscCall(rep.Write(comm, reportPath));
   PetscFunctionReturn(0);

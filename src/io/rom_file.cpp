@@ -13,6 +13,11 @@ static const char *kRomFormat = "rbcontact-rom";
 
 void RomWriter::Dataset(const std::string &path, const std::vector<unsigned long long> &dims, const std::vector<double> &data)
 {
+  for (auto &it : items_) // a dataset given again replaces the first (offline -estimate rewrites its calibration)
+    if (it.path == path) {
+      it = {path, dims, data};
+      return;
+    }
   items_.push_back({path, dims, data});
 }
 

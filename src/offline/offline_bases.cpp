@@ -7,6 +7,7 @@
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/supremizers.hpp"
 #include "rbcontact/offline_rom.hpp"
+#include "rbcontact/estimate_calibration.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
@@ -76,6 +77,41 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
 
   PetscFunctionBeginUser;
   PetscCheck(m > 0, world, PETSC_ERR_ARG_SIZ, "offline: no snapshot to build the bases from");
+  // --- the error estimate's enrichment (-estimate): the same bases to tighter tolerances, the answer's sizes noted
+  PetscBool estimate = PETSC_FALSE, podNSet = PETSC_FALSE, podTolSet, dualTolSet;
+  PetscReal podTol = 1e-8, dualTol = 1e-3, estPodTol = -1, estDualTol = -1; // the defaults of ComputePOD and BuildDualBasis
+  char      dualType[16] = "cpg";
+  PetscCall(PetscOptionsGetReal(NULL, "pod_", "-tol", &podTol, &podTolSet));
+  PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, &dualTolSet));
+  PetscCall(PetscOptionsHasName(NULL, "pod_", "-n", &podNSet));
+  PetscCall(PetscOptionsGetString(NULL, "dual_", "-type", dualType, sizeof dualType, NULL));
+  PetscOptionsBegin(world, NULL, "Online error estimate (offline)", "OfflineBases");
+  PetscCall(PetscOptionsBool("-estimate", "store enriched bases and a calibration for the online error estimate (docs/error_estimate.md)", "", estimate, &estimate, NULL));
+  estPodTol  = podTol * 1e-2;
+  estDualTol = dualTol * 0.1;
+  PetscCall(PetscOptionsReal("-estimate_pod_tol", "POD tolerance of the enriched primal space (default -pod_tol / 100)", "", estPodTol, &estPodTol, NULL));
+  PetscCall(PetscOptionsReal("-estimate_dual_tol", "dual greedy tolerance of the enriched dual space (default -dual_tol / 10)", "", estDualTol, &estDualTol, NULL));
+  PetscOptionsEnd();
+  b->estimate = estimate;
+  b->nDefault = b->rDefault = -1;
+  if (estimate) {
+    PetscCheck(estPodTol >= 0 && estPodTol <= podTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_pod_tol %g must lie in [0, -pod_tol = %g]", (double)estPodTol, (double)podTol);
+    PetscCheck(estDualTol > 0 && estDualTol <= dualTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_dual_tol %g must lie in (0, -dual_tol = %g]", (double)estDualTol, (double)dualTol);
+  }
+  // runs f with the option name set to value, the user's value (or none) restored after
+  auto withOption = [&](const char *name, PetscReal value, auto &&f) -> PetscErrorCode {
+    char      old[64], val[64];
+    PetscBool had;
+    PetscFunctionBeginUser;
+    PetscCall(PetscOptionsGetString(NULL, NULL, name, old, sizeof old, &had));
+    PetscCall(PetscSNPrintf(val, sizeof val, "%.17g", (double)value));
+    PetscCall(PetscOptionsSetValue(NULL, name, val));
+    PetscErrorCode ierr = f();
+    if (had) PetscCall(PetscOptionsSetValue(NULL, name, old));
+    else PetscCall(PetscOptionsClearValue(NULL, name));
+    PetscCall(ierr);
+    PetscFunctionReturn(0);
+  };
   // --- primal: POD in the chosen inner product of the reference configuration
   PetscCall(PetscTime(&t0));
   PetscOptionsBegin(world, "pod_", "Primal basis (offline)", "OfflineBases");
@@ -108,7 +144,11 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   }
   PODResult &pod = b->pod;
   PetscCall(BVDestroy(&pod.modes));
-  PetscCall(ComputePOD(X, M, &pod));
+  if (estimate && !podNSet) { // -pod_n fixes the size: no primal enrichment then
+    PetscCall(withOption("-pod_tol", estPodTol, [&]() { return ComputePOD(X, M, &pod); }));
+    const PetscInt n = PODSizeForTolerance(pod, podTol);
+    b->nDefault      = n < pod.N ? n : -1;
+  } else PetscCall(ComputePOD(X, M, &pod));
   for (auto &v : X) PetscCall(VecDestroy(&v));
   PetscCall(PetscTime(&t1));
 
@@ -137,7 +177,17 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
       for (PetscInt j = 0; j < m; ++j)
         for (PetscInt i = 0; i < R; ++i) L(i, j) *= sw[i];
     }
-    PetscCall(BuildDualBasis(L, &dual));
+    if (estimate && strcmp(dualType, "nmf")) { // a greedy: its first vectors are those of the looser tolerance
+      PetscCall(withOption("-dual_tol", estDualTol, [&]() { return BuildDualBasis(L, &dual); }));
+      const PetscReal tolAbs = estDualTol > 0 ? dual.tolAbs * dualTol / estDualTol : dualTol;
+      PetscInt        r      = dual.W.cols;
+      for (size_t k = 0; k < dual.history.size(); ++k)
+        if (dual.history[k] <= tolAbs) {
+          r = (PetscInt)k + 1;
+          break;
+        }
+      b->rDefault = r < dual.W.cols ? r : -1;
+    } else PetscCall(BuildDualBasis(L, &dual));
     if (massWeighted)
       for (PetscInt k = 0; k < dual.W.cols; ++k)
         for (PetscInt i = 0; i < R; ++i) dual.W(i, k) = sw[i] > 0 ? dual.W(i, k) / sw[i] : 0.0;
@@ -269,9 +319,10 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     rep->root["dual_mass_weighted"] = bs.massWeighted;
     // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
     // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
-    const bool tooCoarse = dual.W.cols >= m - 1 && m > 2;
+    const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols;
+    const bool     tooCoarse = rAnswer >= m - 1 && m > 2;
     rep->root["dual_kept_all_snapshots"] = tooCoarse;
-    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", dual.W.cols, m));
+    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", rAnswer, m));
   }
 
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
@@ -320,9 +371,10 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
       wr.Attr("basis_file", RelativeTo(basisPath, romPath)); // read back relative to the ROM file (rom_fields.cpp)
       WriteDualBasis(dual, &wr, false);
     }
-    PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep));
+    PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep, bs.nDefault, bs.rDefault));
     PetscCall(w.Write(world, bpath));
     PetscCall(wr.Write(world, romPath));
+    if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
     unsigned long long big[2] = {0, 0};
     std::string        bigName;
     if (wrank == 0) {

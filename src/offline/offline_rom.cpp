@@ -155,7 +155,7 @@ PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMa
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep)
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault, PetscInt rDefault)
 {
   PetscLogDouble t0, t1, t2;
   PetscMPIInt    wrank;
@@ -392,7 +392,35 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     std::vector<PetscReal> H;
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
-    if (co.fit == CubatureFit::Action) CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, (PetscInt)(rm.warmL.size() / R), &H, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim);
+    // with the error estimate's enrichment (offline -estimate) the points are fitted to the answer's sizes only
+    // (-estimate_cubature answer, the default: the answer's cost as without -estimate) or to every stored basis
+    // function (enriched); the enrichment's terms are evaluated at the same points (docs/error_estimate.md)
+    PetscBool fitAll = PETSC_FALSE;
+    if (nDefault > 0 || rDefault > 0) {
+      const char *fits[] = {"answer", "enriched"};
+      PetscInt    f      = 0;
+      PetscOptionsBegin(world, "estimate_", "Online error estimate: cubature (offline)", "OfflineReducedModel");
+      PetscCall(PetscOptionsEList("-cubature", "the cubature's fit: the answer's sizes or every stored basis function", "", fits, 2, fits[f], &f, NULL));
+      PetscOptionsEnd();
+      fitAll = f == 1 ? PETSC_TRUE : PETSC_FALSE;
+    }
+    const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
+    if ((nDefault > 0 || rDefault > 0) && !fitAll) {
+      const PetscInt        rA = rDefault > 0 ? rDefault : R, nA = nDefault > 0 ? nDefault : Npod;
+      std::vector<PetscInt> cols;
+      for (PetscInt i = 0; i < nA; ++i) cols.push_back(i);
+      for (PetscInt i = 0; i < std::min(nsup, rA); ++i) cols.push_back(Npod + i);
+      const PetscInt         Na = (PetscInt)cols.size();
+      std::vector<PetscReal> PA(P.begin(), P.begin() + (size_t)rA * Q), SkA((size_t)ms * Q * Na), LA((size_t)nt * rA), VA((size_t)nt * Na);
+      for (size_t sp = 0; sp < (size_t)ms * Q; ++sp)
+        for (PetscInt c = 0; c < Na; ++c) SkA[sp * Na + c] = Sk[sp * N + cols[c]];
+      for (PetscInt j = 0; j < nt; ++j) {
+        for (PetscInt i = 0; i < rA; ++i) LA[(size_t)j * rA + i] = rm.warmL[(size_t)j * R + i];
+        for (PetscInt c = 0; c < Na; ++c) VA[(size_t)j * Na + c] = rm.warmV[(size_t)j * N + cols[c]];
+      }
+      if (co.fit == CubatureFit::Action) CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, &H, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim);
+      else CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, &H);
+    } else if (co.fit == CubatureFit::Action) CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, &H, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim);
     else CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
     PetscCall(EmpiricalCubature(H, Q, co, &cr));
     PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
@@ -455,6 +483,20 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     surfaceWeightDiff = wmax > 0 ? dmax / wmax : dmax;
     // a multiplier space whose int psi_i is not |facet| / vertices (not ours today): no surface outputs rather than wrong ones
     if (!(surfaceWeightDiff <= 1e-10)) rm.surface = SurfaceOutputs();
+    // the error estimate's enrichment (offline -estimate, docs/error_estimate.md): the answer's sizes and the
+    // lambda norm of validate's error (the slave mass weights of the reference configuration) on the dual basis
+    if (nDefault > 0 || rDefault > 0) {
+      rm.NDefault = nDefault > 0 ? nDefault : Npod;
+      rm.RDefault = rDefault > 0 ? rDefault : R;
+      rm.massGram.assign((size_t)R * R, 0.0);
+      for (PetscInt i = 0; i < R; ++i)
+        for (PetscInt j = 0; j < R; ++j) {
+          PetscReal g = 0;
+          for (PetscInt k = 0; k < Rfom; ++k) g += dual.W(k, i) * wc[k] * dual.W(k, j);
+          rm.massGram[(size_t)i * R + j] = g;
+        }
+      PetscCall(rm.Truncate(-1, -1, -1, -1)); // the answer's sizes (report)
+    }
   }
   if (wrank == 0) {
     WriteReducedModel(rm, w);
@@ -536,6 +578,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["hyper_stored"] = std::string(hyper.ecsw ? "ecsw" : "") + (hyper.ecsw && hyper.eim ? "," : "") + (hyper.eim ? "eim" : "");
   ro["Mc"] = (long long)rm.Mc();
   ro["Mk_stored"] = (long long)rm.MkFull;
+  ro["N_in_use"]  = (long long)rm.N(); // the answer's sizes: N, R minus the error estimate's enrichment (offline -estimate)
+  ro["R_in_use"]  = (long long)rm.R();
+  ro["estimate_enrichment"] = rm.HasEnrichment();
   ro["Mg_stored"] = (long long)rm.MgFull;
   ro["surface_outputs"] = !rm.surface.Empty();                 // max pressure, contact half-width online
   ro["surface_weight_check"] = (double)surfaceWeightDiff;      // max rel diff of int psi_i: facets vs the FOM

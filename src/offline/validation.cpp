@@ -58,6 +58,8 @@ struct Errors {
   std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
   std::vector<double> pmaxOnline, halfwidthOnline; // the online max pressure and half-width (surface_outputs.hpp)
   std::vector<double> outOfRange; // contact projections at the edge of the stored contact patch, per parameter
+  std::vector<double> estU, estLambda, estForce; // the online error estimates (ReducedSolution::estimate), when available
+  std::vector<double> rawU, rawLambda, rawForce; // and their enriched-space changes before the calibration
   PetscInt            failed = 0;
   std::string         firstFailure;
   void Fill(JsonValue *j) const
@@ -271,14 +273,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
 
   // ROM (timed) and ROM without EIM on the test set, for one truncation of the model
   // sols (may be null): the converged reduced solutions, in the order of the test parameters
-  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols) -> PetscErrorCode {
+  // mediansNoEstimate (may be null): the same timing with -rom_error_estimate false, when the model estimates
+  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols, std::vector<double> *mediansNoEstimate = nullptr) -> PetscErrorCode {
     PetscFunctionBeginUser;
     for (PetscInt j = 0; j < nt; ++j) {
       ReducedSolution sol;
       PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
       PetscCall(m.Solve(F[j].mu, &sol)); // warm-up
-      if (timed) {
+      auto timeSolves = [&](std::vector<double> *meds) -> PetscErrorCode {
         std::vector<double> ts;
+        PetscFunctionBeginUser;
         for (PetscInt k = 0; k < repeat; ++k) {
           PetscLogDouble a, b;
           PetscCall(PetscTime(&a));
@@ -286,8 +290,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
           PetscCall(PetscTime(&b));
           ts.push_back(b - a);
         }
-        medians->push_back(Median(ts));
+        meds->push_back(Median(ts));
+        PetscFunctionReturn(0);
+      };
+      if (timed && mediansNoEstimate && sol.estimate.available) {
+        const PetscBool on = m.errorEstimate;
+        m.errorEstimate    = PETSC_FALSE;
+        PetscCall(timeSolves(mediansNoEstimate));
+        m.errorEstimate = on;
       }
+      if (timed) PetscCall(timeSolves(medians));
       PetscCall(PetscLogEventEnd(VAL_ROM, 0, 0, 0, 0));
       if (!sol.converged) {
         if (!E->failed) E->firstFailure = sol.message;
@@ -302,6 +314,14 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       E->u.push_back(eu);
       E->lambda.push_back(el);
       E->force.push_back(ef);
+      if (sol.estimate.available) {
+        E->estU.push_back(sol.estimate.u);
+        E->estLambda.push_back(sol.estimate.lambda);
+        E->estForce.push_back(sol.estimate.force);
+        E->rawU.push_back(sol.estimate.uRaw);
+        E->rawLambda.push_back(sol.estimate.lambdaRaw);
+        E->rawForce.push_back(sol.estimate.forceRaw);
+      }
       if ((PetscInt)sol.force.size() == dim) {
         PetscReal df = 0, nf = 0;
         for (PetscInt d = 0; d < dim; ++d) {
@@ -318,10 +338,11 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     PetscFunctionReturn(0);
   };
   Errors                E, E0;
-  std::vector<double>   medians;
+  std::vector<double>   medians, mediansNoEstimate;
   std::vector<PetscInt> romIts;
   std::vector<ReducedSolution> sols;
-  PetscCall(evaluate(model, true, &E, &medians, &romIts, settings.residual ? &sols : nullptr));
+  exact.errorEstimate = PETSC_FALSE;
+  PetscCall(evaluate(model, true, &E, &medians, &romIts, settings.residual ? &sols : nullptr, &mediansNoEstimate));
   PetscCall(evaluate(exact, false, &E0, nullptr, nullptr, nullptr));
   // the residual indicator of each reduced solution (the greedy's, on the mesh: docs/error_estimate.md) against its
   // energy error: the effectivity an online estimate built on this residual would start from
@@ -360,6 +381,45 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     r["share_above_1"]    = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1; }) / effectivity.size();
     r["share_within_20"]  = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1 && x <= 20; }) / effectivity.size();
   }
+  { // the online error estimate against the true errors (docs/error_estimate.md): effectivity = estimate / error
+    JsonValue &r = rep.root["estimate"];
+    const bool available = !E.estU.empty() && E.estU.size() == E.u.size();
+    r["available"]       = available;
+    if (available) {
+      auto block = [&](const char *key, const std::vector<double> &est, const std::vector<double> &err) {
+        JsonValue          &b = r[key];
+        std::vector<double> eff(est.size());
+        for (size_t k = 0; k < est.size(); ++k) eff[k] = err[k] > 0 ? est[k] / err[k] : (est[k] > 0 ? PETSC_INFINITY : 1.0);
+        b["estimate"]        = est;
+        b["rel_err"]         = err;
+        b["effectivity"]     = eff;
+        b["min_effectivity"] = *std::min_element(eff.begin(), eff.end());
+        b["max_effectivity"] = *std::max_element(eff.begin(), eff.end());
+        b["share_above_1"]   = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1; }) / eff.size();
+        b["share_within_20"] = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1 && x <= 20; }) / eff.size();
+        b["max_estimate"]    = *std::max_element(est.begin(), est.end());
+      };
+      const std::vector<double> &forceErr = E.forceOnline.size() == E.estForce.size() ? E.forceOnline : E.force;
+      if (settings.estimateRaw && settings.estimateErr) {
+        settings.estimateRaw[0] = E.rawU;
+        settings.estimateRaw[1] = E.rawLambda;
+        settings.estimateRaw[2] = E.rawForce;
+        settings.estimateErr[0] = E.u;
+        settings.estimateErr[1] = E.lambda;
+        settings.estimateErr[2] = forceErr;
+      }
+      block("u", E.estU, E.u);
+      block("lambda", E.estLambda, E.lambda);
+      // the force the online stage reports (its cubature's, ReducedSolution::force) when there is one
+      block("force", E.estForce, forceErr);
+      r["scale"] = std::vector<double>(model.estimateScale, model.estimateScale + 3);
+      r["floor"] = std::vector<double>(model.estimateFloor, model.estimateFloor + 3);
+      // the raw changes (before the calibration): what offline -estimate fits the calibration to
+      r["u"]["raw"]      = E.rawU;
+      r["lambda"]["raw"] = E.rawLambda;
+      r["force"]["raw"]  = E.rawForce;
+    }
+  }
   {
     std::vector<double> mus;
     for (const auto &mu : test.points) mus.insert(mus.end(), mu.begin(), mu.end());
@@ -370,6 +430,10 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   rep.root["online_time_s"]["max"]    = medians.empty() ? 0.0 : *std::max_element(medians.begin(), medians.end());
   rep.root["online_time_s"]["per_parameter_median"] = medians;
   rep.root["online_time_s"]["repeat"] = (long long)repeat;
+  if (!mediansNoEstimate.empty()) { // the solve alone, without the error estimate (same parameters, same repeats)
+    rep.root["online_time_s"]["median_without_estimate"] = Median(mediansNoEstimate);
+    rep.root["online_time_s"]["estimate_cost_ratio"]     = Median(mediansNoEstimate) > 0 ? onlineMedian / Median(mediansNoEstimate) : 0.0;
+  }
   rep.root["fom_time_s"]["median"]    = fomMedian;
   rep.root["fom_time_s"]["all"]       = fomTimes;
   rep.root["speedup_median"]          = onlineMedian > 0 ? fomMedian / onlineMedian : 0.0;
@@ -427,7 +491,11 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     PetscCall(WriteFileAtomic(comm, std::string(sweepOut) + ".json", table.Dump()));
     rep.root["sweep_files"] = std::string(sweepOut) + ".{csv,json}";
   }
-  PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " %s: max rel err u %.3e lambda %.3e force %.3e (exact contact terms: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), model.HyperSizes().c_str(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
+  if (settings.print) PetscCall(PetscPrintf(comm, "rbcontact validate: %s, %" PetscInt_FMT " test parameters, N %" PetscInt_FMT " R %" PetscInt_FMT " %s: max rel err u %.3e lambda %.3e force %.3e (exact contact terms: u %.3e lambda %.3e); online median %.3g s, FOM median %.3g s, speedup %.0f\n", scene.name.c_str(), nt, model.N(), model.R(), model.HyperSizes().c_str(), rep.root["test"]["max_rel_err_u"].AsNumber(), rep.root["test"]["max_rel_err_lambda"].AsNumber(), rep.root["test"]["max_rel_err_force"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_u"].AsNumber(), rep.root["test_no_eim"]["max_rel_err_lambda"].AsNumber(), onlineMedian, fomMedian, onlineMedian > 0 ? fomMedian / onlineMedian : 0.0));
+  if (settings.print && !E.estU.empty() && E.estU.size() == E.u.size()) {
+    JsonValue &r = rep.root["estimate"];
+    PetscCall(PetscPrintf(comm, "rbcontact validate: error estimate effectivity (estimate / error) u [%.3g, %.3g], lambda [%.3g, %.3g], force [%.3g, %.3g]; >= 1 on %.0f %% / %.0f %% / %.0f %%; online time with it %.2fx\n", r["u"]["min_effectivity"].AsNumber(), r["u"]["max_effectivity"].AsNumber(), r["lambda"]["min_effectivity"].AsNumber(), r["lambda"]["max_effectivity"].AsNumber(), r["force"]["min_effectivity"].AsNumber(), r["force"]["max_effectivity"].AsNumber(), 100 * r["u"]["share_above_1"].AsNumber(), 100 * r["lambda"]["share_above_1"].AsNumber(), 100 * r["force"]["share_above_1"].AsNumber(), rep.root["online_time_s"].Has("estimate_cost_ratio") ? rep.root["online_time_s"]["estimate_cost_ratio"].AsNumber() : 0.0));
+  }
   for (auto &s : F) {
     PetscCall(VecDestroy(&s.u));
     PetscCall(VecDestroy(&s.lambda));

@@ -415,4 +415,19 @@ PetscErrorCode PODProjectionErrors(BV modes, const std::vector<Vec> &snapshots, 
   PetscFunctionReturn(0);
 }
 
+PetscInt PODSizeForTolerance(const PODResult &res, PetscReal tol)
+{
+  const std::vector<PetscReal> &s = res.singularValues;
+  const PetscInt                m = (PetscInt)s.size();
+  std::vector<PetscReal>        left(m + 1, 0.0);
+  for (PetscInt i = m - 1; i >= 0; --i) left[i] = left[i + 1] + s[i] * s[i];
+  PetscInt N = m;
+  for (PetscInt i = 0; i <= m; ++i)
+    if (left[i] <= tol * left[0]) {
+      N = i;
+      break;
+    }
+  return std::max<PetscInt>(1, std::min(N, res.rank));
+}
+
 } // namespace rbc

@@ -10,7 +10,7 @@
 
 namespace rbc {
 
-static PetscLogEvent ROM_Solve = 0, ROM_Contact = 0, ROM_QP = 0;
+static PetscLogEvent ROM_Solve = 0, ROM_Contact = 0, ROM_QP = 0, ROM_Estimate = 0;
 
 static PetscErrorCode RegisterEvents()
 {
@@ -19,6 +19,7 @@ static PetscErrorCode RegisterEvents()
     PetscCall(PetscLogEventRegister("RBCOnlineSolve", DM_CLASSID, &ROM_Solve));
     PetscCall(PetscLogEventRegister("RBCOnlineContact", DM_CLASSID, &ROM_Contact));
     PetscCall(PetscLogEventRegister("RBCOnlineQP", DM_CLASSID, &ROM_QP));
+    PetscCall(PetscLogEventRegister("RBCOnlineEstimate", DM_CLASSID, &ROM_Estimate));
   }
   PetscFunctionReturn(0);
 }
@@ -219,6 +220,11 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
   }
   w->Dataset("/online/hyper_default", {1}, {m.hyperDefault == ReducedModel::ContactMode::Cubature ? 1.0 : 0.0});
   if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
+  if (m.HasEnrichment()) { // the answer's sizes, the rest is the error estimate's enrichment (docs/error_estimate.md)
+    w->Dataset("/online/estimate/default_sizes", {2}, {(double)m.NDefault, (double)m.RDefault});
+    w->Dataset("/online/estimate/calibration", {2, 3}, {m.estimateScale[0], m.estimateScale[1], m.estimateScale[2], m.estimateFloor[0], m.estimateFloor[1], m.estimateFloor[2]});
+    if (!m.massGram.empty()) w->Dataset("/online/estimate/mass_gram", {R, R}, m.massGram);
+  }
   std::vector<std::pair<std::string, std::pair<std::vector<U64>, std::vector<double>>>> items;
   m.patch.Serialize(&items);
   for (auto &it : items) w->Dataset("/online/contact/" + it.first, it.second.first, it.second.second);
@@ -325,6 +331,30 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       MgDefault = (PetscInt)d[1];
     }
   }
+  NDefault = RDefault = -1;
+  massGram.clear();
+  for (int k = 0; k < 3; ++k) {
+    estimateScale[k] = 1;
+    estimateFloor[k] = 0;
+  }
+  { // optional (files of before 2026-11-26 have none): the answer's sizes inside the stored ones and the estimate's data
+    bool found;
+    PetscCall(RomReadOptional(path, "/online/estimate/default_sizes", &d, &found));
+    if (found) {
+      PetscCheck(d.size() == 2 && d[0] >= 1 && d[0] <= Npod && d[1] >= 1 && d[1] <= Rfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/default_sizes must hold 2 sizes within [1, %" PetscInt_FMT "] (POD modes) and [1, %" PetscInt_FMT "] (dual vectors)", path.c_str(), Npod, Rfull);
+      NDefault = (PetscInt)d[0];
+      RDefault = (PetscInt)d[1];
+      PetscCall(ReadChecked(path, "/online/estimate/calibration", 6, &d));
+      for (int k = 0; k < 3; ++k) {
+        PetscCheck(std::isfinite(d[k]) && d[k] > 0 && std::isfinite(d[3 + k]) && d[3 + k] >= 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/calibration: scale %g and floor %g of quantity %d must be > 0 and >= 0", path.c_str(), d[k], d[3 + k], k);
+        estimateScale[k] = d[k];
+        estimateFloor[k] = d[3 + k];
+      }
+      PetscCall(RomReadOptional(path, "/online/estimate/mass_gram", &massGram, &found));
+      if (!found) massGram.clear();
+      PetscCheck(massGram.empty() || massGram.size() == R * R, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/mass_gram has %zu entries, expected %zu", path.c_str(), massGram.size(), R * R);
+    }
+  }
   { // optional (files of before 2026-11-25): the surface data of the max pressure and the contact half-width
     bool found;
     PetscCall(surface.Read(path, &found));
@@ -350,8 +380,9 @@ PetscErrorCode ReducedModel::SetFromOptions()
   // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
   if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
   PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
-  PetscCall(PetscOptionsInt("-N", "POD modes used (default: all in the file)", "", n, &n, NULL));
-  PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: all)", "", r, &r, NULL));
+  PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
+  PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
+  PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
   PetscCall(PetscOptionsInt("-Mk", "EIM terms of kappa used (default: the offline selection)", "", mk, &mk, NULL));
   PetscCall(PetscOptionsInt("-Mg", "EIM terms of the gap used (default: the offline selection)", "", mg, &mg, NULL));
   PetscOptionsEnd();
@@ -359,6 +390,8 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
+  PetscCall(qpEst_.SetFromOptions("rom_"));
+  qpEst_.residuals = false;
   if (hyperSet) {
     std::string h(hyper);
     h = h.substr(0, h.find(',')); // a list (the offline stage's form): its first entry
@@ -378,8 +411,8 @@ PetscErrorCode ReducedModel::SetFromOptions()
 PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg)
 {
   PetscFunctionBeginUser;
-  if (n < 0) n = Npod;
-  if (r < 0) r = Rfull;
+  if (n < 0) n = NDefault >= 1 ? std::min(NDefault, Npod) : Npod;
+  if (r < 0) r = RDefault >= 1 ? std::min(RDefault, Rfull) : Rfull;
   if (mk < 0) mk = MkDefault >= 0 ? std::min(MkDefault, MkFull) : MkFull;
   if (mg < 0) mg = MgDefault >= 0 ? std::min(MgDefault, MgFull) : MgFull;
   PetscCheck(n >= 1 && n <= Npod, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_N %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "] (POD modes in %s)", n, Npod, file.c_str());
@@ -455,6 +488,20 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   A_.assign((size_t)Na * Na, 0.0);
   f_.assign(Na, 0.0);
   qp.Reserve(Na, r);
+  ePwT_.clear();
+  eThetaT_.clear();
+  if (Na < Nfull || r < Rfull) { // the error estimate's enriched terms (EstimateError): every stored row and column
+    qpEst_.Reserve(Nfull, Rfull);
+    const PetscInt rpf = PaddedRows(Rfull), Mc = (PetscInt)cPoint.size(), nd = patch.nnode * patch.dim;
+    ePwT_.assign((size_t)Mc * rpf, 0.0);
+    for (PetscInt p = 0; p < Mc; ++p)
+      for (PetscInt i = 0; i < Rfull; ++i) ePwT_[(size_t)p * rpf + i] = cPw[(size_t)i * Mc + p];
+    if (cDofs_) {
+      eThetaT_.assign((size_t)Nfull * nd, 0.0);
+      for (PetscInt c = 0; c < Nfull; ++c)
+        for (PetscInt a = 0; a < nd; ++a) eThetaT_[(size_t)c * nd + a] = patch.theta[(size_t)a * patch.N + c];
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -738,7 +785,131 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     o << "reduced KKT residual " << kkt << " exceeds -rom_kkt_tol " << kktTol << " (primal " << sol->qp.primal << ", dual " << sol->qp.dual << ", complementarity " << sol->qp.complementarity << ", stationarity " << sol->qp.stationarity << ")";
     sol->message   = o.str();
     sol->converged = false;
+    PetscFunctionReturn(0);
   }
+  PetscCall(EstimateError(mu, sol));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol)
+{
+  ErrorEstimate &e = sol->estimate;
+  const PetscInt Na = (PetscInt)cols_.size(), r = r_, Nf = Nfull, Rf = Rfull;
+
+  PetscFunctionBeginUser;
+  e = ErrorEstimate();
+  if (!errorEstimate) {
+    e.why = "-rom_error_estimate false";
+    PetscFunctionReturn(0);
+  }
+  if (Na >= Nf && r >= Rf) {
+    e.why = "no enrichment: the model uses every basis function of the ROM file (rebuild it with offline -estimate, or use fewer with -rom_N/-rom_R)";
+    PetscFunctionReturn(0);
+  }
+  if (wnMode_ == ContactMode::EIM) {
+    e.why = "the EIM interpolates the reduced terms of the answer's sizes only (use -rom_hyper ecsw)";
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscLogEventBegin(ROM_Estimate, 0, 0, 0, 0));
+  // the contact terms of every stored basis function at the last evaluation's geometry and points:
+  // K(i, n) = sum_p Pw(i, p) kappa(p, n), g(i) = sum_p Pw(i, p) gamma(p)
+  const bool       exact = wnMode_ == ContactMode::Exact;
+  const PetscInt   M     = exact ? (PetscInt)(P_.size() / Rf) : (PetscInt)cPoint.size();
+  const PetscReal *Pw    = exact ? P_.data() : cPw.data(); // Rf x M, row-major
+  const PetscInt rpf = PaddedRows(Rf);
+  eKp_.resize((size_t)rpf * Nf);
+  eg_.assign(rpf, 0.0);
+  if (exact) { // offline / validation only: plain loops over the full quadrature
+    std::fill(eKp_.begin(), eKp_.end(), 0.0);
+    for (PetscInt i = 0; i < Rf; ++i)
+      for (PetscInt p = 0; p < M; ++p) {
+        const PetscReal wp = Pw[(size_t)i * M + p];
+        for (PetscInt n = 0; n < Nf; ++n) eKp_[i + (size_t)rpf * n] += wp * kap_[(size_t)p * Nf + n];
+        eg_[i] += wp * gam_[p];
+      }
+  } else if (cDofs_) { // Q(a, :) = sum_p coef(p, a) Pw(:, p) with every stored row, then K = Q' theta (the answer's dof sum)
+    const PetscInt nd = patch.nnode * patch.dim;
+    eQ_.assign((size_t)nd * rpf, 0.0);
+    ScatterRows(M, rpf, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), ePwT_.data(), gam_.data(), eQ_.data(), eg_.data());
+    SumOfOuterProducts(nd, rpf, Nf, eQ_.data(), eThetaT_.data(), eKp_.data());
+  } else { // [K g] = sum_p Pw(:, p) [kappa(p, :) gamma(p)] (the answer's point sum)
+    eX_.resize((size_t)(Nf + 1) * M);
+    for (PetscInt n = 0; n < Nf; ++n)
+      for (PetscInt p = 0; p < M; ++p) eX_[(size_t)n * M + p] = kap_[(size_t)p * Nf + n];
+    std::copy(gam_.begin(), gam_.begin() + M, eX_.begin() + (size_t)Nf * M);
+    eKp_.resize((size_t)rpf * (Nf + 1));
+    SumOfOuterProducts(M, rpf, Nf + 1, ePwT_.data(), eX_.data(), eKp_.data());
+    std::copy_n(&eKp_[(size_t)Nf * rpf], rpf, eg_.begin());
+  }
+  eK_.resize((size_t)Rf * Nf);
+  for (PetscInt n = 0; n < Nf; ++n) std::copy_n(&eKp_[(size_t)n * rpf], Rf, &eK_[(size_t)Rf * n]);
+  // A(mu), f(mu) of all stored columns
+  par.ThetaA(mu, &thA_);
+  par.ThetaF(mu, &thF_);
+  eA_.assign((size_t)Nf * Nf, 0.0);
+  ef_.assign(Nf, 0.0);
+  for (size_t q = 0; q < thA_.size(); ++q) {
+    const PetscReal *a = &Aq[q * Nf * Nf];
+    for (size_t k = 0; k < (size_t)Nf * Nf; ++k) eA_[k] += thA_[q] * a[k]; // symmetric: row- = column-major
+  }
+  for (size_t q = 0; q < thF_.size(); ++q)
+    for (PetscInt i = 0; i < Nf; ++i) ef_[i] += thF_[q] * fq[q * Nf + i];
+  // the enriched QP, from the answer's multipliers
+  ev_.assign(Nf, 0.0);
+  el_.assign(Rf, 0.0);
+  std::copy(sol->lambda.begin(), sol->lambda.end(), el_.begin());
+  ReducedQPInfo info;
+  PetscCall(qpEst_.Solve(Nf, Rf, eA_.data(), ef_.data(), eK_.data(), eg_.data(), ev_.data(), el_.data(), &info));
+  if (info.status != ReducedQPStatus::Ok) {
+    e.why = std::string("the enriched reduced QP failed (") + ReducedQPStatusName(info.status) + "): " + info.message;
+    PetscCall(PetscLogEventEnd(ROM_Estimate, 0, 0, 0, 0));
+    PetscFunctionReturn(0);
+  }
+  // u: energy norm of A(mu) of the change, relative to the enriched solution
+  eTh_.assign(ev_.begin(), ev_.end()); // the change d = v_enriched - v (answer padded with zeros)
+  for (PetscInt i = 0; i < Na; ++i) eTh_[cols_[i]] -= sol->v[i];
+  auto energy = [&](const std::vector<PetscReal> &x) {
+    PetscReal s = 0;
+    for (PetscInt j = 0; j < Nf; ++j) {
+      PetscReal t = 0;
+      for (PetscInt i = 0; i < Nf; ++i) t += eA_[i + (size_t)Nf * j] * x[i];
+      s += x[j] * t;
+    }
+    return std::max<PetscReal>(s, 0);
+  };
+  const PetscReal du2 = energy(eTh_), u2 = energy(ev_);
+  e.uRaw = u2 > 0 ? std::sqrt(du2 / u2) : std::sqrt(du2);
+  // lambda: the slave-mass weighted norm (W'W without the mass Gram)
+  const std::vector<PetscReal> &G = massGram.empty() ? dualGram : massGram;
+  PetscReal                     dl2 = 0, l2 = 0;
+  for (PetscInt i = 0; i < Rf; ++i)
+    for (PetscInt j = 0; j < Rf; ++j) {
+      const PetscReal g = G[(size_t)i * Rf + j], di = el_[i] - (i < r ? sol->lambda[i] : 0), dj = el_[j] - (j < r ? sol->lambda[j] : 0);
+      dl2 += di * g * dj;
+      l2 += el_[i] * g * el_[j];
+    }
+  dl2        = std::max<PetscReal>(dl2, 0);
+  e.lambdaRaw = l2 > 0 ? std::sqrt(dl2 / l2) : std::sqrt(dl2);
+  // the resultant force of the enriched multipliers at the same points
+  if (!sol->force.empty() && (PetscInt)wn_.size() == M * dim) {
+    std::vector<PetscReal> F2(dim, 0.0);
+    for (PetscInt p = 0; p < M; ++p) {
+      PetscReal l = 0;
+      for (PetscInt i = 0; i < Rf; ++i) l += Pw[(size_t)i * M + p] * el_[i];
+      for (PetscInt k = 0; k < dim; ++k) F2[k] += l * wn_[(size_t)p * dim + k];
+    }
+    PetscReal df = 0, nf = 0;
+    for (PetscInt k = 0; k < dim; ++k) {
+      df += PetscSqr(F2[k] - sol->force[k]);
+      nf += PetscSqr(F2[k]);
+    }
+    e.forceRaw = nf > 0 ? std::sqrt(df / nf) : std::sqrt(df);
+  }
+  e.u         = estimateScale[0] * e.uRaw + estimateFloor[0];
+  e.lambda    = estimateScale[1] * e.lambdaRaw + estimateFloor[1];
+  e.force     = estimateScale[2] * e.forceRaw + estimateFloor[2];
+  e.available = true;
+  PetscCall(PetscLogEventEnd(ROM_Estimate, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
