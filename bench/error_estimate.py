@@ -12,7 +12,7 @@ answer's sizes. --cubature answer|enriched|both: the cubature's fit (-estimate_c
 
 It is a benchmark: it exits 0 unless a run fails. Timings depend on the machine's load.
 Usage: /usr/bin/python3 bench/error_estimate.py [--np 2] [--exe build/bin/rbcontact] [--cases ring_on_block half_disks]
-           [--cubature answer] [--test-size 100] [--repeat 20] [--keep] [--json out.json] [--extra-offline "..."]
+           [--cubature enriched] [--test-size 100] [--repeat 20] [--keep] [--json out.json] [--extra-offline "..."]
 """
 import argparse
 import json
@@ -51,7 +51,7 @@ def main():
     ap.add_argument("--np", type=int, default=2)
     ap.add_argument("--exe", default=os.path.join(ROOT, "build/bin/rbcontact"))
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
-    ap.add_argument("--cubature", default="answer", choices=["answer", "enriched", "both"])
+    ap.add_argument("--cubature", default="enriched", choices=["answer", "enriched", "both"])
     ap.add_argument("--test-size", type=int, default=100)
     ap.add_argument("--repeat", type=int, default=20, help="-validate_repeat (online timing)")
     ap.add_argument("--extra-offline", default="")

@@ -493,7 +493,7 @@ def estimate(args):
     # validate: the effectivities on 20 random radii (the measure on 100: bench/error_estimate.py)
     run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "2", "-report", d + "/val.json"])
     v = report(d + "/val.json")
-    for k in ("u", "lambda"):
+    for k in ("u", "lambda", "force"):
         b = v["estimate"][k]
         print("  %s: effectivity %.2f..%.2f, >= 1 on %.0f %%, within [1, 20] on %.0f %%" % (k, b["min_effectivity"], b["max_effectivity"], 100 * b["share_above_1"], 100 * b["share_within_20"]))
         check(b["share_above_1"] >= 0.95 and b["share_within_20"] >= 0.9, "%s: the estimate >= the error on >= 95 %% of the radii, within 20x on >= 90 %%" % k)

@@ -392,13 +392,13 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     std::vector<PetscReal> H;
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
-    // with the error estimate's enrichment (offline -estimate) the points are fitted to the answer's sizes only
-    // (-estimate_cubature answer, the default: the answer's cost as without -estimate) or to every stored basis
-    // function (enriched); the enrichment's terms are evaluated at the same points (docs/error_estimate.md)
+    // with the error estimate's enrichment (offline -estimate) the points are fitted to every stored basis function
+    // (-estimate_cubature enriched, the default: the tighter estimate) or to the answer's sizes only (answer: the
+    // answer's cost as without -estimate); the enrichment's terms are evaluated at the same points (docs/error_estimate.md)
     PetscBool fitAll = PETSC_FALSE;
     if (nDefault > 0 || rDefault > 0) {
       const char *fits[] = {"answer", "enriched"};
-      PetscInt    f      = 0;
+      PetscInt    f      = 1;
       PetscOptionsBegin(world, "estimate_", "Online error estimate: cubature (offline)", "OfflineReducedModel");
       PetscCall(PetscOptionsEList("-cubature", "the cubature's fit: the answer's sizes or every stored basis function", "", fits, 2, fits[f], &f, NULL));
       PetscOptionsEnd();
