@@ -115,6 +115,22 @@ for tag, path in (("refine 0", "validate.json"), ("refine 0", "validate_eim.json
           % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], x["max_rel_err_u"], x["max_rel_err_lambda"]))
     print("  online median %.2e s per solve, FOM median %.2e s, speedup %.0f" % (r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
 PY
+  # the online error estimate (docs/error_estimate.md): the same snapshots, enriched bases and a calibration on 20
+  # FOM solves (offline -estimate); every online solve reports its estimated errors, validate their effectivity
+  rbc offline "$OUT/estimate/offline.json" -options_file "runs/$SCENE.opts" -rom "$OUT/estimate/rom.h5" -snapshots "$OUT/rom.snapshots.h5" -estimate
+  rbc online "$OUT/estimate/online.json" -rom "$OUT/estimate/rom.h5" -mu "$MU_ONLINE" -online_repeat 1000 -options_file "runs/$SCENE.opts"
+  rbc validate "$OUT/estimate/validate.json" -options_file "runs/$SCENE.opts" -rom "$OUT/estimate/rom.h5"
+  "$PYTHON" - "$OUT/estimate" <<'PY' || die "reading the error-estimate reports failed"
+import json, os, sys
+d = sys.argv[1]
+on, v = json.load(open(os.path.join(d, "online.json"))), json.load(open(os.path.join(d, "validate.json")))
+e, t = on["error_estimate"], v["online_time_s"]
+print("error estimate at %s: u %.2e, lambda %.2e, force %.2e (estimated relative errors)" % (", ".join("%s %g" % kv for kv in on["mu"].items()), e["u"], e["lambda"], e["force"]))
+for k in ("u", "lambda", "force"):
+    b = v["estimate"][k]
+    print("  %-6s effectivity (estimate / true error) %.2f..%.2f on %d random radii, >= 1 on %.0f %%" % (k, b["min_effectivity"], b["max_effectivity"], len(b["effectivity"]), 100 * b["share_above_1"]))
+print("  online %.2e s with the estimate, %.2e s without (%.2fx)" % (t["median"], t["median_without_estimate"], t["estimate_cost_ratio"]))
+PY
   # 3D contact: a hemisphere on a block against Hertz's point contact, the deformed bodies in section and the
   # pressure on the slave surface (3D picture; radial profile against Hertz, contact plane)
   rbc fom "results/hertz3d/fom.json" -options_file runs/hertz3d.opts -fom_output "results/hertz3d/fom.h5"
