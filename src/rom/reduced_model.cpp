@@ -879,7 +879,7 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   };
   const PetscReal du2 = energy(eTh_), u2 = energy(ev_);
   e.uRaw = u2 > 0 ? std::sqrt(du2 / u2) : std::sqrt(du2);
-  // lambda: the slave-mass weighted norm (W'W without the mass Gram)
+  // lambda: the slave-mass weighted norm (W'W when the file has no mass Gram)
   const std::vector<PetscReal> &G = massGram.empty() ? dualGram : massGram;
   PetscReal                     dl2 = 0, l2 = 0;
   for (PetscInt i = 0; i < Rf; ++i)
@@ -892,7 +892,7 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   e.lambdaRaw = l2 > 0 ? std::sqrt(dl2 / l2) : std::sqrt(dl2);
   // the resultant force of the enriched multipliers at the same points
   if (!sol->force.empty() && (PetscInt)wn_.size() == M * dim) {
-    std::vector<PetscReal> F2(dim, 0.0);
+    PetscReal F2[3] = {0, 0, 0};
     for (PetscInt p = 0; p < M; ++p) {
       PetscReal l = 0;
       for (PetscInt i = 0; i < Rf; ++i) l += Pw[(size_t)i * M + p] * el_[i];
