@@ -304,9 +304,19 @@ def greedy(args):
         t = report(d + "/v.json")["test"]
         print("  validate, 6 FOM solves: max rel err u %.2e, lambda %.2e, force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
         check(t["max_rel_err_u"] <= 1e-4 and t["max_rel_err_lambda"] <= 1e-2 and t["max_rel_err_force"] <= 1e-3, "the 6-solve greedy ROM meets u <= 1e-4, lambda <= 1e-2, force <= 1e-3 on 20 random radii")
-    # refused: a greedy run that stops before the ROM, an unknown criterion
+    # -greedy_indicator estimate (docs/error_estimate.md): the rounds with an enrichment ranked by the online estimate's
+    # raw u change, the others by the residual
+    re_ = off(2, "ge", 8, ["-estimate", "-greedy_indicator", "estimate", "-estimate_calibration_size", "4"])
+    ge = re_["greedy"]
+    est_rounds = [rd for rd in ge["rounds"] if rd["indicator"] == "estimate"]
+    for rd in ge["rounds"]:
+        print("  estimate greedy round %d: %d solves, indicator %s, max %.3e" % (rd["round"], rd["solves"], rd["indicator"], rd["max_indicator"]))
+    check(ge["indicator"] == "estimate" and ge["estimate_rounds"] == len(est_rounds) >= 1 and ge["training_set_size"] == 8
+          and all(rd["max_indicator"] == rd["max_estimate_u"] > 0 for rd in est_rounds) and all("max_residual" in rd for rd in ge["rounds"] if rd["indicator"] == "residual"),
+          "-greedy_indicator estimate: %d of %d rounds ranked by the estimate's u change, the others by the residual" % (len(est_rounds), len(ge["rounds"])))
+    # refused: a greedy run that stops before the ROM, an unknown criterion, the estimate without its enrichment
     for extra, needle in ((["-offline_stop", "snapshots", "-snapshots", d + "/x.h5"], "-train_type greedy builds the reduced model"),
-                          (["-greedy_indicator", "bogus"], "bogus")):
+                          (["-greedy_indicator", "bogus"], "bogus"), (["-greedy_indicator", "estimate"], "needs -estimate")):
         c = ["mpirun", "-n", "1", args.exe, "offline"] + base + ["-rom", d + "/never.h5"] + extra
         p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         check(p.returncode != 0 and needle in p.stdout, "refused with a message naming '%s'" % needle)

@@ -14,8 +14,9 @@
 
 namespace rbc {
 
-// Which measure ranks the candidates: GreedyEstimate::residual, ::penetration, or the larger.
-enum class GreedyCriterion { Residual, Penetration, Max };
+// Which measure ranks the candidates: GreedyEstimate::residual, ::penetration, the larger, or the online error
+// estimate's raw u change in the enriched spaces (offline -estimate; GreedyRounds, docs/greedy_training.md).
+enum class GreedyCriterion { Residual, Penetration, Max, Estimate };
 
 // What the indicator measured at one parameter.
 struct GreedyEstimate {

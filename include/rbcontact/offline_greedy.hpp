@@ -21,9 +21,10 @@ namespace rbc {
 // -greedy_tol (1e-4): stop once the largest indicator over the candidates not solved is at most this;
 // -greedy_max_solves (100): FOM solves in all, initial set included; -greedy_batch (0: the number of
 // groups of ranks): parameters solved per round; -greedy_separation (2): the picks of one round lie at
-// least this many typical candidate spacings apart (unit box); -greedy_indicator residual|penetration|max
+// least this many typical candidate spacings apart (unit box); -greedy_indicator residual|penetration|max|estimate
 // (residual: the penetration of the reduced constraint is bounded below by the dual basis' truncation,
-// which more snapshots do not lower; docs/greedy_training.md); -greedy_monitor.
+// which more snapshots do not lower; estimate: the online error estimate's raw u change, with -estimate, the
+// residual in a round whose bases have no enrichment yet; docs/greedy_training.md); -greedy_monitor.
 struct GreedyOptions {
   PetscReal tol        = 1e-4;
   GreedyCriterion criterion = GreedyCriterion::Residual;

@@ -3,6 +3,7 @@
 #include "rbcontact/offline_greedy.hpp"
 #include "rbcontact/offline_bases.hpp"
 #include "rbcontact/offline_rom.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -19,7 +20,7 @@ PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
   PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks)", "", o->batch, &o->batch, NULL));
   PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
   {
-    const char *const names[] = {"residual", "penetration", "max", "GreedyCriterion", "GREEDY_", NULL};
+    const char *const names[] = {"residual", "penetration", "max", "estimate", "GreedyCriterion", "GREEDY_", NULL};
     PetscEnum         c       = (PetscEnum)o->criterion;
     PetscCall(PetscOptionsEnum("-indicator", "Measure that ranks the candidates", "", names, c, &c, NULL));
     o->criterion = (GreedyCriterion)c;
@@ -79,7 +80,11 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   PetscCall(ind.Setup(fom));
-  ind.criterion = go.criterion;
+  const bool byEstimate = go.criterion == GreedyCriterion::Estimate;
+  ind.criterion         = byEstimate ? GreedyCriterion::Residual : go.criterion; // (a round without enrichment: the residual)
+  std::vector<PetscReal> slaveMass;                                              // the estimate's lambda norm
+  if (byEstimate) PetscCall(ReferenceSlaveMass(fom, cmap, order, &slaveMass));
+  PetscInt nEstimateRounds = 0;
   for (PetscInt round = 0;; ++round) {
     std::vector<PetscInt> done;
     PetscCall(file.DoneIndices(&done));
@@ -105,6 +110,28 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     rm.warmStart      = PETSC_FALSE;
     rm.loop.monitor   = PETSC_FALSE;
     rm.recordIterates = false;
+    // -greedy_indicator estimate: the answer's sizes inside the enriched bases (BuildBases with -estimate), the
+    // estimate's lambda norm; without an enrichment this round (few snapshots: every POD mode and dual vector
+    // is needed by the answer's tolerances already) the residual ranks the candidates
+    bool estimated = false;
+    if (byEstimate) {
+      PetscCheck(bs.estimate, world, PETSC_ERR_ARG_INCOMP, "-greedy_indicator estimate needs -estimate (the enriched bases of the online error estimate)");
+      if (bs.nDefault > 0 || bs.rDefault > 0) {
+        const PetscInt R = bs.dual.W.cols, Rfom = bs.dual.W.rows;
+        rm.NDefault      = bs.nDefault > 0 ? bs.nDefault : bs.pod.N - bs.nsup;
+        rm.RDefault      = bs.rDefault > 0 ? bs.rDefault : R;
+        rm.massGram.assign((size_t)R * R, 0.0);
+        for (PetscInt i = 0; i < R; ++i)
+          for (PetscInt j = 0; j < R; ++j) {
+            PetscReal g = 0;
+            for (PetscInt k = 0; k < Rfom; ++k) g += bs.dual.W(k, i) * slaveMass[k] * bs.dual.W(k, j);
+            rm.massGram[(size_t)i * R + j] = g;
+          }
+        PetscCall(rm.Truncate(-1, -1, -1, -1));
+        estimated = true;
+        ++nEstimateRounds;
+      }
+    }
     PetscCall(PetscTime(&t1));
     // the indicator at every candidate not solved; candidate j of those goes to group j mod ngroups
     std::vector<char> isDone(npool, 0);
@@ -114,7 +141,15 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     for (PetscInt c = ninitial; c < npool; ++c) {
       if (isDone[c] || j++ % ngroups != color) continue;
       GreedyEstimate e;
-      PetscCall(ind.EvaluateReduced(fom, cmap, order, rm, *full, bs.pod.modes, bs.dual.W, pool.points[c], &e));
+      if (estimated) { // the raw changes of u and lambda in the enriched spaces (no mesh); a failed solve first
+        ReducedSolution sol;
+        full->SetGeometry(&fom.map, pool.points[c]);
+        PetscCall(rm.Solve(pool.points[c], &sol));
+        const bool ok = sol.converged && sol.estimate.available;
+        e.value       = ok ? sol.estimate.uRaw : PETSC_MAX_REAL;
+        e.residual    = ok ? sol.estimate.uRaw : PETSC_MAX_REAL;
+        e.penetration = ok ? sol.estimate.lambdaRaw : PETSC_MAX_REAL;
+      } else PetscCall(ind.EvaluateReduced(fom, cmap, order, rm, *full, bs.pod.modes, bs.dual.W, pool.points[c], &e));
       val[c]             = e.value;
       val[npool + c]     = e.residual;
       val[2 * npool + c] = e.penetration;
@@ -148,8 +183,14 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     r["R"]               = (long long)bs.dual.W.cols;
     r["candidates"]      = (long long)ncand;
     r["max_indicator"]   = Finite(std::vector<double>{eta[best]})[0];
-    r["max_residual"]    = (double)maxRes;
-    r["max_penetration"] = (double)maxPen;
+    r["indicator"]       = estimated ? "estimate" : byEstimate ? "residual" : go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : "max";
+    if (estimated) { // the raw u and lambda changes of the online estimate (docs/error_estimate.md)
+      r["max_estimate_u"]      = (double)maxRes;
+      r["max_estimate_lambda"] = (double)maxPen;
+    } else {
+      r["max_residual"]    = (double)maxRes;
+      r["max_penetration"] = (double)maxPen;
+    }
     r["rom_failures"]    = (long long)nfail;
     r["argmax"]          = std::vector<double>(pool.points[best].begin(), pool.points[best].end());
     r["seconds_model"]   = (double)(t1 - t0);
@@ -157,7 +198,7 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     if (go.monitor && wrank == 0) {
       std::ostringstream m;
       for (auto v : pool.points[best]) m << " " << v;
-      PetscCall(PetscPrintf(PETSC_COMM_SELF, "  greedy round %2" PetscInt_FMT ": %3" PetscInt_FMT " solves, N %3" PetscInt_FMT " R %3" PetscInt_FMT ", max indicator %.3e (residual %.3e, penetration %.3e, %" PetscInt_FMT " failed) at mu =%s; model %.2f s, indicator %.2f s (%" PetscInt_FMT " candidates)\n", round, nsolved, bs.pod.N, bs.dual.W.cols, (double)eta[best], (double)maxRes, (double)maxPen, nfail, m.str().c_str(), (double)(t1 - t0), (double)(t2 - t1), ncand));
+      PetscCall(PetscPrintf(PETSC_COMM_SELF, "  greedy round %2" PetscInt_FMT ": %3" PetscInt_FMT " solves, N %3" PetscInt_FMT " R %3" PetscInt_FMT ", max indicator %.3e (%s %.3e, %s %.3e, %" PetscInt_FMT " failed) at mu =%s; model %.2f s, indicator %.2f s (%" PetscInt_FMT " candidates)\n", round, nsolved, bs.pod.N, bs.dual.W.cols, (double)eta[best], estimated ? "estimate u" : "residual", (double)maxRes, estimated ? "lambda" : "penetration", (double)maxPen, nfail, m.str().c_str(), (double)(t1 - t0), (double)(t2 - t1), ncand));
     }
     if (eta[best] <= go.tol) {
       r["picked"] = std::vector<double>();
@@ -180,7 +221,8 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
   g["tol"]                  = (double)go.tol;
   g["max_solves"]           = (long long)go.maxSolves;
   g["separation"]           = (double)(go.separation * spacing);
-  g["indicator"]            = go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : "max"; // of the reduced model with exact contact terms
+  g["indicator"]            = go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : go.criterion == GreedyCriterion::Max ? "max" : "estimate"; // of the reduced model with exact contact terms
+  g["estimate_rounds"]      = (long long)nEstimateRounds; // rounds ranked by the online estimate (-greedy_indicator estimate)
   g["stop"]                 = stop;
   g["reached_tol"]          = stop == "tol";
   g["training_set_size"]    = (long long)done.size();
