@@ -78,11 +78,11 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscFunctionBeginUser;
   PetscCheck(m > 0, world, PETSC_ERR_ARG_SIZ, "offline: no snapshot to build the bases from");
   // --- the error estimate's enrichment (-estimate): the same bases to tighter tolerances, the answer's sizes noted
-  PetscBool estimate = PETSC_FALSE, podNSet = PETSC_FALSE, podTolSet, dualTolSet;
+  PetscBool estimate = PETSC_FALSE, podNSet = PETSC_FALSE;
   PetscReal podTol = 1e-8, dualTol = 1e-3, estPodTol = -1, estDualTol = -1; // the defaults of ComputePOD and BuildDualBasis
   char      dualType[16] = "cpg";
-  PetscCall(PetscOptionsGetReal(NULL, "pod_", "-tol", &podTol, &podTolSet));
-  PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, &dualTolSet));
+  PetscCall(PetscOptionsGetReal(NULL, "pod_", "-tol", &podTol, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, NULL));
   PetscCall(PetscOptionsHasName(NULL, "pod_", "-n", &podNSet));
   PetscCall(PetscOptionsGetString(NULL, "dual_", "-type", dualType, sizeof dualType, NULL));
   PetscOptionsBegin(world, NULL, "Online error estimate (offline)", "OfflineBases");
@@ -179,7 +179,7 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     }
     if (estimate && strcmp(dualType, "nmf")) { // a greedy: its first vectors are those of the looser tolerance
       PetscCall(withOption("-dual_tol", estDualTol, [&]() { return BuildDualBasis(L, &dual); }));
-      const PetscReal tolAbs = estDualTol > 0 ? dual.tolAbs * dualTol / estDualTol : dualTol;
+      const PetscReal tolAbs = dual.tolAbs * dualTol / estDualTol; // the answer's absolute tolerance
       PetscInt        r      = dual.W.cols;
       for (size_t k = 0; k < dual.history.size(); ++k)
         if (dual.history[k] <= tolAbs) {
