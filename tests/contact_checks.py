@@ -549,9 +549,38 @@ def saddle(args):
           "-fom_saddle_pdas_max_it 2: refused with a message naming the option, the report says so (exit %d)" % p.returncode)
 
 
+def search(args):
+    """-contact_master_search near (each rank holds the master facets near its slave facets) against all (np 1 and 2)."""
+    print("Master facets near the slave facets (-contact_master_search near) vs every master facet (np %d)" % args.np)
+    cases = [("ring_on_block", []), ("half_disks", []), ("half_disks", ["-contact_master_search_margin", "0.3"]), ("flat_punch3d", []),
+             ("hertz3d", ["-mesh_geo_set", "h_fine=0.08,h_far=1.2"]), ("hertz3d", ["-mesh_geo_set", "h_fine=0.08,h_far=1.2", "-contact_master_search_margin", "0.3"])]
+    for s, opts in cases:
+        tag = s + "".join(opts).replace("=", "").replace(",", "").replace("-", "_")
+        part = ["-mesh_partitioner", "metis"] if args.np > 1 else []
+        ra, _ = run(args, args.np, "runs/%s.opts" % s, [o for o in opts if "margin" not in o and o != "0.3"] + part + ["-contact_master_search", "all"], tag + "_all")
+        rn, _ = run(args, args.np, "runs/%s.opts" % s, opts + part + ["-contact_master_search", "near"], tag + "_near")
+        cs = rn["contact_search"]
+        d = abs(rn["contact_force"] - ra["contact_force"]) / ra["contact_force"]
+        print("  %-44s force %.15g / %.15g (rel %.1e), held %d of %d master facets, %d of %d assemblies fell back, %d points out of reach"
+              % (tag, rn["contact_force"], ra["contact_force"], d, cs["master_facets_held_max"], cs["master_facets_total"], cs["fallbacks"], cs["assemblies"], cs["far_points"]))
+        check(d <= 1e-12 and rn["kacanov_iterations"] == ra["kacanov_iterations"] and rn["nactive"] == ra["nactive"],
+              "%s: the same force (rel %.1e <= 1e-12), Kacanov iterations and active set as with every facet" % (tag, d))
+        check(ra["contact_search"]["type"] == "all" and ra["contact_search"]["master_facets_held_max"] == ra["contact_search"]["master_facets_total"], "%s: all holds the whole master" % tag)
+        if s == "half_disks" and opts and args.np > 1:
+            check(cs["master_facets_held_max"] < cs["master_facets_total"] and cs["far_points"] > 0 and cs["fallbacks"] == 0,
+                  "%s: a rank holds fewer master facets than the master's (%d of %d), with points out of reach" % (tag, cs["master_facets_held_max"], cs["master_facets_total"]))
+        if s == "hertz3d" and opts[-1] == "0.3":
+            check(cs["fallbacks"] == cs["assemblies"], "%s: the graded mesh puts large facets within half the margin: every assembly falls back to all" % tag)
+    for extra, needle in ((["-contact_master_search", "bogus"], "-contact_master_search"), (["-contact_master_search_margin", "-1"], "-contact_master_search_margin")):
+        out = workdir("rbc_contact_")
+        p = subprocess.run(["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/flat_punch.opts"] + extra + ["-report", out + "/x.json"],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and needle in p.stdout, "refused with a message naming %s" % needle)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

@@ -122,7 +122,14 @@ public:
   // Options: -contact_quadrature gauss|nodal, -contact_quadrature_points n, -contact_normal smooth|facet,
   // -contact_multiplier dual|standard (nodal quadrature: standard, collocation is already diagonal),
   // -contact_segment_search pair|full (2D mortar segments: how the switches of the closest master facet
-  // are bisected; the same cuts, full = the closest-point search at every bisection step, the reference).
+  // are bisected; the same cuts, full = the closest-point search at every bisection step, the reference),
+  // -contact_master_search all|near (each rank holds every master facet, or only those within a margin of its
+  // slave facets' bounding box: a slave point whose closest master facet lies within the margin less a band of
+  // facet diameters gets the answer of all; a point beyond is out of reach, its row an inactive constraint (its
+  // distance to the master as gap, K from the closest facet held); a rank with slave facets and no master facet,
+  // or a margin leaving less than 4 slave facet diameters of exact reach, makes every rank fall back to all for
+  // that assembly), -contact_master_search_margin m (default: half the slave surface's bounding-box diagonal +
+  // 4 master + 2 slave facet diameters).
   PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
   // Moves both surfaces to the physical configuration at mu (reference configuration + map).
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
@@ -156,8 +163,21 @@ public:
   bool              smoothNormal = true;
   ContactMultiplier multiplier   = ContactMultiplier::Dual;
   bool              segmentPairSearch = true;
+  bool              masterSearchNear  = false; // -contact_master_search near
+  PetscReal         masterSearchMargin = -1;   // -contact_master_search_margin (< 0: automatic)
+  // The master facets this rank held at the last Assemble, the whole master's, and the assemblies that fell back
+  // from near to all (report key contact_search).
+  struct MasterSearchStats {
+    PetscInt held = 0, total = 0, fallbacks = 0, assemblies = 0, farPoints = 0; // farPoints: out of reach, last assembly
+  };
+  const MasterSearchStats &MasterSearch() const { return searchStats_; }
 
 private:
+  // masterAll_ := the master facets near this rank's slave facets (-contact_master_search near): those whose
+  // deformed bounding box meets the slave facets' box grown by the margin (*margin, *hs, *hm: the margin and the
+  // largest slave and master facet diameters). Collective; the relative order of the facets is that of Gather.
+  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *hs, PetscReal *hm);
+  MasterSearchStats searchStats_;
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
   PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);
   void           SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const;

@@ -80,6 +80,16 @@ PetscErrorCode StageFom(MPI_Comm comm)
       sd["krylov"]         = (long long)nk;
     }
     if (kacanov.contactDofs >= 0) rep.root["contact_dofs"] = (long long)kacanov.contactDofs; // the dofs of the slave and master facets (the rows of the dense G)
+    { // the master facets each rank held (-contact_master_search all|near, docs/contact.md "Parallel")
+      const auto &ms = map.MasterSearch();
+      JsonValue  &j  = rep.root["contact_search"];
+      j["type"]              = map.masterSearchNear ? "near" : "all";
+      j["master_facets_held_max"] = (long long)ms.held; // the largest count on one rank, last assembly
+      j["master_facets_total"]    = (long long)ms.total;
+      j["fallbacks"]              = (long long)ms.fallbacks; // near: assemblies that fell back to all
+      j["assemblies"]             = (long long)ms.assemblies;
+      j["far_points"]             = (long long)ms.farPoints; // near: integration points out of reach, last assembly
+    }
     rep.root["initial_overlap"]["max_penetration"] = (double)kacanov.initialPenetration; // at u = 0 (0: none)
     rep.root["initial_overlap"]["nodes"]           = (long long)kacanov.initialPenetrating;
     rep.root["ncontact"]           = (long long)cs.R;

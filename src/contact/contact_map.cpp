@@ -114,6 +114,15 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   else if (!strcmp(seg, "full")) segmentPairSearch = false;
   else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_segment_search: unknown value '%s' (pair or full)", seg);
   {
+    char ms[16] = "all";
+    PetscCall(PetscOptionsString("-contact_master_search", "Master facets held by each rank: all (gathered) or near (those near its slave facets)", "docs/contact.md", ms, ms, sizeof ms, NULL));
+    if (!strcmp(ms, "all")) masterSearchNear = false;
+    else if (!strcmp(ms, "near")) masterSearchNear = true;
+    else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_master_search: unknown value '%s' (all or near)", ms);
+    PetscCall(PetscOptionsReal("-contact_master_search_margin", "near: the margin around the slave facets' bounding box (default automatic)", "docs/contact.md", masterSearchMargin, &masterSearchMargin, &flg));
+    PetscCheck(!flg || (masterSearchMargin > 0 && std::isfinite(masterSearchMargin)), comm, PETSC_ERR_ARG_OUTOFRANGE, "-contact_master_search_margin %g must be > 0", (double)masterSearchMargin);
+  }
+  {
     char cm[32] = "auto"; // read by ElasticFOM and SurfaceCompliance (listed here for -help)
     PetscCall(PetscOptionsString("-contact_compliance", "Surface compliance (A^-1)_DD: auto, schur, inverse, redundant or solves", "docs/contact.md", cm, cm, sizeof cm, NULL));
   }
@@ -434,6 +443,104 @@ void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std
     if (cuts[i + 1] > cuts[i]) segs->emplace_back(cuts[i], cuts[i + 1]);
 }
 
+// The deformed vertices' bounding box of a facet (the geometry of the closest-point search) and its diagonal.
+static PetscReal FacetBox(const SurfaceFacet &F, PetscInt dim, PetscReal lo[3], PetscReal hi[3])
+{
+  for (PetscInt d = 0; d < 3; ++d) {
+    lo[d] = PETSC_MAX_REAL;
+    hi[d] = -PETSC_MAX_REAL;
+  }
+  for (PetscInt k = 0; k < F.nv; ++k) {
+    PetscInt node = -1;
+    for (PetscInt i = 0; i < F.nnodes; ++i)
+      if (F.nodeKind[i] == k) node = i;
+    for (PetscInt d = 0; d < dim; ++d) {
+      const PetscReal x = F.X[k * dim + d] + (node >= 0 ? F.U[node * dim + d] : 0.0);
+      lo[d]             = std::min(lo[d], x);
+      hi[d]             = std::max(hi[d], x);
+    }
+  }
+  PetscReal diag = 0;
+  for (PetscInt d = 0; d < dim; ++d) diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+  return std::sqrt(diag);
+}
+
+PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *hs, PetscReal *hm)
+{
+  const PetscInt dim = slave_.facets.empty() ? (master_.facets.empty() ? 2 : master_.facets[0].nv) : slave_.facets[0].nv;
+  PetscMPIInt    size;
+  PetscReal      box[6], lo[3], hi[3], h[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  // this rank's slave box (empty: lo > hi), the largest facet diameters
+  for (PetscInt d = 0; d < 3; ++d) {
+    box[d]     = PETSC_MAX_REAL;
+    box[3 + d] = -PETSC_MAX_REAL;
+  }
+  for (const auto &F : slave_.facets) {
+    h[0] = std::max(h[0], FacetBox(F, dim, lo, hi));
+    for (PetscInt d = 0; d < dim; ++d) {
+      box[d]     = std::min(box[d], lo[d]);
+      box[3 + d] = std::max(box[3 + d], hi[d]);
+    }
+  }
+  for (const auto &F : master_.facets) h[1] = std::max(h[1], FacetBox(F, dim, lo, hi));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, h, 2, MPIU_REAL, MPI_MAX, comm));
+  std::vector<PetscReal> boxes(6 * size);
+  PetscCallMPI(MPI_Allgather(box, 6, MPIU_REAL, boxes.data(), 6, MPIU_REAL, comm));
+  PetscReal diag = 0;
+  {
+    PetscReal all[6];
+    for (PetscInt d = 0; d < 3; ++d) {
+      all[d]     = PETSC_MAX_REAL;
+      all[3 + d] = -PETSC_MAX_REAL;
+    }
+    for (PetscMPIInt r = 0; r < size; ++r)
+      for (PetscInt d = 0; d < dim; ++d) {
+        all[d]     = std::min(all[d], boxes[6 * r + d]);
+        all[3 + d] = std::max(all[3 + d], boxes[6 * r + 3 + d]);
+      }
+    for (PetscInt d = 0; d < dim; ++d)
+      if (all[3 + d] >= all[d]) diag += (all[3 + d] - all[d]) * (all[3 + d] - all[d]);
+    diag = std::sqrt(diag);
+  }
+  *hs     = h[0];
+  *hm     = h[1];
+  *margin = masterSearchMargin > 0 ? masterSearchMargin : 0.5 * diag + 4 * h[1] + 2 * h[0];
+  // each local master facet to every rank whose grown slave box it meets
+  const int                      bytes = (int)sizeof(SurfaceFacet);
+  std::vector<std::vector<char>> out(size);
+  for (const auto &F : master_.facets) {
+    FacetBox(F, dim, lo, hi);
+    for (PetscMPIInt r = 0; r < size; ++r) {
+      bool meets = boxes[6 * r] <= boxes[6 * r + 3]; // a rank without slave facets needs none
+      for (PetscInt d = 0; d < dim && meets; ++d) meets = lo[d] <= boxes[6 * r + 3 + d] + *margin && hi[d] >= boxes[6 * r + d] - *margin;
+      if (meets) out[r].insert(out[r].end(), reinterpret_cast<const char *>(&F), reinterpret_cast<const char *>(&F) + bytes);
+    }
+  }
+  std::vector<int> scount(size), rcount(size), sdispl(size), rdispl(size);
+  long long        stot = 0, rtot = 0;
+  for (PetscMPIInt r = 0; r < size; ++r) {
+    scount[r] = (int)out[r].size();
+    sdispl[r] = (int)stot;
+    stot += scount[r];
+  }
+  PetscCheck(stot < 2147483647LL, comm, PETSC_ERR_SUP, "Master surface too large to exchange (%lld bytes)", stot);
+  PetscCallMPI(MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt r = 0; r < size; ++r) {
+    rdispl[r] = (int)rtot;
+    rtot += rcount[r];
+  }
+  PetscCheck(rtot < 2147483647LL, comm, PETSC_ERR_SUP, "Master surface too large to exchange (%lld bytes)", rtot);
+  std::vector<char> sbuf(stot);
+  for (PetscMPIInt r = 0; r < size; ++r) std::copy(out[r].begin(), out[r].end(), sbuf.begin() + sdispl[r]);
+  masterAll_.resize(rtot / bytes);
+  // SurfaceFacet is trivially copyable: raw bytes, as Gather (homogeneous cluster assumed)
+  PetscCallMPI(MPI_Alltoallv(sbuf.data(), scount.data(), sdispl.data(), MPI_BYTE, masterAll_.data(), rcount.data(), rdispl.data(), MPI_BYTE, comm));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSystem *sys)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)elas.dm);
@@ -474,9 +581,43 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
     PetscCheck(!bad, comm, PETSC_ERR_FP, "contact: the displacement or the geometry of the contact surfaces holds non-finite values (a NaN in the data, or a singular elastic solve): the contact map cannot be evaluated");
   }
-  PetscCall(master_.Gather(comm, &masterAll_));
   ClosestPoint cp;
-  PetscCall(cp.Build(masterAll_, dim, true));
+  ++searchStats_.assemblies;
+  // near: a point whose closest master facet is within exactReach of it sees the answer of all (that facet, the
+  // facets around its vertices (normals) and the 3D clipping's neighbours all lie within the margin of the slave
+  // box); a point farther than that is out of reach: its K entries come from the closest facet held and its gap
+  // is its distance to the master (> exactReach: an inactive constraint, as in all); no facet at all on a rank with
+  // slave facets: every rank falls back to all for this assembly
+  PetscReal searchMargin = PETSC_MAX_REAL; // near: the margin in use (PETSC_MAX_REAL: every master facet held)
+  PetscInt  farPoints = 0, nearFar = 0;
+  if (masterSearchNear) {
+    PetscReal margin, hs, hm;
+    PetscCall(GatherNearMaster(comm, &margin, &hs, &hm));
+    // (a margin that leaves less than 4 slave facet diameters of exact reach could put an active point and one out of
+    // reach in the same multiplier row: all then)
+    (void)hs;
+    (void)hm;
+    searchMargin = margin;
+    PetscCall(cp.Build(masterAll_, dim, true));
+    PetscInt bad = masterAll_.empty() && !slave_.facets.empty();
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
+    if (bad) {
+      ++searchStats_.fallbacks;
+      searchMargin = PETSC_MAX_REAL;
+      PetscCall(master_.Gather(comm, &masterAll_));
+      PetscCall(cp.Build(masterAll_, dim, true));
+    }
+  } else {
+    PetscCall(master_.Gather(comm, &masterAll_));
+    PetscCall(cp.Build(masterAll_, dim, true));
+  }
+  {
+    PetscInt held = (PetscInt)masterAll_.size(), total = (PetscInt)master_.facets.size();
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &held, 1, MPIU_INT, MPI_MAX, comm));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &total, 1, MPIU_INT, MPI_SUM, comm));
+    searchStats_.held  = held;
+    searchStats_.total = total;
+  }
   // Nodal normals of the deformed master (area-weighted facet normals)
   std::unordered_map<PetscInt, std::array<PetscReal, 3>> vnormal;
   if (smoothNormal) {
@@ -543,6 +684,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     for (const auto &ip : ipts) {
       const PetscReal  b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
       ContactPointEval e;
+      PetscReal        found = 0; // the distance to the closest master facet held
       EvaluateContactPoint(
         F, dim, b, masterAll_, cp.Vertices(0), smoothNormal,
         [&](const PetscReal *p, PetscInt *m, PetscReal *bm, PetscReal *dist) {
@@ -550,9 +692,13 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
           // their reach (a closer facet would be among them); else the bin search
           if (!near3.empty()) {
             cp.FindAmong(p, near3.data(), (PetscInt)near3.size(), m, bm, dist);
-            if (*m >= 0 && *dist < reach3) return;
+            if (*m >= 0 && *dist < reach3) {
+              found = *dist;
+              return;
+            }
           }
           cp.Find(p, m, bm, dist);
+          found = *dist;
         },
         [&](const SurfaceFacet &M, PetscInt k) { return vnormal[M.vglobal[k]].data(); }, &e);
       {
@@ -567,8 +713,18 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
         points_.push_back(P);
       }
       const SurfaceFacet &M = masterAll_[e.m];
-      const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2, gap = e.gap;
-      if (dim == 2)
+      const PetscReal    *Ns = e.Ns, *Nm = e.Nm, *n2 = e.n2;
+      // -contact_master_search near: within reach when the found facet f, the facets around its vertices (within
+      // found + diam f) and the 3D clipping's neighbours (within found + diam F + diam f) are surely held
+      bool far = false;
+      if (searchMargin < PETSC_MAX_REAL) {
+        PetscReal lo[3], hi[3];
+        far = found + 2 * FacetBox(F, dim, lo, hi) + 3 * FacetBox(M, dim, lo, hi) > searchMargin;
+        nearFar += far && found < 0.5 * searchMargin; // out of reach by its facets' size, not its distance
+      }
+      const PetscReal gap = far ? found : e.gap;
+      farPoints += far;
+      if (dim == 2 && !far)
         for (PetscInt k = 0; k < 2; ++k)
           if (e.bm[k] == 1.0 && vcount[M.vglobal[k]] == 1) {
             // clamped to an end vertex: past the end when the slave point lies beyond it along the facet
@@ -616,6 +772,24 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
         PetscCall(VecSetValue(sys->coordRef[d], rows[k], F.Xref[k * dim + d], INSERT_VALUES));
       }
   }
+  {
+    PetscInt c[2] = {farPoints, nearFar};
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, c, 2, MPIU_INT, MPI_SUM, comm));
+    farPoints = c[0];
+    nearFar   = c[1];
+  }
+  if (nearFar > 0) { // a point out of reach closer than half the margin (large facets there): this assembly again with all
+    PetscCall(MatDestroy(&sys->K));
+    ++searchStats_.fallbacks;
+    const bool near  = masterSearchNear;
+    masterSearchNear = false;
+    --searchStats_.assemblies;
+    PetscErrorCode ierr = Assemble(elas, uloc, sys);
+    masterSearchNear = near;
+    PetscCall(ierr);
+    PetscFunctionReturn(0);
+  }
+  searchStats_.farPoints = farPoints;
   // K with its exact pattern (a MATPREALLOCATOR pass over the buffered rows, then the values: a fixed
   // guess of 48 per row reallocated K's storage for almost every row of a 3D surface, 476 times per assembly
   // on hertz3d), then the same rows in the same order
