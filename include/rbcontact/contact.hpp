@@ -174,9 +174,9 @@ public:
 
 private:
   // masterAll_ := the master facets near this rank's slave facets (-contact_master_search near): those whose
-  // deformed bounding box meets the slave facets' box grown by the margin (*margin, *hs, *hm: the margin and the
-  // largest slave and master facet diameters). Collective; the relative order of the facets is that of Gather.
-  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *hs, PetscReal *hm);
+  // deformed bounding box meets the slave facets' box grown by *margin (the option's, or the automatic one).
+  // Collective; the relative order of the facets is that of Gather.
+  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin);
   MasterSearchStats searchStats_;
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
   PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);

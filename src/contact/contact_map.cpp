@@ -465,7 +465,7 @@ static PetscReal FacetBox(const SurfaceFacet &F, PetscInt dim, PetscReal lo[3], 
   return std::sqrt(diag);
 }
 
-PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *hs, PetscReal *hm)
+PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
 {
   const PetscInt dim = slave_.facets.empty() ? (master_.facets.empty() ? 2 : master_.facets[0].nv) : slave_.facets[0].nv;
   PetscMPIInt    size;
@@ -505,8 +505,6 @@ PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin, Pe
       if (all[3 + d] >= all[d]) diag += (all[3 + d] - all[d]) * (all[3 + d] - all[d]);
     diag = std::sqrt(diag);
   }
-  *hs     = h[0];
-  *hm     = h[1];
   *margin = masterSearchMargin > 0 ? masterSearchMargin : 0.5 * diag + 4 * h[1] + 2 * h[0];
   // each local master facet to every rank whose grown slave box it meets
   const int                      bytes = (int)sizeof(SurfaceFacet);
@@ -583,21 +581,14 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   }
   ClosestPoint cp;
   ++searchStats_.assemblies;
-  // near: a point whose closest master facet is within exactReach of it sees the answer of all (that facet, the
-  // facets around its vertices (normals) and the 3D clipping's neighbours all lie within the margin of the slave
-  // box); a point farther than that is out of reach: its K entries come from the closest facet held and its gap
-  // is its distance to the master (> exactReach: an inactive constraint, as in all); no facet at all on a rank with
-  // slave facets: every rank falls back to all for this assembly
+  // near (docs/contact.md "Parallel"): a point within reach of the margin (below, per point) sees the answer of
+  // all; a point beyond is out of reach: its K entries come from the closest facet held and its gap is its distance
+  // to the master (an inactive constraint, as in all); a rank with slave facets and no master facet, or a point out
+  // of reach at less than half the margin (large facets there), makes every rank assemble again with all
   PetscReal searchMargin = PETSC_MAX_REAL; // near: the margin in use (PETSC_MAX_REAL: every master facet held)
   PetscInt  farPoints = 0, nearFar = 0;
   if (masterSearchNear) {
-    PetscReal margin, hs, hm;
-    PetscCall(GatherNearMaster(comm, &margin, &hs, &hm));
-    // (a margin that leaves less than 4 slave facet diameters of exact reach could put an active point and one out of
-    // reach in the same multiplier row: all then)
-    (void)hs;
-    (void)hm;
-    searchMargin = margin;
+    PetscCall(GatherNearMaster(comm, &searchMargin));
     PetscCall(cp.Build(masterAll_, dim, true));
     PetscInt bad = masterAll_.empty() && !slave_.facets.empty();
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
