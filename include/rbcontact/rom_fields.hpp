@@ -5,6 +5,7 @@
 #include <memory>
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/contact.hpp"
+#include "rbcontact/dual_basis.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/report.hpp"
@@ -37,6 +38,9 @@ PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const Sc
 PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, ContactSystem *sys);
 // Its weights int psi_i (the slave mass) on every rank, in canonical multiplier order. Collective on fom.
 PetscErrorCode ReferenceSlaveMass(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, std::vector<PetscReal> *w);
+// W' diag(w) W (r x r, row-major) for the dual basis W (R_fom x r) and that slave mass w: the norm of validate's lambda
+// error on the reduced multipliers (the error estimate's, ReducedModel::massGram).
+std::vector<PetscReal> SlaveMassGram(const DenseMatrix &W, const std::vector<PetscReal> &w);
 // The full contact patch (ContactPatch::BuildFull) on the support of the dual basis Wt (r x R_fom,
 // row-major, canonical) with the primal basis modes (N x ndofs, canonical), nsub composite pieces, and
 // P = W' Psi (r x Q, row-major). The surfaces are assembled at the default parameter with u = 0 (they

@@ -117,16 +117,9 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     if (byEstimate) {
       PetscCheck(bs.estimate, world, PETSC_ERR_ARG_INCOMP, "-greedy_indicator estimate needs -estimate (the enriched bases of the online error estimate)");
       if (bs.nDefault > 0 || bs.rDefault > 0) {
-        const PetscInt R = bs.dual.W.cols, Rfom = bs.dual.W.rows;
-        rm.NDefault      = bs.nDefault > 0 ? bs.nDefault : bs.pod.N - bs.nsup;
-        rm.RDefault      = bs.rDefault > 0 ? bs.rDefault : R;
-        rm.massGram.assign((size_t)R * R, 0.0);
-        for (PetscInt i = 0; i < R; ++i)
-          for (PetscInt j = 0; j < R; ++j) {
-            PetscReal g = 0;
-            for (PetscInt k = 0; k < Rfom; ++k) g += bs.dual.W(k, i) * slaveMass[k] * bs.dual.W(k, j);
-            rm.massGram[(size_t)i * R + j] = g;
-          }
+        rm.NDefault = bs.nDefault > 0 ? bs.nDefault : bs.pod.N - bs.nsup;
+        rm.RDefault = bs.rDefault > 0 ? bs.rDefault : bs.dual.W.cols;
+        rm.massGram = SlaveMassGram(bs.dual.W, slaveMass);
         PetscCall(rm.Truncate(-1, -1, -1, -1));
         estimated = true;
         ++nEstimateRounds;

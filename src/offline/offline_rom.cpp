@@ -488,13 +488,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     if (nDefault > 0 || rDefault > 0) {
       rm.NDefault = nDefault > 0 ? nDefault : Npod;
       rm.RDefault = rDefault > 0 ? rDefault : R;
-      rm.massGram.assign((size_t)R * R, 0.0);
-      for (PetscInt i = 0; i < R; ++i)
-        for (PetscInt j = 0; j < R; ++j) {
-          PetscReal g = 0;
-          for (PetscInt k = 0; k < Rfom; ++k) g += dual.W(k, i) * wc[k] * dual.W(k, j);
-          rm.massGram[(size_t)i * R + j] = g;
-        }
+      rm.massGram = SlaveMassGram(dual.W, wc);
       PetscCall(rm.Truncate(-1, -1, -1, -1)); // the answer's sizes (report)
     }
   }

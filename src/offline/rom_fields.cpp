@@ -143,6 +143,19 @@ PetscErrorCode AssembleReferenceContact(ElasticFOM &fom, ContactMap &cmap, Canon
   PetscFunctionReturn(0);
 }
 
+std::vector<PetscReal> SlaveMassGram(const DenseMatrix &W, const std::vector<PetscReal> &w)
+{
+  const PetscInt         r = W.cols;
+  std::vector<PetscReal> G((size_t)r * r, 0.0);
+  for (PetscInt i = 0; i < r; ++i)
+    for (PetscInt j = 0; j < r; ++j) {
+      PetscReal g = 0;
+      for (PetscInt k = 0; k < W.rows; ++k) g += W(k, i) * w[k] * W(k, j);
+      G[(size_t)i * r + j] = g;
+    }
+  return G;
+}
+
 PetscErrorCode ReferenceSlaveMass(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, std::vector<PetscReal> *w)
 {
   ContactSystem          sys;
