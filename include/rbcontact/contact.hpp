@@ -74,7 +74,6 @@ private:
   std::vector<PetscReal> xdef_;
   std::vector<PetscReal> invLen2_; // 2D: 1 / |x1 - x0|^2 per facet (0 for a degenerate one), set with the vertices
   std::vector<PetscReal> sphere_;  // 3D: per facet a bounding sphere (centroid, radius), set with the vertices
-  mutable std::vector<PetscReal> d2c_; // FindAmong's scratch: squared distances to the candidates' centroids
   PetscReal             lo_[3] = {0, 0, 0}, h_[3] = {1, 1, 1};
   PetscInt              nb_[3] = {1, 1, 1};
   std::vector<PetscInt> binStart_, binFacets_;

@@ -166,8 +166,10 @@ public:
   // the FOM (kacanov_loop.hpp). Tolerances matched to the ROM's accuracy targets (docs/online.md): 1e-5 on the
   // primal change (u target 1e-4; the loop's own error is about c/(1-c) times the last change, c <= 0.25
   // measured), 1e-4 on the dual one (lambda target 1e-2); the first iterate's dual change against a warm
-  // start's multipliers is recorded, not tested
-  KacanovLoop loop{1e-5, 1e-4, "ROM Kacanov"};
+  // start's multipliers is recorded, not tested. A ROM file stores the tolerances it was built with
+  // (/online/kacanov_rtol, the offline stage's -rom_kacanov_rtol_*): Open sets them, options override them.
+  static constexpr PetscReal kRtolPrimal = 1e-5, kRtolDual = 1e-4;
+  KacanovLoop                loop{kRtolPrimal, kRtolDual, "ROM Kacanov"};
   PetscReal   kktTol    = 1e-8;
   PetscBool   warmStart = PETSC_TRUE;
   PetscInt    warmDegree = 2; // -rom_warm_start_degree: the polynomial fit with several parameters (warm_start.hpp)

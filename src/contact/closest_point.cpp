@@ -74,10 +74,12 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
     *dist = *facet >= 0 ? std::sqrt(best) : PETSC_MAX_REAL;
     return;
   }
-  // 3D: the candidate whose centroid is nearest first, then only the candidates whose bounding sphere
-  // (centroid c, radius r) may hold a point at the best distance so far, |p - c| <= sqrt(best) + r: a skipped
-  // one is farther than the result, so the facet and coordinates are those of the full scan. The reduced
-  // model's cubature points spent most of their time in the triangle distances of this scan (docs/rom3d.md).
+  // 3D: one pass in the given order (the reduced model's lists are sorted nearest first offline), visiting only
+  // the candidates whose bounding sphere (centroid c, radius r) may hold a point at the best distance so far,
+  // |p - c| <= sqrt(best) + r: a skipped one is farther than the result, so the facet and coordinates are those
+  // of the full scan (ties to the lower facet number, as there). The reduced model's cubature points spent most
+  // of their time in the triangle distances of the full scan, then in a second pass over the candidates
+  // (docs/rom3d.md).
   auto visit = [&](PetscInt f) {
     PetscReal       bb[3];
     const PetscReal dd = DistToFacet2(f, p, bb);
@@ -87,19 +89,14 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
       for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
     }
   };
-  if (dim_ == 3 && nc > 1) { // sphere_ is set with the vertices
-    d2c_.resize(nc);
-    PetscInt first = 0;
+  if (dim_ == 3) { // sphere_ is set with the vertices
+    PetscReal sb = PETSC_MAX_REAL;
     for (PetscInt i = 0; i < nc; ++i) {
       const PetscReal *c = &sphere_[4 * cand[i]];
-      d2c_[i]            = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
-      if (d2c_[i] < d2c_[first]) first = i;
-    }
-    visit(cand[first]);
-    PetscReal sb = std::sqrt(best);
-    for (PetscInt i = 0; i < nc; ++i) {
-      const PetscReal reach = sb + sphere_[4 * cand[i] + 3];
-      if (i == first || d2c_[i] > reach * reach) continue;
+      if (*facet >= 0) {
+        const PetscReal d2c = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]), reach = sb + c[3];
+        if (d2c > reach * reach) continue;
+      }
       const PetscReal before = best;
       visit(cand[i]);
       if (best != before) sb = std::sqrt(best);

@@ -580,6 +580,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["surface_weight_check"] = (double)surfaceWeightDiff;      // max rel diff of int psi_i: facets vs the FOM
   ro["affine_A"] = (long long)rm.par.NumA();
   ro["affine_f"] = (long long)rm.par.NumF();
+  ro["kacanov_rtol_primal"] = (double)rm.loop.rtolPrimal; // stored in the file: the online default (/online/kacanov_rtol)
+  ro["kacanov_rtol_dual"]   = (double)rm.loop.rtolDual;
   rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);
   rep->root["time_s"]["eim"]           = (double)(t2 - t1);
   rep->root["time_s"]["hyper_snapshots"] = (double)(t1 - t0); // the same two phases under names that fit the

@@ -172,8 +172,46 @@ __attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, Pets
   }
 }
 
+// One point's W row held in NB registers over its terms (each term: load, FMA, store of Q's row)
+template <int NB>
+__attribute__((target("avx2,fma"))) void ScatterAvx2Fixed(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
+{
+  __m256d gs[NB];
+  for (int b = 0; b < NB; ++b) gs[b] = _mm256_loadu_pd(g + 4 * b);
+  for (PetscInt p = 0; p < M; ++p) {
+    const PetscReal *w = W + (size_t)p * rp;
+    __m256d          wr[NB];
+    for (int b = 0; b < NB; ++b) wr[b] = _mm256_loadu_pd(w + 4 * b);
+    const PetscInt  *ri = rowIdx + (size_t)p * maxTerms;
+    const PetscReal *cp = coef + (size_t)p * maxTerms;
+    for (PetscInt t = 0; t < nt[p]; ++t) {
+      const __m256d cf = _mm256_broadcast_sd(cp + t);
+      PetscReal    *q  = Q + (size_t)ri[t] * rp;
+      for (int b = 0; b < NB; ++b) _mm256_storeu_pd(q + 4 * b, _mm256_fmadd_pd(cf, wr[b], _mm256_loadu_pd(q + 4 * b)));
+    }
+    const __m256d gp = _mm256_broadcast_sd(gamma + p);
+    for (int b = 0; b < NB; ++b) gs[b] = _mm256_fmadd_pd(gp, wr[b], gs[b]);
+  }
+  for (int b = 0; b < NB; ++b) _mm256_storeu_pd(g + 4 * b, gs[b]);
+}
+
 __attribute__((target("avx2,fma"))) void ScatterAvx2(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
 {
+  switch (rp / 4) { // up to 12 blocks (48 rows) in registers: the rest of the 16 hold the term's coefficient and Q
+  case 1: return ScatterAvx2Fixed<1>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 2: return ScatterAvx2Fixed<2>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 3: return ScatterAvx2Fixed<3>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 4: return ScatterAvx2Fixed<4>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 5: return ScatterAvx2Fixed<5>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 6: return ScatterAvx2Fixed<6>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 7: return ScatterAvx2Fixed<7>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 8: return ScatterAvx2Fixed<8>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 9: return ScatterAvx2Fixed<9>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 10: return ScatterAvx2Fixed<10>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 11: return ScatterAvx2Fixed<11>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  case 12: return ScatterAvx2Fixed<12>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
+  default: break;
+  }
   for (PetscInt p = 0; p < M; ++p) {
     const PetscReal *w = W + (size_t)p * rp;
     for (PetscInt t = 0; t < nt[p]; ++t) {
@@ -200,9 +238,41 @@ __attribute__((target("avx2,fma"))) void RowDotsAvx2(PetscInt rows, PetscInt n, 
   }
 }
 
+// out (NB blocks of 4) held in registers over the terms: per term one broadcast and NB load-FMAs
+template <int NB>
+__attribute__((target("avx2,fma"))) void CombineAvx2Fixed(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscReal *out)
+{
+  __m256d acc[NB];
+  for (int b = 0; b < NB; ++b) acc[b] = _mm256_setzero_pd();
+  for (PetscInt j = 0; j < nt; ++j) {
+    const __m256d    cf = _mm256_broadcast_sd(coef + j);
+    const PetscReal *t  = rows[j];
+    for (int b = 0; b < NB; ++b) acc[b] = _mm256_fmadd_pd(cf, _mm256_loadu_pd(t + 4 * b), acc[b]);
+  }
+  for (int b = 0; b < NB; ++b) _mm256_storeu_pd(out + 4 * b, acc[b]);
+}
+
 __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out)
 {
   PetscInt k = 0;
+  // the first up to 48 entries with the output in registers (12 blocks), the rest block by block
+  const PetscInt nb = std::min<PetscInt>(n / 4, 12);
+  switch (nb) {
+  case 1: CombineAvx2Fixed<1>(nt, coef, rows, out); break;
+  case 2: CombineAvx2Fixed<2>(nt, coef, rows, out); break;
+  case 3: CombineAvx2Fixed<3>(nt, coef, rows, out); break;
+  case 4: CombineAvx2Fixed<4>(nt, coef, rows, out); break;
+  case 5: CombineAvx2Fixed<5>(nt, coef, rows, out); break;
+  case 6: CombineAvx2Fixed<6>(nt, coef, rows, out); break;
+  case 7: CombineAvx2Fixed<7>(nt, coef, rows, out); break;
+  case 8: CombineAvx2Fixed<8>(nt, coef, rows, out); break;
+  case 9: CombineAvx2Fixed<9>(nt, coef, rows, out); break;
+  case 10: CombineAvx2Fixed<10>(nt, coef, rows, out); break;
+  case 11: CombineAvx2Fixed<11>(nt, coef, rows, out); break;
+  case 12: CombineAvx2Fixed<12>(nt, coef, rows, out); break;
+  default: break;
+  }
+  k = 4 * nb;
   for (; k + 4 <= n; k += 4) {
     __m256d a = _mm256_setzero_pd();
     for (PetscInt j = 0; j < nt; ++j) a = _mm256_fmadd_pd(_mm256_broadcast_sd(coef + j), _mm256_loadu_pd(rows[j] + k), a);

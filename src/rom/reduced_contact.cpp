@@ -227,7 +227,24 @@ void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector
     Point P = points[keep[i]];
     P.facet = snew[P.facet];
     out->points.push_back(P);
-    for (PetscInt m : candSets[i]) out->cand.push_back(mnew[m]);
+    // nearest first (reference centroids): ClosestPoint::FindAmong scans in this order and prunes the rest
+    const SurfaceFacet &S = slave[points[keep[i]].facet];
+    PetscReal           z[3] = {0, 0, 0};
+    for (PetscInt k = 0; k < S.nv; ++k)
+      for (PetscInt d = 0; d < dim; ++d) z[d] += points[keep[i]].b[k] * S.Xref[k * dim + d];
+    std::vector<std::pair<PetscReal, PetscInt>> order;
+    for (PetscInt m : candSets[i]) {
+      const SurfaceFacet &Mf = master[m];
+      PetscReal           d2 = 0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        PetscReal c = 0;
+        for (PetscInt k = 0; k < Mf.nv; ++k) c += Mf.Xref[k * dim + d] / Mf.nv;
+        d2 += (z[d] - c) * (z[d] - c);
+      }
+      order.emplace_back(d2, mnew[m]);
+    }
+    std::sort(order.begin(), order.end());
+    for (auto &o : order) out->cand.push_back(o.second);
     out->candStart.push_back((PetscInt)out->cand.size());
   }
 }

@@ -187,6 +187,8 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["Mc"]       = (long long)m.Mc();
   (*r)["hyper"]    = m.HyperName();
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
+  (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
+  (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
 
 void WriteReducedModel(const ReducedModel &m, RomWriter *w)
@@ -219,6 +221,9 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
     w->Dataset("/online/ecsw/Pw", {R, (U64)m.cPoint.size()}, m.cPw);
   }
   w->Dataset("/online/hyper_default", {1}, {m.hyperDefault == ReducedModel::ContactMode::Cubature ? 1.0 : 0.0});
+  // the online Kacanov loop's stopping tolerances the model was built with (-rom_kacanov_rtol_primal, _dual at
+  // offline time: matched to the scene's accuracy targets, docs/online.md); online options override them
+  w->Dataset("/online/kacanov_rtol", {2}, {(double)m.loop.rtolPrimal, (double)m.loop.rtolDual});
   if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
   if (m.HasEnrichment()) { // the answer's sizes, the rest is the error estimate's enrichment (docs/error_estimate.md)
     w->Dataset("/online/estimate/default_sizes", {2}, {(double)m.NDefault, (double)m.RDefault});
@@ -321,6 +326,18 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
     }
   }
   mode_ = hyperDefault;
+  { // optional (files of before 2026-11-26 have none: the library's defaults): the online Kacanov tolerances
+    bool found;
+    PetscCall(RomReadOptional(path, "/online/kacanov_rtol", &d, &found));
+    if (found) {
+      PetscCheck(d.size() == 2 && d[0] > 0 && d[1] > 0 && d[0] < 1 && d[1] < 1, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/kacanov_rtol must hold 2 tolerances in (0, 1) (primal, dual)", path.c_str());
+      loop.rtolPrimal = d[0];
+      loop.rtolDual   = d[1];
+    } else {
+      loop.rtolPrimal = kRtolPrimal;
+      loop.rtolDual   = kRtolDual;
+    }
+  }
   MkDefault = MgDefault = -1;
   { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
     bool found;
@@ -459,9 +476,10 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   cPwT_.assign(cPoint.size() * (size_t)rp, 0.0);
   for (size_t p = 0; p < cPoint.size(); ++p)
     for (PetscInt i = 0; i < r; ++i) cPwT_[p * rp + i] = cPw[(size_t)i * cPoint.size() + p];
-  { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum)
+  { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum); the points'
+    // row combination gathers its rows from theta and counts twice (measured: docs/online.md)
     const PetscInt nd = patch.nnode * patch.dim, Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim)
-    const double   byPoints = (double)Mc * (nt * Nfull + rp * (Na + 1)), byDofs = (double)Mc * rp * (nt + 1) + (double)nd * rp * Na;
+    const double   byPoints = (double)Mc * (2.0 * nt * Nfull + rp * (Na + 1)), byDofs = (double)Mc * rp * (nt + 1) + (double)nd * rp * Na;
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cThetaT_.clear();
     if (cDofs_) {
