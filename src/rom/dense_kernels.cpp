@@ -2,12 +2,15 @@
 // RightSolveT and LowerGram (dense_kernels.hpp). A portable version of each and, on x86-64 with GCC or
 // clang, an AVX2+FMA version (intrinsics for the contact kernels, where the auto-vectorizer shuffled the
 // wrong dimension; the QP's loops compiled for AVX2), chosen once from __builtin_cpu_supports. The
-// blocked sum keeps a 4 x 4 block of K in registers over all points; the plain rank-1 update loop
-// reloaded and stored K at every point. Results differ from the portable ones by rounding (FMA);
+// blocked sum keeps a 4 x 4 (12 x 4) block of K in registers over all points; the plain rank-1 update loop
+// reloaded and stored K at every point. ScatterRows holds a point's row of W, CombineRows the output row in
+// registers (up to 12 blocks of 4, WithRegisterBlocks). Results differ from the portable ones by rounding (FMA);
 // RBC_KERNELS_PORTABLE=1 in the environment selects the portable ones.
 #include "dense_kernels.hpp"
 #include <algorithm>
 #include <cstdlib>
+#include <type_traits>
+#include <utility>
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #define RBC_KERNEL_DISPATCH 1
@@ -172,6 +175,21 @@ __attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, Pets
   }
 }
 
+// Calls f(std::integral_constant<int, B>()) for the block count nb when 1 <= nb <= 12 (the kernels that hold
+// B blocks of 4 in registers are instantiated for those); false otherwise
+template <int B = 1, class F>
+bool WithRegisterBlocks(PetscInt nb, F &&f)
+{
+  if constexpr (B > 12) return false;
+  else {
+    if (nb == B) {
+      f(std::integral_constant<int, B>());
+      return true;
+    }
+    return WithRegisterBlocks<B + 1>(nb, std::forward<F>(f));
+  }
+}
+
 // One point's W row held in NB registers over its terms (each term: load, FMA, store of Q's row)
 template <int NB>
 __attribute__((target("avx2,fma"))) void ScatterAvx2Fixed(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
@@ -197,21 +215,8 @@ __attribute__((target("avx2,fma"))) void ScatterAvx2Fixed(PetscInt M, PetscInt r
 
 __attribute__((target("avx2,fma"))) void ScatterAvx2(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
 {
-  switch (rp / 4) { // up to 12 blocks (48 rows) in registers: the rest of the 16 hold the term's coefficient and Q
-  case 1: return ScatterAvx2Fixed<1>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 2: return ScatterAvx2Fixed<2>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 3: return ScatterAvx2Fixed<3>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 4: return ScatterAvx2Fixed<4>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 5: return ScatterAvx2Fixed<5>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 6: return ScatterAvx2Fixed<6>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 7: return ScatterAvx2Fixed<7>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 8: return ScatterAvx2Fixed<8>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 9: return ScatterAvx2Fixed<9>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 10: return ScatterAvx2Fixed<10>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 11: return ScatterAvx2Fixed<11>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  case 12: return ScatterAvx2Fixed<12>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g);
-  default: break;
-  }
+  // up to 12 blocks (48 rows) in registers: the rest of the 16 hold the term's coefficient and Q
+  if (WithRegisterBlocks(rp / 4, [&](auto nb) { ScatterAvx2Fixed<decltype(nb)::value>(M, rp, nt, maxTerms, rowIdx, coef, W, gamma, Q, g); })) return;
   for (PetscInt p = 0; p < M; ++p) {
     const PetscReal *w = W + (size_t)p * rp;
     for (PetscInt t = 0; t < nt[p]; ++t) {
@@ -257,21 +262,7 @@ __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscRea
   PetscInt k = 0;
   // the first up to 48 entries with the output in registers (12 blocks), the rest block by block
   const PetscInt nb = std::min<PetscInt>(n / 4, 12);
-  switch (nb) {
-  case 1: CombineAvx2Fixed<1>(nt, coef, rows, out); break;
-  case 2: CombineAvx2Fixed<2>(nt, coef, rows, out); break;
-  case 3: CombineAvx2Fixed<3>(nt, coef, rows, out); break;
-  case 4: CombineAvx2Fixed<4>(nt, coef, rows, out); break;
-  case 5: CombineAvx2Fixed<5>(nt, coef, rows, out); break;
-  case 6: CombineAvx2Fixed<6>(nt, coef, rows, out); break;
-  case 7: CombineAvx2Fixed<7>(nt, coef, rows, out); break;
-  case 8: CombineAvx2Fixed<8>(nt, coef, rows, out); break;
-  case 9: CombineAvx2Fixed<9>(nt, coef, rows, out); break;
-  case 10: CombineAvx2Fixed<10>(nt, coef, rows, out); break;
-  case 11: CombineAvx2Fixed<11>(nt, coef, rows, out); break;
-  case 12: CombineAvx2Fixed<12>(nt, coef, rows, out); break;
-  default: break;
-  }
+  WithRegisterBlocks(nb, [&](auto b) { CombineAvx2Fixed<decltype(b)::value>(nt, coef, rows, out); });
   k = 4 * nb;
   for (; k + 4 <= n; k += 4) {
     __m256d a = _mm256_setzero_pd();
