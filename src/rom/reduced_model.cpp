@@ -326,7 +326,7 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
     }
   }
   mode_ = hyperDefault;
-  { // optional (files of before 2026-11-26 have none: the library's defaults): the online Kacanov tolerances
+  { // optional (files written before 2026-11-25's eleventh session have none: the library's defaults): the online Kacanov tolerances
     bool found;
     PetscCall(RomReadOptional(path, "/online/kacanov_rtol", &d, &found));
     if (found) {
