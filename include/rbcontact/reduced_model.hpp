@@ -130,6 +130,8 @@ public:
   const std::vector<PetscInt> &Columns() const { return cols_; }
   // Reduced A^(mu) (N x N, column-major) and f^(mu).
   void Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
+  // The same for the n columns cols of the stored basis (nullptr: the first n).
+  void AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
   // Reduced contact terms at (mu, v) in the current mode: K (R x N column-major), g (R). Returns the out-of-range count.
   PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g);
 
@@ -186,6 +188,8 @@ private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
   // The error estimate of a converged sol (ErrorEstimate), from the contact terms' last evaluation.
   PetscErrorCode EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  // [K g] of the cubature over the last point evaluation, rows PwT (padded to rp), nc columns (ContactTerms, EstimateError)
+  void CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, const std::vector<PetscReal> &ThetaT, const PetscInt *cols, PetscInt nc, std::vector<PetscReal> *Q, std::vector<PetscReal> *X, std::vector<PetscReal> *Kp);
   ReducedQP              qpEst_;                      // the enriched QP (all stored sizes)
   std::vector<PetscReal> eA_, ef_, eK_, eKp_, eg_, ev_, el_, eTh_, eQ_, eX_; // enriched operators and scratch
   std::vector<PetscReal> ePwT_, eThetaT_;             // cubature weights of every stored row (M x padded, point-major); theta' of every column
@@ -200,7 +204,6 @@ private:
   PetscInt               nkEval_ = 0;                 // evalPoints_[0, nkEval_) carry kappa points
   std::vector<PetscReal> A_, f_, Kc_, Gc_, KB_, GB_;  // active operators
   std::vector<PetscReal> kap_, gam_, phi_, vals_, K_, g_, Ath_, fth_;
-  std::vector<PetscReal> thA_, thF_;
   std::shared_ptr<ContactPatch> full_;
   ContactPatch           fullActive_;
   std::vector<PetscReal> P_, Pact_;
@@ -208,13 +211,17 @@ private:
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   bool                   cDofs_ = false;              // the cubature's K^ summed by patch dofs (-rom_ecsw_sum)
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
-  std::vector<PetscReal> cG_;                         // dofs sum: g^ padded to rp
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
 };
 
-// The sizes in use into a report object: N, R, Mk, Mg, Mc, hyper (ecsw|eim), ecsw_sum (points|dofs).
+// The stored basis columns of a model of sizes (n, r): the leading n POD modes, then the supremizers of the
+// leading r dual vectors (at most nsup), columns Npod + i.
+std::vector<PetscInt> ReducedColumns(PetscInt Npod, PetscInt nsup, PetscInt n, PetscInt r);
+
+// The sizes in use into a report object: N, R, Mk, Mg, Mc, hyper (ecsw|eim), ecsw_sum (points|dofs), and the online
+// Kacanov tolerances kacanov_rtol_primal, kacanov_rtol_dual.
 void ReportSizes(const ReducedModel &m, JsonValue *r);
 
 // Writes the online part of a model (everything Open reads) to w.

@@ -443,13 +443,19 @@ void ContactMap::SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std
     if (cuts[i + 1] > cuts[i]) segs->emplace_back(cuts[i], cuts[i + 1]);
 }
 
-// The deformed vertices' bounding box of a facet (the geometry of the closest-point search) and its diagonal.
-static PetscReal FacetBox(const SurfaceFacet &F, PetscInt dim, PetscReal lo[3], PetscReal hi[3])
+// An empty bounding box (lo > hi in every direction).
+static void EmptyBox(PetscReal lo[3], PetscReal hi[3])
 {
   for (PetscInt d = 0; d < 3; ++d) {
     lo[d] = PETSC_MAX_REAL;
     hi[d] = -PETSC_MAX_REAL;
   }
+}
+
+// The deformed vertices' bounding box of a facet (the geometry of the closest-point search) and its diagonal.
+static PetscReal FacetBox(const SurfaceFacet &F, PetscInt dim, PetscReal lo[3], PetscReal hi[3])
+{
+  EmptyBox(lo, hi);
   for (PetscInt k = 0; k < F.nv; ++k) {
     PetscInt node = -1;
     for (PetscInt i = 0; i < F.nnodes; ++i)
@@ -474,10 +480,7 @@ PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   // this rank's slave box (empty: lo > hi), the largest facet diameters
-  for (PetscInt d = 0; d < 3; ++d) {
-    box[d]     = PETSC_MAX_REAL;
-    box[3 + d] = -PETSC_MAX_REAL;
-  }
+  EmptyBox(box, box + 3);
   for (const auto &F : slave_.facets) {
     h[0] = std::max(h[0], FacetBox(F, dim, lo, hi));
     for (PetscInt d = 0; d < dim; ++d) {
@@ -492,10 +495,7 @@ PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
   PetscReal diag = 0;
   {
     PetscReal all[6];
-    for (PetscInt d = 0; d < 3; ++d) {
-      all[d]     = PETSC_MAX_REAL;
-      all[3 + d] = -PETSC_MAX_REAL;
-    }
+    EmptyBox(all, all + 3);
     for (PetscMPIInt r = 0; r < size; ++r)
       for (PetscInt d = 0; d < dim; ++d) {
         all[d]     = std::min(all[d], boxes[6 * r + d]);

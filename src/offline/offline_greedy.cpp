@@ -11,6 +11,9 @@
 
 namespace rbc {
 
+// GreedyCriterion's names (option values and report keys), in the PetscOptionsEnum form
+static const char *const kCriterionNames[] = {"residual", "penetration", "max", "estimate", "GreedyCriterion", "GREEDY_", NULL};
+
 PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
 {
   PetscFunctionBeginUser;
@@ -20,9 +23,8 @@ PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
   PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks)", "", o->batch, &o->batch, NULL));
   PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
   {
-    const char *const names[] = {"residual", "penetration", "max", "estimate", "GreedyCriterion", "GREEDY_", NULL};
-    PetscEnum         c       = (PetscEnum)o->criterion;
-    PetscCall(PetscOptionsEnum("-indicator", "Measure that ranks the candidates", "", names, c, &c, NULL));
+    PetscEnum c = (PetscEnum)o->criterion;
+    PetscCall(PetscOptionsEnum("-indicator", "Measure that ranks the candidates", "", kCriterionNames, c, &c, NULL));
     o->criterion = (GreedyCriterion)c;
   }
   PetscCall(PetscOptionsBool("-monitor", "Print every round", "", o->monitor, &o->monitor, NULL));
@@ -176,7 +178,7 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     r["R"]               = (long long)bs.dual.W.cols;
     r["candidates"]      = (long long)ncand;
     r["max_indicator"]   = Finite(std::vector<double>{eta[best]})[0];
-    r["indicator"]       = estimated ? "estimate" : byEstimate ? "residual" : go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : "max";
+    r["indicator"]       = kCriterionNames[(int)(estimated ? GreedyCriterion::Estimate : ind.criterion)];
     if (estimated) { // the raw u and lambda changes of the online estimate (docs/error_estimate.md)
       r["max_estimate_u"]      = (double)maxRes;
       r["max_estimate_lambda"] = (double)maxPen;
@@ -214,7 +216,7 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
   g["tol"]                  = (double)go.tol;
   g["max_solves"]           = (long long)go.maxSolves;
   g["separation"]           = (double)(go.separation * spacing);
-  g["indicator"]            = go.criterion == GreedyCriterion::Residual ? "residual" : go.criterion == GreedyCriterion::Penetration ? "penetration" : go.criterion == GreedyCriterion::Max ? "max" : "estimate"; // of the reduced model with exact contact terms
+  g["indicator"]            = kCriterionNames[(int)go.criterion]; // of the reduced model with exact contact terms (estimate: the online estimate's)
   g["estimate_rounds"]      = (long long)nEstimateRounds; // rounds ranked by the online estimate (-greedy_indicator estimate)
   g["stop"]                 = stop;
   g["reached_tol"]          = stop == "tol";

@@ -407,9 +407,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
     if ((nDefault > 0 || rDefault > 0) && !fitAll) {
       const PetscInt        rA = rDefault > 0 ? rDefault : R, nA = nDefault > 0 ? nDefault : Npod;
-      std::vector<PetscInt> cols;
-      for (PetscInt i = 0; i < nA; ++i) cols.push_back(i);
-      for (PetscInt i = 0; i < std::min(nsup, rA); ++i) cols.push_back(Npod + i);
+      const std::vector<PetscInt> cols = ReducedColumns(Npod, nsup, nA, rA);
       const PetscInt         Na = (PetscInt)cols.size();
       std::vector<PetscReal> PA(P.begin(), P.begin() + (size_t)rA * Q), SkA((size_t)ms * Q * Na), LA((size_t)nt * rA), VA((size_t)nt * Na);
       for (size_t sp = 0; sp < (size_t)ms * Q; ++sp)

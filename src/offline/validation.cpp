@@ -53,6 +53,17 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
 
 namespace {
+// Effectivities (estimate / error, one per parameter; not empty) and their summary under j: effectivity,
+// min_effectivity, max_effectivity, share_above_1, share_within_20 (the shares of >= 1, and of [1, 20])
+void EffectivityStats(const std::vector<double> &eff, JsonValue *j)
+{
+  (*j)["effectivity"]     = eff;
+  (*j)["min_effectivity"] = *std::min_element(eff.begin(), eff.end());
+  (*j)["max_effectivity"] = *std::max_element(eff.begin(), eff.end());
+  (*j)["share_above_1"]   = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1; }) / eff.size();
+  (*j)["share_within_20"] = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1 && x <= 20; }) / eff.size();
+}
+
 struct Errors {
   std::vector<double> u, lambda, force;
   std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
@@ -375,11 +386,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     JsonValue &r = rep.root["residual"];
     r["indicator"]        = indicator;
     r["rel_err_u_energy"] = E.u;
-    r["effectivity"]      = effectivity;
-    r["min_effectivity"]  = *std::min_element(effectivity.begin(), effectivity.end());
-    r["max_effectivity"]  = *std::max_element(effectivity.begin(), effectivity.end());
-    r["share_above_1"]    = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1; }) / effectivity.size();
-    r["share_within_20"]  = (double)std::count_if(effectivity.begin(), effectivity.end(), [](double x) { return x >= 1 && x <= 20; }) / effectivity.size();
+    EffectivityStats(effectivity, &r);
   }
   { // the online error estimate against the true errors (docs/error_estimate.md): effectivity = estimate / error
     JsonValue &r = rep.root["estimate"];
@@ -390,14 +397,10 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         JsonValue          &b = r[key];
         std::vector<double> eff(est.size());
         for (size_t k = 0; k < est.size(); ++k) eff[k] = err[k] > 0 ? est[k] / err[k] : (est[k] > 0 ? PETSC_INFINITY : 1.0);
-        b["estimate"]        = est;
-        b["rel_err"]         = err;
-        b["effectivity"]     = eff;
-        b["min_effectivity"] = *std::min_element(eff.begin(), eff.end());
-        b["max_effectivity"] = *std::max_element(eff.begin(), eff.end());
-        b["share_above_1"]   = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1; }) / eff.size();
-        b["share_within_20"] = (double)std::count_if(eff.begin(), eff.end(), [](double x) { return x >= 1 && x <= 20; }) / eff.size();
-        b["max_estimate"]    = *std::max_element(est.begin(), est.end());
+        b["estimate"]     = est;
+        b["rel_err"]      = err;
+        EffectivityStats(eff, &b);
+        b["max_estimate"] = *std::max_element(est.begin(), est.end());
       };
       const std::vector<double> &forceErr = E.forceOnline.size() == E.estForce.size() ? E.forceOnline : E.force;
       if (settings.estimateRaw && settings.estimateErr) {

@@ -89,6 +89,18 @@ PetscReal SignOf(const PetscScalar *v, PetscInt m)
 
 // Rank and N from the singular values (decreasing, s_0 > 0). `missing`: energy not represented by
 // singularValues (-pod_method svd with fewer converged triplets than snapshots), part of every tail.
+// Suffix sums (accurate tails) left[i] = sum_{k>=i} s_k^2 + missing, and the smallest N with left[N] <= tol left[0]
+// (m when none).
+PetscInt TailSize(const std::vector<PetscReal> &s, PetscReal missing, PetscReal tol, std::vector<PetscReal> *left)
+{
+  const PetscInt m = (PetscInt)s.size();
+  left->assign(m + 1, missing);
+  for (PetscInt i = m - 1; i >= 0; --i) (*left)[i] = (*left)[i + 1] + s[i] * s[i];
+  for (PetscInt i = 0; i <= m; ++i)
+    if ((*left)[i] <= tol * (*left)[0]) return i;
+  return m;
+}
+
 void SelectSize(const PODOptions &o, PetscReal missing, PODResult *res)
 {
   const std::vector<PetscReal> &s = res->singularValues;
@@ -96,17 +108,9 @@ void SelectSize(const PODOptions &o, PetscReal missing, PODResult *res)
   res->rank = 0;
   for (PetscInt i = 0; i < m; ++i)
     if (s[i] > o.rankTol * s[0]) res->rank = i + 1;
-  // Suffix sums (accurate tails): left[i] = sum_{k>=i} s_k^2 + missing.
-  std::vector<PetscReal> left(m + 1, missing);
-  for (PetscInt i = m - 1; i >= 0; --i) left[i] = left[i + 1] + s[i] * s[i];
-  PetscInt N = m;
-  if (o.nSet) N = o.n;
-  else
-    for (PetscInt i = 0; i <= m; ++i)
-      if (left[i] <= o.tol * left[0]) {
-        N = i;
-        break;
-      }
+  std::vector<PetscReal> left;
+  const PetscInt         byTol = TailSize(s, missing, o.tol, &left);
+  const PetscInt         N     = o.nSet ? o.n : byTol;
   res->N              = std::max<PetscInt>(1, std::min(N, res->rank));
   res->energyCaptured = 1.0 - left[res->N] / left[0];
 }
@@ -417,17 +421,8 @@ PetscErrorCode PODProjectionErrors(BV modes, const std::vector<Vec> &snapshots, 
 
 PetscInt PODSizeForTolerance(const PODResult &res, PetscReal tol)
 {
-  const std::vector<PetscReal> &s = res.singularValues;
-  const PetscInt                m = (PetscInt)s.size();
-  std::vector<PetscReal>        left(m + 1, 0.0);
-  for (PetscInt i = m - 1; i >= 0; --i) left[i] = left[i + 1] + s[i] * s[i];
-  PetscInt N = m;
-  for (PetscInt i = 0; i <= m; ++i)
-    if (left[i] <= tol * left[0]) {
-      N = i;
-      break;
-    }
-  return std::max<PetscInt>(1, std::min(N, res.rank));
+  std::vector<PetscReal> left;
+  return std::max<PetscInt>(1, std::min(TailSize(res.singularValues, 0.0, tol, &left), res.rank));
 }
 
 } // namespace rbc

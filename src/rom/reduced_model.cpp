@@ -178,6 +178,14 @@ PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector
 }
 
 // ------------------------------------------------------------------ model I/O
+std::vector<PetscInt> ReducedColumns(PetscInt Npod, PetscInt nsup, PetscInt n, PetscInt r)
+{
+  std::vector<PetscInt> cols;
+  for (PetscInt i = 0; i < n; ++i) cols.push_back(i);
+  for (PetscInt i = 0; i < std::min(nsup, r); ++i) cols.push_back(Npod + i);
+  return cols;
+}
+
 void ReportSizes(const ReducedModel &m, JsonValue *r)
 {
   (*r)["N"]        = (long long)m.N();
@@ -437,9 +445,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mk, MkFull);
   PetscCheck(mg >= 0 && mg <= MgFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mg, MgFull);
   geomMu_.clear();
-  cols_.clear();
-  for (PetscInt i = 0; i < n; ++i) cols_.push_back(i);
-  for (PetscInt i = 0; i < std::min(nsup, r); ++i) cols_.push_back(Npod + i);
+  cols_ = ReducedColumns(Npod, nsup, n, r);
   r_  = r;
   mk_ = mk;
   mg_ = mg;
@@ -530,19 +536,21 @@ void ReducedModel::SetExactContact(std::shared_ptr<ContactPatch> full, const std
   P_    = P;
 }
 
-void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
+void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const { AffineAt(mu, cols_.data(), (PetscInt)cols_.size(), A, f); }
+
+void ReducedModel::AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
 {
   std::vector<PetscReal> thA, thF;
   par.ThetaA(mu, &thA);
   par.ThetaF(mu, &thF);
-  const PetscInt Na = (PetscInt)cols_.size();
-  A->assign((size_t)Na * Na, 0.0);
-  f->assign(Na, 0.0);
+  auto col = [&](PetscInt i) { return cols ? cols[i] : i; };
+  A->assign((size_t)n * n, 0.0);
+  f->assign(n, 0.0);
   for (size_t q = 0; q < thA.size(); ++q)
-    for (PetscInt j = 0; j < Na; ++j)
-      for (PetscInt i = 0; i < Na; ++i) (*A)[i + (size_t)Na * j] += thA[q] * Aq[(q * Nfull + cols_[i]) * Nfull + cols_[j]];
+    for (PetscInt j = 0; j < n; ++j)
+      for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * j] += thA[q] * Aq[(q * Nfull + col(i)) * Nfull + col(j)];
   for (size_t q = 0; q < thF.size(); ++q)
-    for (PetscInt i = 0; i < Na; ++i) (*f)[i] += thF[q] * fq[q * Nfull + cols_[i]];
+    for (PetscInt i = 0; i < n; ++i) (*f)[i] += thF[q] * fq[q * Nfull + col(i)];
 }
 
 // Forward substitution with the unit lower triangular B (M x M, column-major).
@@ -553,6 +561,33 @@ static void Forward(PetscInt M, const PetscReal *B, const PetscReal *b, PetscRea
     for (PetscInt j = 0; j < i; ++j) s -= B[i + (size_t)M * j] * x[j];
     x[i] = s / B[i + (size_t)M * i];
   }
+}
+
+// [K g] (rp x (nc + 1), column-major, g last) = sum over the cubature points of PwT(p, :) (M x rp, point-major) times
+// [kappa(p, cols) gamma(p)] of the last point evaluation (cols: nc columns of the stored basis, nullptr: the first nc).
+// By patch dofs (cDofs_: Q(a, :) = sum_p coef(p, a) PwT(p, :), then K = Q' theta(:, cols) with ThetaT = theta(:, cols)',
+// one blocked kernel over the dofs) or by points (the columns point-contiguous in X, one blocked kernel).
+void ReducedModel::CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, const std::vector<PetscReal> &ThetaT, const PetscInt *cols, PetscInt nc, std::vector<PetscReal> *Q, std::vector<PetscReal> *X, std::vector<PetscReal> *Kp)
+{
+  const PetscInt M = (PetscInt)cPoint.size();
+  Kp->resize((size_t)rp * (nc + 1));
+  if (cDofs_) {
+    const PetscInt nd = patch.nnode * patch.dim;
+    Q->assign((size_t)nd * rp, 0.0);
+    PetscReal *g = Kp->data() + (size_t)nc * rp;
+    std::fill(g, g + rp, 0.0);
+    ScatterRows(M, rp, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), PwT.data(), gam_.data(), Q->data(), g);
+    SumOfOuterProducts(nd, rp, nc, Q->data(), ThetaT.data(), Kp->data());
+    return;
+  }
+  X->resize((size_t)(nc + 1) * M);
+  for (PetscInt c = 0; c < nc; ++c) {
+    PetscReal     *x   = &(*X)[(size_t)c * M];
+    const PetscInt col = cols ? cols[c] : c;
+    for (PetscInt p = 0; p < M; ++p) x[p] = kap_[(size_t)p * Nfull + col];
+  }
+  std::copy(gam_.begin(), gam_.begin() + M, X->begin() + (size_t)nc * M);
+  SumOfOuterProducts(M, rp, nc + 1, PwT.data(), X->data(), Kp->data());
 }
 
 PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
@@ -599,30 +634,9 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     const PetscInt rp = PaddedRows(r);
     wn_.resize((size_t)M * patch.dim);
     wnMode_ = ContactMode::Cubature;
-    if (cDofs_) {
-      // Q(a, :) = sum_p coef(p, a) Pw(:, p) over the patch dofs a, then K^ = Q' theta(:, cols) (one blocked
-      // kernel over the dofs), g^ = sum_p Pw(:, p) gamma(p)
-      const PetscInt nd = patch.nnode * patch.dim;
-      out = patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data());
-      std::fill(cQ_.begin(), cQ_.end(), 0.0);
-      cG_.assign(rp, 0.0);
-      ScatterRows(M, rp, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwT_.data(), gam_.data(), cQ_.data(), cG_.data());
-      std::copy_n(cG_.data(), r, g);
-      cK_.resize((size_t)rp * Na);
-      SumOfOuterProducts(nd, rp, Na, cQ_.data(), cThetaT_.data(), cK_.data());
-      for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
-      return out;
-    }
-    out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
-    // [K g] = sum_p Pw(:, p) [kappa(p, cols) gamma(p)]: the columns point-contiguous, one blocked kernel
-    cX_.resize((size_t)(Na + 1) * M);
-    cK_.resize((size_t)rp * (Na + 1));
-    for (PetscInt c = 0; c < Na; ++c) {
-      PetscReal *x = &cX_[(size_t)c * M];
-      for (PetscInt p = 0; p < M; ++p) x[p] = kap_[(size_t)p * Nfull + cols_[c]];
-    }
-    std::copy(gam_.begin(), gam_.begin() + M, cX_.begin() + (size_t)Na * M);
-    SumOfOuterProducts(M, rp, Na + 1, cPwT_.data(), cX_.data(), cK_.data());
+    out = cDofs_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
+                 : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    CubatureSum(rp, cPwT_, cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
     for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
     return out;
@@ -677,6 +691,18 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
 
 // F = sum_i lambda_i int psi_i n2 (the FOM's resultant) through the contact terms' last evaluation:
 // lambda(x_p) times the point's weight and cubature weight = (Pw(:, p)' lambda^) and w_p n2(x_p) (wn_).
+// F (d entries) = sum_p (sum_i P(i, p) lambda_i) wn(p, :) over M points and r rows, P(i, p) = P[i * si + p * sp]:
+// the multipliers' weight at each point times w_p n2(x_p)
+static void ForceAtPoints(PetscInt M, PetscInt r, const PetscReal *P, size_t si, size_t sp, const PetscReal *lambda, const PetscReal *wn, PetscInt d, PetscReal *F)
+{
+  for (PetscInt k = 0; k < d; ++k) F[k] = 0;
+  for (PetscInt p = 0; p < M; ++p) {
+    PetscReal l = 0;
+    for (PetscInt i = 0; i < r; ++i) l += P[i * si + p * sp] * lambda[i];
+    for (PetscInt k = 0; k < d; ++k) F[k] += l * wn[(size_t)p * d + k];
+  }
+}
+
 void ReducedModel::ResultantForce(const std::vector<PetscReal> &lambda, std::vector<PetscReal> *F) const
 {
   F->clear();
@@ -686,11 +712,8 @@ void ReducedModel::ResultantForce(const std::vector<PetscReal> &lambda, std::vec
   const PetscInt M     = exact ? (PetscInt)(Pact_.size() / std::max<PetscInt>(r, 1)) : (PetscInt)cPoint.size(), rp = PaddedRows(r);
   if ((PetscInt)wn_.size() != M * d || (PetscInt)lambda.size() != r) return;
   F->assign(d, 0.0);
-  for (PetscInt p = 0; p < M; ++p) {
-    PetscReal l = 0;
-    for (PetscInt i = 0; i < r; ++i) l += (exact ? Pact_[(size_t)i * M + p] : cPwT_[(size_t)p * rp + i]) * lambda[i];
-    for (PetscInt k = 0; k < d; ++k) (*F)[k] += l * wn_[(size_t)p * d + k];
-  }
+  if (exact) ForceAtPoints(M, r, Pact_.data(), M, 1, lambda.data(), wn_.data(), d, F->data());
+  else ForceAtPoints(M, r, cPwT_.data(), 1, rp, lambda.data(), wn_.data(), d, F->data());
 }
 
 PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol)
@@ -835,43 +858,19 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   const PetscInt   M     = exact ? (PetscInt)(P_.size() / Rf) : (PetscInt)cPoint.size();
   const PetscReal *Pw    = exact ? P_.data() : cPw.data(); // Rf x M, row-major
   const PetscInt rpf = PaddedRows(Rf);
-  eKp_.resize((size_t)rpf * Nf);
-  eg_.assign(rpf, 0.0);
   if (exact) { // offline / validation only: plain loops over the full quadrature
-    std::fill(eKp_.begin(), eKp_.end(), 0.0);
+    eKp_.assign((size_t)rpf * (Nf + 1), 0.0);
     for (PetscInt i = 0; i < Rf; ++i)
       for (PetscInt p = 0; p < M; ++p) {
         const PetscReal wp = Pw[(size_t)i * M + p];
         for (PetscInt n = 0; n < Nf; ++n) eKp_[i + (size_t)rpf * n] += wp * kap_[(size_t)p * Nf + n];
-        eg_[i] += wp * gam_[p];
+        eKp_[i + (size_t)rpf * Nf] += wp * gam_[p];
       }
-  } else if (cDofs_) { // Q(a, :) = sum_p coef(p, a) Pw(:, p) with every stored row, then K = Q' theta (the answer's dof sum)
-    const PetscInt nd = patch.nnode * patch.dim;
-    eQ_.assign((size_t)nd * rpf, 0.0);
-    ScatterRows(M, rpf, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), ePwT_.data(), gam_.data(), eQ_.data(), eg_.data());
-    SumOfOuterProducts(nd, rpf, Nf, eQ_.data(), eThetaT_.data(), eKp_.data());
-  } else { // [K g] = sum_p Pw(:, p) [kappa(p, :) gamma(p)] (the answer's point sum)
-    eX_.resize((size_t)(Nf + 1) * M);
-    for (PetscInt n = 0; n < Nf; ++n)
-      for (PetscInt p = 0; p < M; ++p) eX_[(size_t)n * M + p] = kap_[(size_t)p * Nf + n];
-    std::copy(gam_.begin(), gam_.begin() + M, eX_.begin() + (size_t)Nf * M);
-    eKp_.resize((size_t)rpf * (Nf + 1));
-    SumOfOuterProducts(M, rpf, Nf + 1, ePwT_.data(), eX_.data(), eKp_.data());
-    std::copy_n(&eKp_[(size_t)Nf * rpf], rpf, eg_.begin());
-  }
+  } else CubatureSum(rpf, ePwT_, eThetaT_, nullptr, Nf, &eQ_, &eX_, &eKp_); // the answer's sum, every stored row and column
   eK_.resize((size_t)Rf * Nf);
   for (PetscInt n = 0; n < Nf; ++n) std::copy_n(&eKp_[(size_t)n * rpf], Rf, &eK_[(size_t)Rf * n]);
-  // A(mu), f(mu) of all stored columns
-  par.ThetaA(mu, &thA_);
-  par.ThetaF(mu, &thF_);
-  eA_.assign((size_t)Nf * Nf, 0.0);
-  ef_.assign(Nf, 0.0);
-  for (size_t q = 0; q < thA_.size(); ++q) {
-    const PetscReal *a = &Aq[q * Nf * Nf];
-    for (size_t k = 0; k < (size_t)Nf * Nf; ++k) eA_[k] += thA_[q] * a[k]; // symmetric: row- = column-major
-  }
-  for (size_t q = 0; q < thF_.size(); ++q)
-    for (PetscInt i = 0; i < Nf; ++i) ef_[i] += thF_[q] * fq[q * Nf + i];
+  eg_.assign(eKp_.begin() + (size_t)Nf * rpf, eKp_.begin() + (size_t)Nf * rpf + Rf);
+  AffineAt(mu, nullptr, Nf, &eA_, &ef_); // A(mu), f(mu) of all stored columns
   // the enriched QP, from the answer's multipliers
   ev_.assign(Nf, 0.0);
   el_.assign(Rf, 0.0);
@@ -911,11 +910,7 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   // the resultant force of the enriched multipliers at the same points
   if (!sol->force.empty() && (PetscInt)wn_.size() == M * dim) {
     PetscReal F2[3] = {0, 0, 0};
-    for (PetscInt p = 0; p < M; ++p) {
-      PetscReal l = 0;
-      for (PetscInt i = 0; i < Rf; ++i) l += Pw[(size_t)i * M + p] * el_[i];
-      for (PetscInt k = 0; k < dim; ++k) F2[k] += l * wn_[(size_t)p * dim + k];
-    }
+    ForceAtPoints(M, Rf, Pw, M, 1, el_.data(), wn_.data(), dim, F2);
     PetscReal df = 0, nf = 0;
     for (PetscInt k = 0; k < dim; ++k) {
       df += PetscSqr(F2[k] - sol->force[k]);
