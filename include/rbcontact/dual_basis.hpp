@@ -125,6 +125,8 @@ struct DualBasisResult {
 // Builds the dual basis of the snapshot matrix L (R x m, nonnegative) with the options above.
 // Collective on PETSC_COMM_WORLD only for reading options; the computation is local and identical on every rank.
 PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res);
+// -dual_tol's default (read by BuildDualBasis, and by offline -estimate).
+constexpr PetscReal kDualDefaultTol = 1e-3;
 
 // Projection errors of every column of L onto the cone of W (NNLS), in l-infinity or l2.
 // solver: a configured NNLSSolver to use (null: a local one, configured from the options: collective).

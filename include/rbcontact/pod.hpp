@@ -54,6 +54,8 @@ PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *r
 // The N that -pod_tol tol would have chosen from res's singular values (smallest N with the energy left out
 // <= tol, within [1, rank]): the answer's size inside a POD computed to a smaller tolerance (offline -estimate).
 PetscInt PODSizeForTolerance(const PODResult &res, PetscReal tol);
+// -pod_tol's default (read by ComputePOD, and by offline -estimate for the answer's size).
+constexpr PetscReal kPODDefaultTol = 1e-8;
 
 // M-norm projection error of each snapshot onto span(modes): ||x - V V^T M x||_M, M the modes' BV
 // matrix (l2 if none). sum_j err_j^2 = sum_{i >= N} s_i^2 (the left-out energy).

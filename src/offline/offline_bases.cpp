@@ -79,8 +79,8 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscCheck(m > 0, world, PETSC_ERR_ARG_SIZ, "offline: no snapshot to build the bases from");
   // --- the error estimate's enrichment (-estimate): the same bases to tighter tolerances, the answer's sizes noted
   PetscBool estimate = PETSC_FALSE, podNSet = PETSC_FALSE;
-  PetscReal podTol = 1e-8, dualTol = 1e-3, estPodTol = -1, estDualTol = -1; // the defaults of ComputePOD and BuildDualBasis
-  char      dualType[16] = "cpg";
+  PetscReal podTol = kPODDefaultTol, dualTol = kDualDefaultTol, estPodTol = -1, estDualTol = -1;
+  char      dualType[16] = ""; // unset: BuildDualBasis's default, a greedy
   PetscCall(PetscOptionsGetReal(NULL, "pod_", "-tol", &podTol, NULL));
   PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, NULL));
   PetscCall(PetscOptionsHasName(NULL, "pod_", "-n", &podNSet));

@@ -355,7 +355,7 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
   const char *types[] = {"nmf", "angle", "cpg", "mcpg"};
   const char *norms[] = {"linf", "l2"};
   PetscInt    type = 2, norm = 0, r = 5, seed = 1, nmfMaxIt = 2000, maxR = L.cols;
-  PetscReal   tol = 1e-3, nmfRtol = 1e-6, feasTol = 1e-12, maxCond = 1e12;
+  PetscReal   tol = kDualDefaultTol, nmfRtol = 1e-6, feasTol = 1e-12, maxCond = 1e12;
   PetscBool   tolRelative = PETSC_FALSE, monitor = PETSC_FALSE;
   const PetscInt R = L.rows, m = L.cols;
 

@@ -35,7 +35,7 @@ struct PODOptions {
   PetscInt  n        = -1;
   PetscBool nSet     = PETSC_FALSE;
   PetscInt  svdNsv   = -1; // singular triplets requested from SLEPc (-pod_svd_nsv, default m)
-  PetscReal tol      = 1e-8;
+  PetscReal tol      = kPODDefaultTol;
   PetscReal rankTol  = 0;
   PetscBool view     = PETSC_FALSE;
   char      svOut[PETSC_MAX_PATH_LEN] = "";
