@@ -404,14 +404,32 @@ def sphere_block3d(args):
           "3D ROM at its training parameters within the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)")
     dmax = max(abs(a - b) / max(abs(b), 1e-300) for k in ("rel_err_u", "rel_err_lambda", "rel_err_force") for a, b in zip(vals[1][k], vals[2][k]))
     check(dmax <= 1e-6, "1 and 2 ranks: the same errors to %.1e relative (<= 1e-6)" % dmax)
+    # -rom_ecsw_precision single (runs/sphere_block3d.opts, stored in the file): the dof sum in float changes the errors
+    # by less than 1 % of the 3D targets (u 1e-5, lambda 2e-4, force 1e-5; measured on the 9 x 9 grid's ROM: 2e-7,
+    # < 1e-5, 8e-7) against the same model summed in double
+    with h5py.File(rom, "r") as f:
+        prec = list(f["online/ecsw_precision"][:])
+    check(prec == [32] and ro["ecsw_precision"] == "single" and ro["ecsw_sum"] == "dofs", "the ROM file stores the single-precision dof sum: %s, %s" % (prec, ro["ecsw_sum"]))
+    run(args, 1, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-test_type", "grid", "-test_size", "3",
+                              "-validate_repeat", "3", "-rom_ecsw_precision", "double", "-report", "%s/val_double.json" % d])
+    vd = report("%s/val_double.json" % d)
+    check(vd["rom"]["ecsw_precision"] == "double" and report("%s/val1.json" % d)["rom"]["ecsw_precision"] == "single", "the option overrides the stored precision")
+    for k, bound in (("rel_err_u", 1e-5), ("rel_err_lambda", 2e-4), ("rel_err_force", 1e-5)):
+        dd = max(abs(a - b) for a, b in zip(vals[1][k], vd["test"][k]))
+        print("  single against double precision: max |change| of %s %.1e (bound %.0e)" % (k, dd, bound))
+        check(dd <= bound, "single precision moves %s by %.1e <= %.0e" % (k, dd, bound))
     # the online Kacanov tolerances of the options file travel in the ROM file (/online/kacanov_rtol): an online
-    # solve without options uses them (3 iterates from this 3 x 3 grid's warm start against 5 to 1e-9), and what the
+    # solve without options uses them (2 iterates from this 3 x 3 grid's warm start against 5 to 1e-9), and what the
     # looser tolerance leaves is far below the 3D u target (docs/online.md: one iterate and 1-2e-6 on the 9 x 9 grid)
     with h5py.File(rom, "r") as f:
         stored = list(f["online/kacanov_rtol"][:])
     check(stored == [1e-3, 1e-4] and ro["kacanov_rtol_primal"] == 1e-3, "the ROM file stores -rom_kacanov_rtol_primal 1e-3, -rom_kacanov_rtol_dual 1e-4: %s" % stored)
     sols = {}
-    for tag, extra in (("stored", []), ("tight", ["-rom_kacanov_rtol_primal", "1e-9", "-rom_kacanov_rtol_dual", "1e-9"])):
+    # (the tight reference in double: the float dof sum leaves a noise floor near 1e-6 / 1e-5 on the changes, below
+    # which the loop cannot converge and says so)
+    p = run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-rom_kacanov_rtol_primal", "1e-9", "-rom_kacanov_rtol_dual", "1e-9"], expect_ok=False)
+    check(p.returncode != 0 and "-rom_ecsw_precision double" in p.stdout, "single precision with tolerances 1e-9: not converged, and the message names -rom_ecsw_precision double")
+    for tag, extra in (("stored", []), ("tight", ["-rom_kacanov_rtol_primal", "1e-9", "-rom_kacanov_rtol_dual", "1e-9", "-rom_ecsw_precision", "double"])):
         run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", "%s/on_%s.json" % (d, tag)] + extra)
         sols[tag] = report("%s/on_%s.json" % (d, tag))
     a, b = sols["stored"], sols["tight"]
@@ -420,7 +438,16 @@ def sphere_block3d(args):
           % (a["kacanov_iterations"], b["kacanov_iterations"], du))
     check(a["rom"]["kacanov_rtol_primal"] == 1e-3 and b["rom"]["kacanov_rtol_primal"] == 1e-9, "the stored tolerance is the default, the option overrides it")
     check(a["kacanov_iterations"] < b["kacanov_iterations"] and du <= 1e-4, "the stored tolerance stops earlier, within 1e-4 of the converged reduced solution (u target 1e-3)")
+    with h5py.File(rom, "r+") as f: # a file without the precision (written before 2026-11-26): double
+        del f["online/ecsw_precision"]
+    run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", "%s/on_old.json" % d])
+    check(report("%s/on_old.json" % d)["rom"]["ecsw_precision"] == "double", "a ROM file without /online/ecsw_precision sums in double")
     with h5py.File(rom, "r+") as f:
+        f["online/ecsw_precision"] = [16.0]
+    p = run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043"], expect_ok=False)
+    check(p.returncode != 0 and "/online/ecsw_precision" in p.stdout, "a tampered precision (16 bits) is refused naming the dataset")
+    with h5py.File(rom, "r+") as f:
+        del f["online/ecsw_precision"]
         f["online/kacanov_rtol"][0] = 0.0
     p = run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043"], expect_ok=False)
     check(p.returncode != 0 and "/online/kacanov_rtol" in p.stdout, "a tampered stored tolerance (0) is refused naming the dataset")

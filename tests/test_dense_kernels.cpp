@@ -4,7 +4,8 @@
 // register blocks, and beyond), and ScatterRows (the patch-dof accumulation, rows 1..60: the point's row in
 // 1..12 register blocks, and beyond) with repeated target rows, 0..8 terms per point; RightSolveT (through the
 // residual X L' - D) and LowerGram of the reduced QP's set-up, n 1..60; RowDots (U = uD + theta v). The dispatched version (AVX2+FMA
-// where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|).
+// where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|). The single-precision
+// dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) within the float accumulation bound.
 #include "../src/rom/dense_kernels.hpp"
 #include <cmath>
 #include <random>
@@ -15,7 +16,7 @@ using namespace rbc;
 int main(int argc, char **argv)
 {
   int          failures = 0, checks = 0;
-  double       worst    = 0;
+  double       worst = 0, worst32 = 0;
   std::mt19937 gen(3);
   std::uniform_real_distribution<double> u(-1, 1);
 
@@ -113,6 +114,68 @@ int main(int argc, char **argv)
       for (size_t k = 0; k < Q.size(); ++k) PetscCall(check(Q[k], Qr[k], Qa[k], "Q", (PetscInt)k));
       for (PetscInt i = 0; i < rp; ++i) PetscCall(check(g[i], gr[i], ga[i], "g", i));
     }
+  // the dof sum in single precision (-rom_ecsw_precision single): float inputs, float accumulation; against the
+  // double sum of the same float inputs, within the accumulation bound (terms + 2) 2^-24 sum |terms| per entry
+  // (a misplaced row or column is off by O(1) of the sum)
+  const double uf = std::ldexp(1.0, -24);
+  for (PetscInt M : {0, 1, 7, 202, 631})
+    for (PetscInt r : {1, 5, 8, 9, 24, 30, 33, 44})
+      for (PetscInt nc : {1, 3, 4, 5, 44}) {
+        const PetscInt      rps = (r + 7) / 8 * 8;
+        std::vector<float>  W((size_t)M * rps, 0.0f), X((size_t)nc * M);
+        std::vector<double> K((size_t)rps * nc, -7.0);
+        for (PetscInt p = 0; p < M; ++p)
+          for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rps + i] = (float)u(gen);
+        for (auto &x : X) x = (float)u(gen);
+        SumOfOuterProductsSingle(M, rps, nc, W.data(), X.data(), K.data());
+        for (PetscInt c = 0; c < nc; ++c)
+          for (PetscInt i = 0; i < rps; ++i) {
+            double s = 0, a = 0;
+            for (PetscInt p = 0; p < M; ++p) {
+              s += (double)W[(size_t)p * rps + i] * X[(size_t)c * M + p];
+              a += std::abs((double)W[(size_t)p * rps + i] * X[(size_t)c * M + p]);
+            }
+            const double e = std::abs(K[(size_t)c * rps + i] - s), bound = (M + 2) * uf * a;
+            worst32        = std::max(worst32, a > 0 ? e / a : e);
+            ++checks;
+            if (!(e <= bound)) {
+              ++failures;
+              PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL SumOfOuterProductsSingle M %d r %d nc %d entry (%d, %d): %g vs %g\n", (int)M, (int)r, (int)nc, (int)i, (int)c, K[(size_t)c * rps + i], s));
+            }
+          }
+      }
+  for (PetscInt M : {0, 1, 7, 202})
+    for (PetscInt r : {1, 5, 8, 9, 24, 30, 45, 96, 97, 120}) {
+      const PetscInt        rps = (r + 7) / 8 * 8, nd = 13, maxT = 36;
+      std::vector<float>    W((size_t)M * rps, 0.0f), Q((size_t)nd * rps, 0.5f);
+      std::vector<double>   coef((size_t)M * maxT, 99.0), Qr(Q.size(), 0.5), Qa(Q.size(), 0.5);
+      std::vector<PetscInt> nt(M), row((size_t)M * maxT, -1), count(Q.size(), 1);
+      for (PetscInt p = 0; p < M; ++p) {
+        for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rps + i] = (float)u(gen);
+        nt[p] = p % 9;
+        for (PetscInt t = 0; t < nt[p]; ++t) {
+          coef[(size_t)p * maxT + t] = u(gen);
+          row[(size_t)p * maxT + t]  = (p + 3 * t) % nd;
+          for (PetscInt i = 0; i < rps; ++i) {
+            const size_t k    = (size_t)row[(size_t)p * maxT + t] * rps + i;
+            const double term = (double)(float)coef[(size_t)p * maxT + t] * W[(size_t)p * rps + i];
+            Qr[k] += term;
+            Qa[k] += std::abs(term);
+            ++count[k];
+          }
+        }
+      }
+      ScatterRowsSingle(M, rps, nt.data(), maxT, row.data(), coef.data(), W.data(), Q.data());
+      for (size_t k = 0; k < Q.size(); ++k) {
+        const double e = std::abs(Q[k] - Qr[k]);
+        worst32        = std::max(worst32, e / Qa[k]);
+        ++checks;
+        if (!(e <= (count[k] + 2) * uf * Qa[k])) {
+          ++failures;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL ScatterRowsSingle M %d r %d entry %d: %g vs %g\n", (int)M, (int)r, (int)k, (double)Q[k], Qr[k]));
+        }
+      }
+    }
   // RowDots: out = b + A v
   for (PetscInt rows : {0, 1, 7})
     for (PetscInt n : {0, 1, 3, 4, 5, 13, 60}) {
@@ -176,7 +239,7 @@ int main(int argc, char **argv)
           }
         }
     }
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "%s: %d entries checked, worst relative difference %.2e (bound 1e-13)\n", failures ? "FAIL" : "ok", checks, worst));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "%s: %d entries checked, worst relative difference %.2e (bound 1e-13), single precision %.2e (bound (terms + 2) 2^-24)\n", failures ? "FAIL" : "ok", checks, worst, worst32));
   PetscCall(PetscFinalize());
   return failures ? 1 : 0;
 }

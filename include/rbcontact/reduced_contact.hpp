@@ -59,6 +59,9 @@ public:
   static constexpr PetscInt MaxTerms = 36; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
   PetscInt EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn = nullptr) const;
   PetscInt NumPoints() const { return (PetscInt)points.size(); }
+  // The dofs [0, TermDofs()) hold every node a term can fall on (slave facets, searchable master facets); the
+  // rest serve the master vertex normals only. Restrict numbers the term nodes first (older files: up to nnode * dim).
+  PetscInt TermDofs() const;
 
   // Serialization: named float64 arrays (row-major) and their shapes, for the ROM file.
   void Serialize(std::vector<std::pair<std::string, std::pair<std::vector<unsigned long long>, std::vector<double>>>> *out) const;

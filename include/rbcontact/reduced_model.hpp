@@ -181,6 +181,11 @@ public:
   // smaller count. docs/online.md, "Where the online time goes".
   enum class EcswSum { Auto, Points, Dofs } ecswSum = EcswSum::Auto;
   bool EcswSumsByDofs() const { return cDofs_; }
+  // -rom_ecsw_precision double|single: the dof sum's Q and K^ = Q' theta in float (twice the vector width; g^, the
+  // points' kernel and the QP stay double). Measured on sphere_block3d: 248 -> 192 us, errors unchanged to 3 digits
+  // (docs/online.md "Single precision"). Stored in the ROM file (/online/ecsw_precision); options override it.
+  bool ecswSingle = false;
+  bool EcswSingle() const { return cSingle_; }
   bool      recordIterates = false;
   ReducedQP qp;
 
@@ -210,6 +215,9 @@ private:
   std::vector<PetscReal> cPwT_;                       // cubature weights of the active rows, M x PaddedRows(r) (point-major, zero padded)
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   bool                   cDofs_ = false;              // the cubature's K^ summed by patch dofs (-rom_ecsw_sum)
+  PetscInt               cNd_   = 0;                  // ... over the dofs [0, cNd_) that terms fall on (ContactPatch::TermDofs)
+  bool                   cSingle_ = false;            // the dof sum in float (ecswSingle and cDofs_)
+  std::vector<float>     cPwTs_, cThetaTs_, cQs_;     // ... its weights (M x rp rounded up to 8), theta' and Q
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;

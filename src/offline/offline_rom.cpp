@@ -580,6 +580,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["affine_f"] = (long long)rm.par.NumF();
   ro["kacanov_rtol_primal"] = (double)rm.loop.rtolPrimal; // stored in the file: the online default (/online/kacanov_rtol)
   ro["kacanov_rtol_dual"]   = (double)rm.loop.rtolDual;
+  ro["ecsw_sum"]            = rm.EcswSumsByDofs() ? "dofs" : "points";                  // the online sum (-rom_ecsw_sum auto: by flops)
+  ro["ecsw_precision"]      = rm.EcswSingle() ? "single" : "double";                    // ... and its arithmetic in effect
+  ro["ecsw_precision_stored"] = rm.ecswSingle ? "single" : "double";                    // /online/ecsw_precision
   rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);
   rep->root["time_s"]["eim"]           = (double)(t2 - t1);
   rep->root["time_s"]["hyper_snapshots"] = (double)(t1 - t0); // the same two phases under names that fit the

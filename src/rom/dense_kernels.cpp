@@ -104,6 +104,33 @@ void ScatterPortable(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTe
   }
 }
 
+// Single precision (-rom_ecsw_precision single): the dof sum's Q and theta' in float, the output in double
+void OuterPortableF(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
+{
+  for (PetscInt c = 0; c < nc; ++c)
+    for (PetscInt i0 = 0; i0 < rp; i0 += 8) {
+      float        acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+      const float *x      = X + (size_t)c * M;
+      for (PetscInt p = 0; p < M; ++p) {
+        const float *w = W + (size_t)p * rp + i0;
+        for (int i = 0; i < 8; ++i) acc[i] += w[i] * x[p];
+      }
+      for (int i = 0; i < 8; ++i) K[(size_t)c * rp + i0 + i] = acc[i];
+    }
+}
+
+void ScatterPortableF(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
+{
+  for (PetscInt p = 0; p < M; ++p) {
+    const float *w = W + (size_t)p * rp;
+    for (PetscInt t = 0; t < nt[p]; ++t) {
+      const float cf = (float)coef[(size_t)p * maxTerms + t];
+      float      *q  = Q + (size_t)rowIdx[(size_t)p * maxTerms + t] * rp;
+      for (PetscInt i = 0; i < rp; ++i) q[i] += cf * w[i];
+    }
+  }
+}
+
 void RowDotsPortable(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
 {
   for (PetscInt r = 0; r < rows; ++r) {
@@ -229,6 +256,86 @@ __attribute__((target("avx2,fma"))) void ScatterAvx2(PetscInt M, PetscInt rp, co
   }
 }
 
+// 24 rows (3 x 8 floats) x 4 columns in 12 registers, then blocks of 8 rows
+// 8 floats to 8 doubles at k
+__attribute__((target("avx2,fma"))) RBC_INLINE void StoreAsDouble(PetscReal *k, __m256 a)
+{
+  _mm256_storeu_pd(k, _mm256_cvtps_pd(_mm256_castps256_ps128(a)));
+  _mm256_storeu_pd(k + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)));
+}
+
+__attribute__((target("avx2,fma"))) void OuterAvx2F(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
+{
+  auto store = [K, rp](PetscInt c, PetscInt i0, __m256 a) __attribute__((target("avx2,fma"))) { StoreAsDouble(K + (size_t)c * rp + i0, a); };
+  PetscInt c0 = 0;
+  for (; c0 + 4 <= nc; c0 += 4) {
+    const float *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
+    PetscInt     i0 = 0;
+    for (; i0 + 24 <= rp; i0 += 24) {
+      __m256 a[3][4];
+      for (int b = 0; b < 3; ++b)
+        for (int j = 0; j < 4; ++j) a[b][j] = _mm256_setzero_ps();
+      for (PetscInt p = 0; p < M; ++p) {
+        const float *wp = W + (size_t)p * rp + i0;
+        const __m256 w0 = _mm256_loadu_ps(wp), w1 = _mm256_loadu_ps(wp + 8), w2 = _mm256_loadu_ps(wp + 16);
+        const __m256 xs[4] = {_mm256_broadcast_ss(x0 + p), _mm256_broadcast_ss(x1 + p), _mm256_broadcast_ss(x2 + p), _mm256_broadcast_ss(x3 + p)};
+        for (int j = 0; j < 4; ++j) {
+          a[0][j] = _mm256_fmadd_ps(w0, xs[j], a[0][j]);
+          a[1][j] = _mm256_fmadd_ps(w1, xs[j], a[1][j]);
+          a[2][j] = _mm256_fmadd_ps(w2, xs[j], a[2][j]);
+        }
+      }
+      for (int j = 0; j < 4; ++j)
+        for (int b = 0; b < 3; ++b) store(c0 + j, i0 + 8 * b, a[b][j]);
+    }
+    for (; i0 < rp; i0 += 8) {
+      __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
+      for (PetscInt p = 0; p < M; ++p) {
+        const __m256 w = _mm256_loadu_ps(W + (size_t)p * rp + i0);
+        a0             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x0 + p), a0);
+        a1             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x1 + p), a1);
+        a2             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x2 + p), a2);
+        a3             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x3 + p), a3);
+      }
+      store(c0, i0, a0);
+      store(c0 + 1, i0, a1);
+      store(c0 + 2, i0, a2);
+      store(c0 + 3, i0, a3);
+    }
+  }
+  for (; c0 < nc; ++c0) {
+    const float *x = X + (size_t)c0 * M;
+    for (PetscInt i0 = 0; i0 < rp; i0 += 8) {
+      __m256 a = _mm256_setzero_ps();
+      for (PetscInt p = 0; p < M; ++p) a = _mm256_fmadd_ps(_mm256_loadu_ps(W + (size_t)p * rp + i0), _mm256_broadcast_ss(x + p), a);
+      store(c0, i0, a);
+    }
+  }
+}
+
+template <int NB>
+__attribute__((target("avx2,fma"))) void ScatterAvx2FFixed(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
+{
+  for (PetscInt p = 0; p < M; ++p) {
+    const float *w = W + (size_t)p * rp;
+    __m256       wr[NB];
+    for (int b = 0; b < NB; ++b) wr[b] = _mm256_loadu_ps(w + 8 * b);
+    const PetscInt  *ri = rowIdx + (size_t)p * maxTerms;
+    const PetscReal *cp = coef + (size_t)p * maxTerms;
+    for (PetscInt t = 0; t < nt[p]; ++t) {
+      const __m256 cf = _mm256_set1_ps((float)cp[t]);
+      float       *q  = Q + (size_t)ri[t] * rp;
+      for (int b = 0; b < NB; ++b) _mm256_storeu_ps(q + 8 * b, _mm256_fmadd_ps(cf, wr[b], _mm256_loadu_ps(q + 8 * b)));
+    }
+  }
+}
+
+__attribute__((target("avx2,fma"))) void ScatterAvx2F(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
+{
+  if (WithRegisterBlocks(rp / 8, [&](auto nb) { ScatterAvx2FFixed<decltype(nb)::value>(M, rp, nt, maxTerms, rowIdx, coef, W, Q); })) return;
+  ScatterPortableF(M, rp, nt, maxTerms, rowIdx, coef, W, Q);
+}
+
 __attribute__((target("avx2,fma"))) void RowDotsAvx2(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
 {
   for (PetscInt r = 0; r < rows; ++r) {
@@ -333,6 +440,22 @@ void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
   if (HaveAvx2()) return LowerGramAvx2(r, n, X, S);
 #endif
   LowerGramPortable(r, n, X, S);
+}
+
+void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return OuterAvx2F(M, rp, nc, W, X, K);
+#endif
+  OuterPortableF(M, rp, nc, W, X, K);
+}
+
+void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return ScatterAvx2F(M, rp, nt, maxTerms, rowIdx, coef, W, Q);
+#endif
+  ScatterPortableF(M, rp, nt, maxTerms, rowIdx, coef, W, Q);
 }
 
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)

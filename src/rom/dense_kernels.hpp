@@ -19,6 +19,11 @@ void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W
 // row-major, g of length rp; rowIdx and coef hold maxTerms entries per point). Accumulates into Q, g.
 void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g);
 
+// The dof sum in single precision (-rom_ecsw_precision single, docs/online.md): the same two steps with W, Q and X
+// in float (rp a multiple of 8, padding zero), the output K in double; ScatterRowsSingle leaves g to the caller.
+void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q);
+void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K);
+
 // out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major): the patch's nodal displacement
 // U = uD + theta v (ContactPatch::SetReduced).
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out);

@@ -195,6 +195,11 @@ void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector
     }
     return F;
   };
+  // the nodes that carry terms first (slave facets, then the candidate master facets), those that serve the
+  // vertex normals only after them: the dof sum runs over the first TermDofs() (docs/online.md)
+  for (auto &s : snew) renode(slave[s.first]);
+  for (auto &m : mnew)
+    if (search.count(m.first)) renode(master[m.first]);
   for (auto &s : snew) out->slave.push_back(renode(slave[s.first]));
   for (auto &m : mnew) {
     SurfaceFacet F = renode(master[m.first]);
@@ -247,6 +252,17 @@ void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector
     for (auto &o : order) out->cand.push_back(o.second);
     out->candStart.push_back((PetscInt)out->cand.size());
   }
+}
+
+PetscInt ContactPatch::TermDofs() const
+{
+  PetscInt last = -1; // the highest node of a facet that can carry a term: every slave facet, the searchable masters
+  for (const auto &F : slave)
+    for (PetscInt a = 0; a < F.nnodes; ++a) last = std::max(last, F.dof[a * dim] / dim);
+  for (size_t m = 0; m < master.size(); ++m)
+    if (searchable.empty() || searchable[m])
+      for (PetscInt a = 0; a < master[m].nnodes; ++a) last = std::max(last, master[m].dof[a * dim] / dim);
+  return (last + 1) * dim;
 }
 
 void ContactPatch::SelectBasis(const std::vector<PetscInt> &cols, ContactPatch *out) const
@@ -361,12 +377,13 @@ PetscInt ContactPatch::PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], P
     const PetscReal     sg = side ? 1.0 : -1.0;
     for (PetscInt a = 0; a < G.nnodes; ++a)
       for (PetscInt d = 0; d < dim; ++d) {
+        // written always, kept when nonzero (no branch: a projection onto an edge or vertex has zero shape values)
         const PetscReal cf = sg * Nb[a] * e.n2[d];
-        if (cf == 0.0) continue;
-        const PetscInt r = G.dof[a * dim + d];
+        const PetscInt  r  = G.dof[a * dim + d];
         g -= cf * uD[r];
-        coef[*nt]     = w * cf;
-        rowIdx[(*nt)++] = r;
+        coef[*nt]   = w * cf;
+        rowIdx[*nt] = r;
+        *nt += cf != 0.0;
       }
   }
   *gamma = w * g;

@@ -195,6 +195,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["Mc"]       = (long long)m.Mc();
   (*r)["hyper"]    = m.HyperName();
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
+  (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
   (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
@@ -232,6 +233,8 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
   // the online Kacanov loop's stopping tolerances the model was built with (-rom_kacanov_rtol_primal, _dual at
   // offline time: matched to the scene's accuracy targets, docs/online.md); online options override them
   w->Dataset("/online/kacanov_rtol", {2}, {(double)m.loop.rtolPrimal, (double)m.loop.rtolDual});
+  // the arithmetic of the cubature's dof sum the model was validated with (-rom_ecsw_precision: 64 or 32 bits)
+  w->Dataset("/online/ecsw_precision", {1}, {m.ecswSingle ? 32.0 : 64.0});
   if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
   if (m.HasEnrichment()) { // the answer's sizes, the rest is the error estimate's enrichment (docs/error_estimate.md)
     w->Dataset("/online/estimate/default_sizes", {2}, {(double)m.NDefault, (double)m.RDefault});
@@ -346,6 +349,12 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       loop.rtolDual   = kRtolDual;
     }
   }
+  { // optional (files written before 2026-11-26 have none: double): the arithmetic of the cubature's dof sum
+    bool found;
+    PetscCall(RomReadOptional(path, "/online/ecsw_precision", &d, &found));
+    PetscCheck(!found || (d.size() == 1 && (d[0] == 32 || d[0] == 64)), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw_precision must hold 32 or 64 (bits)", path.c_str());
+    ecswSingle = found && d[0] == 32;
+  }
   MkDefault = MgDefault = -1;
   { // optional: the EIM sizes chosen offline on held-out parameters (absent: all terms)
     bool found;
@@ -393,7 +402,8 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscInt  n = -1, r = -1, mk = -1, mg = -1, k = (PetscInt)ecswSum;
   char      hyper[64] = "";
   PetscBool hyperSet = PETSC_FALSE, sumSet = PETSC_FALSE;
-  const char *sums[] = {"auto", "points", "dofs"};
+  const char *sums[] = {"auto", "points", "dofs"}, *precisions[] = {"double", "single"};
+  PetscInt    prec = ecswSingle ? 1 : 0;
 
   PetscFunctionBeginUser;
   PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
@@ -405,6 +415,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
   if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
   PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
+  PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's dof sum (K^; g^ stays double): double or single (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
   PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
@@ -429,6 +440,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
     } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
   }
   if (sumSet) ecswSum = (EcswSum)k;
+  ecswSingle = prec == 1;
   PetscCall(Truncate(n, r, mk, mg));
   PetscFunctionReturn(0);
 }
@@ -484,9 +496,12 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     for (PetscInt i = 0; i < r; ++i) cPwT_[p * rp + i] = cPw[(size_t)i * cPoint.size() + p];
   { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum); the points'
     // row combination gathers its rows from theta and counts twice (measured: docs/online.md)
-    const PetscInt nd = patch.nnode * patch.dim, Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim)
-    const double   byPoints = (double)Mc * (2.0 * nt * Nfull + rp * (Na + 1)), byDofs = (double)Mc * rp * (nt + 1) + (double)nd * rp * Na;
+    const PetscInt nd = patch.TermDofs(), Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim); nd: the dofs terms fall on
+    // (single precision: the dof sum's kernels do twice the work per vector operation, count half; measured on the
+    // hertz3d mesh, docs/rom3d.md: points 1.46 ms, dofs 1.60 ms in double, 0.87 ms in single)
+    const double byPoints = (double)Mc * (2.0 * nt * Nfull + rp * (Na + 1)), byDofs = (ecswSingle ? 0.5 : 1.0) * ((double)Mc * rp * (nt + 1) + (double)nd * rp * Na);
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
+    cNd_   = nd;
     cThetaT_.clear();
     if (cDofs_) {
       cThetaT_.assign((size_t)Na * nd, 0.0);
@@ -496,6 +511,16 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
       cNt_.assign(Mc, 0);
       cRow_.assign((size_t)Mc * ContactPatch::MaxTerms, 0);
       cCoef_.assign((size_t)Mc * ContactPatch::MaxTerms, 0.0);
+    }
+    cSingle_ = cDofs_ && ecswSingle;
+    cPwTs_.clear();
+    cThetaTs_.clear();
+    if (cSingle_) {
+      const PetscInt rps = (r + 7) / 8 * 8;
+      cPwTs_.assign((size_t)Mc * rps, 0.0f);
+      for (PetscInt p = 0; p < Mc; ++p)
+        for (PetscInt i = 0; i < r; ++i) cPwTs_[(size_t)p * rps + i] = (float)cPwT_[(size_t)p * rp + i];
+      cThetaTs_.assign(cThetaT_.begin(), cThetaT_.end());
     }
   }
   if (!P_.empty()) {
@@ -516,7 +541,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   eThetaT_.clear();
   if (Na < Nfull || r < Rfull) { // the error estimate's enriched terms (EstimateError): every stored row and column
     qpEst_.Reserve(Nfull, Rfull);
-    const PetscInt rpf = PaddedRows(Rfull), Mc = (PetscInt)cPoint.size(), nd = patch.nnode * patch.dim;
+    const PetscInt rpf = PaddedRows(Rfull), Mc = (PetscInt)cPoint.size(), nd = cNd_;
     ePwT_.assign((size_t)Mc * rpf, 0.0);
     for (PetscInt p = 0; p < Mc; ++p)
       for (PetscInt i = 0; i < Rfull; ++i) ePwT_[(size_t)p * rpf + i] = cPw[(size_t)i * Mc + p];
@@ -572,7 +597,7 @@ void ReducedModel::CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, c
   const PetscInt M = (PetscInt)cPoint.size();
   Kp->resize((size_t)rp * (nc + 1));
   if (cDofs_) {
-    const PetscInt nd = patch.nnode * patch.dim;
+    const PetscInt nd = cNd_; // the dofs terms fall on (ContactPatch::TermDofs)
     Q->assign((size_t)nd * rp, 0.0);
     PetscReal *g = Kp->data() + (size_t)nc * rp;
     std::fill(g, g + rp, 0.0);
@@ -636,6 +661,18 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     wnMode_ = ContactMode::Cubature;
     out = cDofs_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
                  : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    if (cSingle_) {
+      const PetscInt rps = (r + 7) / 8 * 8, nd = cNd_;
+      cQs_.assign((size_t)nd * rps, 0.0f);
+      cK_.resize((size_t)rps * Na);
+      ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
+      SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
+      for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
+      cX_.resize(rp);
+      SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
+      std::copy(cX_.begin(), cX_.begin() + r, g);
+      return out;
+    }
     CubatureSum(rp, cPwT_, cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
     for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
@@ -713,7 +750,16 @@ void ReducedModel::ResultantForce(const std::vector<PetscReal> &lambda, std::vec
   if ((PetscInt)wn_.size() != M * d || (PetscInt)lambda.size() != r) return;
   F->assign(d, 0.0);
   if (exact) ForceAtPoints(M, r, Pact_.data(), M, 1, lambda.data(), wn_.data(), d, F->data());
-  else ForceAtPoints(M, r, cPwT_.data(), 1, rp, lambda.data(), wn_.data(), d, F->data());
+  else { // the points' multipliers l = PwT lambda in one vectorized kernel (rows of PwT contiguous), then sum_p l_p wn_p
+    thread_local std::vector<PetscReal> lpad, zero, l;
+    lpad.assign(rp, 0.0);
+    std::copy(lambda.begin(), lambda.end(), lpad.begin());
+    zero.assign(M, 0.0);
+    l.resize(M);
+    RowDots(M, rp, cPwT_.data(), lpad.data(), zero.data(), l.data());
+    for (PetscInt p = 0; p < M; ++p)
+      for (PetscInt k = 0; k < d; ++k) (*F)[k] += l[p] * wn_[(size_t)p * d + k];
+  }
 }
 
 PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol)
@@ -818,6 +864,8 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   sol->nactive = loop.history.nactive;
   if (!sol->converged) {
     sol->message = "reduced model: " + loop.NotConverged(false);
+    // the float dof sum leaves a noise floor on the changes (about 1e-6 on u, 1e-5 on lambda: docs/online.md)
+    if (cSingle_) sol->message += "; -rom_ecsw_precision single (stored in the ROM file) bounds the attainable changes to about 1e-6 (u) and 1e-5 (lambda): use -rom_ecsw_precision double for tighter tolerances";
     PetscFunctionReturn(0);
   }
   const PetscReal kkt = std::max(std::max(sol->qp.primal, sol->qp.dual), std::max(sol->qp.complementarity, sol->qp.stationarity));
