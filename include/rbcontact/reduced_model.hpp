@@ -183,7 +183,9 @@ public:
   bool EcswSumsByDofs() const { return cDofs_; }
   // -rom_ecsw_precision double|single: the dof sum's Q and K^ = Q' theta in float (twice the vector width; g^, the
   // points' kernel and the QP stay double). Measured on sphere_block3d: 248 -> 192 us, errors unchanged to 3 digits
-  // (docs/online.md "Single precision"). Stored in the ROM file (/online/ecsw_precision); options override it.
+  // (docs/online.md "Single precision"). It leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov
+  // changes: with tolerances near it the loop needs more iterates (half_disks at 1e-5: 2.4 -> 4.85 on average,
+  // slower than double). Stored in the ROM file (/online/ecsw_precision); options override it.
   bool ecswSingle = false;
   bool EcswSingle() const { return cSingle_; }
   bool      recordIterates = false;

@@ -415,7 +415,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
   if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
   PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
-  PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's dof sum (K^; g^ stays double): double or single (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
+  PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's dof sum (K^; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
   PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
