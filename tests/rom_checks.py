@@ -378,6 +378,7 @@ def half_disks(args):
           and du <= 1e-12 and dl <= 1e-8, "-rom_ecsw_sum points vs dofs: u_hat rel diff %.1e <= 1e-12, lambda_hat %.1e <= 1e-8 (coefficients of a "
           "nearly collinear dual basis), %d vs %d iterations" % (du, dl, sp["kacanov_iterations"], sd["kacanov_iterations"]))
     expect_error(args, ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_sum", "bogus"], ["bogus", "-rom_ecsw_sum"], "unknown -rom_ecsw_sum")
+    expect_error(args, ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_precision", "half"], ["half", "-rom_ecsw_precision"], "unknown -rom_ecsw_precision")
     shutil.rmtree(d, ignore_errors=True)
 
 

@@ -152,7 +152,7 @@ def help_(args):
     check("rbcontact: warning" not in p.stdout, "offline with the shipped scene: no rbcontact warning (unused option)")
     p = run(args, 1, ["online", "-rom", rom, "-help"])
     for opt in ("-rom", "-mu", "-report", "-online_repeat", "-rom_reconstruct", "-rom_hyper", "-rom_N", "-rom_R", "-rom_kkt_tol", "-rom_warm_start",
-                "-rom_ecsw_sum", "-rom_kacanov_rtol_primal", "-rom_qp_type"):
+                "-rom_ecsw_sum", "-rom_ecsw_precision", "-rom_kacanov_rtol_primal", "-rom_qp_type"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "online -help lists %s" % opt)
     p = run(args, 1, ["validate", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "1", "-validate_repeat", "1", "-help"])
     for opt in ("-rom", "-report", "-validate_repeat", "-validate_sweep", "-validate_sweep_fractions", "-validate_sweep_output", "-test_type", "-test_size",
