@@ -77,17 +77,21 @@ RBC_INLINE void LowerGramBody(PetscInt r, PetscInt n, const PetscReal *X, PetscR
 void RightSolveTPortable(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
 void LowerGramPortable(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
 
-void OuterPortable(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K)
+// T = double (K in place) or float (-rom_ecsw_precision single: the sum in float, K in double); rows in blocks of
+// 32 bytes (4 doubles, 8 floats)
+template <class T>
+void OuterPortable(PetscInt M, PetscInt rp, PetscInt nc, const T *W, const T *X, PetscReal *K)
 {
+  constexpr int B = 32 / sizeof(T);
   for (PetscInt c = 0; c < nc; ++c)
-    for (PetscInt i0 = 0; i0 < rp; i0 += 4) {
-      PetscReal        acc[4] = {0, 0, 0, 0};
-      const PetscReal *x      = X + (size_t)c * M;
+    for (PetscInt i0 = 0; i0 < rp; i0 += B) {
+      T        acc[B] = {};
+      const T *x      = X + (size_t)c * M;
       for (PetscInt p = 0; p < M; ++p) {
-        const PetscReal *w = W + (size_t)p * rp + i0;
-        for (int i = 0; i < 4; ++i) acc[i] += w[i] * x[p];
+        const T *w = W + (size_t)p * rp + i0;
+        for (int i = 0; i < B; ++i) acc[i] += w[i] * x[p];
       }
-      for (int i = 0; i < 4; ++i) K[(size_t)c * rp + i0 + i] = acc[i];
+      for (int i = 0; i < B; ++i) K[(size_t)c * rp + i0 + i] = acc[i];
     }
 }
 
@@ -104,21 +108,7 @@ void ScatterPortable(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTe
   }
 }
 
-// Single precision (-rom_ecsw_precision single): the dof sum's Q and theta' in float, the output in double
-void OuterPortableF(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
-{
-  for (PetscInt c = 0; c < nc; ++c)
-    for (PetscInt i0 = 0; i0 < rp; i0 += 8) {
-      float        acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-      const float *x      = X + (size_t)c * M;
-      for (PetscInt p = 0; p < M; ++p) {
-        const float *w = W + (size_t)p * rp + i0;
-        for (int i = 0; i < 8; ++i) acc[i] += w[i] * x[p];
-      }
-      for (int i = 0; i < 8; ++i) K[(size_t)c * rp + i0 + i] = acc[i];
-    }
-}
-
+// Single precision (-rom_ecsw_precision single): the dof sum's accumulation in float
 void ScatterPortableF(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
 {
   for (PetscInt p = 0; p < M; ++p) {
@@ -152,52 +142,84 @@ void CombinePortable(PetscInt nt, const PetscReal *coef, const PetscReal *const 
 }
 
 #ifdef RBC_KERNEL_DISPATCH
-__attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K)
+// One AVX2 register of T: 4 doubles or 8 floats (stored to K in double)
+template <class T>
+struct Avx2Reg;
+template <>
+struct Avx2Reg<double> {
+  using V = __m256d;
+  static constexpr int width = 4;
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Zero() { return _mm256_setzero_pd(); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Load(const double *w) { return _mm256_loadu_pd(w); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Bcast(const double *x) { return _mm256_broadcast_sd(x); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Fma(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE void Store(PetscReal *k, V a) { _mm256_storeu_pd(k, a); }
+};
+template <>
+struct Avx2Reg<float> {
+  using V = __m256;
+  static constexpr int width = 8;
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Zero() { return _mm256_setzero_ps(); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Load(const float *w) { return _mm256_loadu_ps(w); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Bcast(const float *x) { return _mm256_broadcast_ss(x); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE V Fma(V a, V b, V c) { return _mm256_fmadd_ps(a, b, c); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE void Store(PetscReal *k, V a) // 8 floats to 8 doubles
+  {
+    _mm256_storeu_pd(k, _mm256_cvtps_pd(_mm256_castps256_ps128(a)));
+    _mm256_storeu_pd(k + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)));
+  }
+};
+
+// 3 registers of rows x 4 columns in 12 registers: 3 loads and 4 broadcasts per 12 FMAs (the 1 x 4 block below
+// needs 1 load and 4 broadcasts per 4); 12 rows in double, 24 in float
+template <class T>
+__attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, PetscInt nc, const T *W, const T *X, PetscReal *K)
 {
-  PetscInt c0 = 0;
+  using R           = Avx2Reg<T>;
+  using V           = typename R::V;
+  constexpr int w   = R::width;
+  PetscInt      c0  = 0;
   for (; c0 + 4 <= nc; c0 += 4) {
-    const PetscReal *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
-    PetscInt         i0 = 0;
-    // 12 rows x 4 columns in 12 registers: 3 loads and 4 broadcasts per 12 FMAs (the 4 x 4 block
-    // below needs 1 load and 4 broadcasts per 4)
-    for (; i0 + 12 <= rp; i0 += 12) {
-      __m256d a[3][4];
+    const T *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
+    PetscInt i0 = 0;
+    for (; i0 + 3 * w <= rp; i0 += 3 * w) {
+      V a[3][4];
       for (int b = 0; b < 3; ++b)
-        for (int j = 0; j < 4; ++j) a[b][j] = _mm256_setzero_pd();
+        for (int j = 0; j < 4; ++j) a[b][j] = R::Zero();
       for (PetscInt p = 0; p < M; ++p) {
-        const PetscReal *wp = W + (size_t)p * rp + i0;
-        const __m256d    w0 = _mm256_loadu_pd(wp), w1 = _mm256_loadu_pd(wp + 4), w2 = _mm256_loadu_pd(wp + 8);
-        const __m256d    xs[4] = {_mm256_broadcast_sd(x0 + p), _mm256_broadcast_sd(x1 + p), _mm256_broadcast_sd(x2 + p), _mm256_broadcast_sd(x3 + p)};
+        const T *wp = W + (size_t)p * rp + i0;
+        const V  w0 = R::Load(wp), w1 = R::Load(wp + w), w2 = R::Load(wp + 2 * w);
+        const V  xs[4] = {R::Bcast(x0 + p), R::Bcast(x1 + p), R::Bcast(x2 + p), R::Bcast(x3 + p)};
         for (int j = 0; j < 4; ++j) {
-          a[0][j] = _mm256_fmadd_pd(w0, xs[j], a[0][j]);
-          a[1][j] = _mm256_fmadd_pd(w1, xs[j], a[1][j]);
-          a[2][j] = _mm256_fmadd_pd(w2, xs[j], a[2][j]);
+          a[0][j] = R::Fma(w0, xs[j], a[0][j]);
+          a[1][j] = R::Fma(w1, xs[j], a[1][j]);
+          a[2][j] = R::Fma(w2, xs[j], a[2][j]);
         }
       }
       for (int j = 0; j < 4; ++j)
-        for (int b = 0; b < 3; ++b) _mm256_storeu_pd(K + (size_t)(c0 + j) * rp + i0 + 4 * b, a[b][j]);
+        for (int b = 0; b < 3; ++b) R::Store(K + (size_t)(c0 + j) * rp + i0 + w * b, a[b][j]);
     }
-    for (; i0 < rp; i0 += 4) {
-      __m256d a0 = _mm256_setzero_pd(), a1 = a0, a2 = a0, a3 = a0;
+    for (; i0 < rp; i0 += w) {
+      V a0 = R::Zero(), a1 = a0, a2 = a0, a3 = a0;
       for (PetscInt p = 0; p < M; ++p) {
-        const __m256d w = _mm256_loadu_pd(W + (size_t)p * rp + i0);
-        a0              = _mm256_fmadd_pd(w, _mm256_broadcast_sd(x0 + p), a0);
-        a1              = _mm256_fmadd_pd(w, _mm256_broadcast_sd(x1 + p), a1);
-        a2              = _mm256_fmadd_pd(w, _mm256_broadcast_sd(x2 + p), a2);
-        a3              = _mm256_fmadd_pd(w, _mm256_broadcast_sd(x3 + p), a3);
+        const V v = R::Load(W + (size_t)p * rp + i0);
+        a0        = R::Fma(v, R::Bcast(x0 + p), a0);
+        a1        = R::Fma(v, R::Bcast(x1 + p), a1);
+        a2        = R::Fma(v, R::Bcast(x2 + p), a2);
+        a3        = R::Fma(v, R::Bcast(x3 + p), a3);
       }
-      _mm256_storeu_pd(K + (size_t)c0 * rp + i0, a0);
-      _mm256_storeu_pd(K + (size_t)(c0 + 1) * rp + i0, a1);
-      _mm256_storeu_pd(K + (size_t)(c0 + 2) * rp + i0, a2);
-      _mm256_storeu_pd(K + (size_t)(c0 + 3) * rp + i0, a3);
+      R::Store(K + (size_t)c0 * rp + i0, a0);
+      R::Store(K + (size_t)(c0 + 1) * rp + i0, a1);
+      R::Store(K + (size_t)(c0 + 2) * rp + i0, a2);
+      R::Store(K + (size_t)(c0 + 3) * rp + i0, a3);
     }
   }
   for (; c0 < nc; ++c0) {
-    const PetscReal *x = X + (size_t)c0 * M;
-    for (PetscInt i0 = 0; i0 < rp; i0 += 4) {
-      __m256d a = _mm256_setzero_pd();
-      for (PetscInt p = 0; p < M; ++p) a = _mm256_fmadd_pd(_mm256_loadu_pd(W + (size_t)p * rp + i0), _mm256_broadcast_sd(x + p), a);
-      _mm256_storeu_pd(K + (size_t)c0 * rp + i0, a);
+    const T *x = X + (size_t)c0 * M;
+    for (PetscInt i0 = 0; i0 < rp; i0 += w) {
+      V a = R::Zero();
+      for (PetscInt p = 0; p < M; ++p) a = R::Fma(R::Load(W + (size_t)p * rp + i0), R::Bcast(x + p), a);
+      R::Store(K + (size_t)c0 * rp + i0, a);
     }
   }
 }
@@ -256,63 +278,7 @@ __attribute__((target("avx2,fma"))) void ScatterAvx2(PetscInt M, PetscInt rp, co
   }
 }
 
-// 24 rows (3 x 8 floats) x 4 columns in 12 registers, then blocks of 8 rows
-// 8 floats to 8 doubles at k
-__attribute__((target("avx2,fma"))) RBC_INLINE void StoreAsDouble(PetscReal *k, __m256 a)
-{
-  _mm256_storeu_pd(k, _mm256_cvtps_pd(_mm256_castps256_ps128(a)));
-  _mm256_storeu_pd(k + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)));
-}
-
-__attribute__((target("avx2,fma"))) void OuterAvx2F(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
-{
-  auto store = [K, rp](PetscInt c, PetscInt i0, __m256 a) __attribute__((target("avx2,fma"))) { StoreAsDouble(K + (size_t)c * rp + i0, a); };
-  PetscInt c0 = 0;
-  for (; c0 + 4 <= nc; c0 += 4) {
-    const float *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
-    PetscInt     i0 = 0;
-    for (; i0 + 24 <= rp; i0 += 24) {
-      __m256 a[3][4];
-      for (int b = 0; b < 3; ++b)
-        for (int j = 0; j < 4; ++j) a[b][j] = _mm256_setzero_ps();
-      for (PetscInt p = 0; p < M; ++p) {
-        const float *wp = W + (size_t)p * rp + i0;
-        const __m256 w0 = _mm256_loadu_ps(wp), w1 = _mm256_loadu_ps(wp + 8), w2 = _mm256_loadu_ps(wp + 16);
-        const __m256 xs[4] = {_mm256_broadcast_ss(x0 + p), _mm256_broadcast_ss(x1 + p), _mm256_broadcast_ss(x2 + p), _mm256_broadcast_ss(x3 + p)};
-        for (int j = 0; j < 4; ++j) {
-          a[0][j] = _mm256_fmadd_ps(w0, xs[j], a[0][j]);
-          a[1][j] = _mm256_fmadd_ps(w1, xs[j], a[1][j]);
-          a[2][j] = _mm256_fmadd_ps(w2, xs[j], a[2][j]);
-        }
-      }
-      for (int j = 0; j < 4; ++j)
-        for (int b = 0; b < 3; ++b) store(c0 + j, i0 + 8 * b, a[b][j]);
-    }
-    for (; i0 < rp; i0 += 8) {
-      __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, a3 = a0;
-      for (PetscInt p = 0; p < M; ++p) {
-        const __m256 w = _mm256_loadu_ps(W + (size_t)p * rp + i0);
-        a0             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x0 + p), a0);
-        a1             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x1 + p), a1);
-        a2             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x2 + p), a2);
-        a3             = _mm256_fmadd_ps(w, _mm256_broadcast_ss(x3 + p), a3);
-      }
-      store(c0, i0, a0);
-      store(c0 + 1, i0, a1);
-      store(c0 + 2, i0, a2);
-      store(c0 + 3, i0, a3);
-    }
-  }
-  for (; c0 < nc; ++c0) {
-    const float *x = X + (size_t)c0 * M;
-    for (PetscInt i0 = 0; i0 < rp; i0 += 8) {
-      __m256 a = _mm256_setzero_ps();
-      for (PetscInt p = 0; p < M; ++p) a = _mm256_fmadd_ps(_mm256_loadu_ps(W + (size_t)p * rp + i0), _mm256_broadcast_ss(x + p), a);
-      store(c0, i0, a);
-    }
-  }
-}
-
+// The single-precision accumulation: the point's row of W in NB registers of 8 floats over its terms
 template <int NB>
 __attribute__((target("avx2,fma"))) void ScatterAvx2FFixed(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
 {
@@ -413,9 +379,9 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
 void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K)
 {
 #ifdef RBC_KERNEL_DISPATCH
-  if (HaveAvx2()) return OuterAvx2(M, rp, nc, W, X, K);
+  if (HaveAvx2()) return OuterAvx2<double>(M, rp, nc, W, X, K);
 #endif
-  OuterPortable(M, rp, nc, W, X, K);
+  OuterPortable<double>(M, rp, nc, W, X, K);
 }
 
 void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const PetscReal *W, const PetscReal *gamma, PetscReal *Q, PetscReal *g)
@@ -445,9 +411,9 @@ void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
 void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
 {
 #ifdef RBC_KERNEL_DISPATCH
-  if (HaveAvx2()) return OuterAvx2F(M, rp, nc, W, X, K);
+  if (HaveAvx2()) return OuterAvx2<float>(M, rp, nc, W, X, K);
 #endif
-  OuterPortableF(M, rp, nc, W, X, K);
+  OuterPortable<float>(M, rp, nc, W, X, K);
 }
 
 void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q)
