@@ -1,4 +1,5 @@
-// src/rom/dense_kernels.cpp: CombineRows, SumOfOuterProducts, ScatterRows, RowDots, and the reduced QP's
+// src/rom/dense_kernels.cpp: CombineRows, SumOfOuterProducts, ScatterRows (and their single-precision variants for
+// -rom_ecsw_precision single), RowDots, and the reduced QP's
 // RightSolveT and LowerGram (dense_kernels.hpp). A portable version of each and, on x86-64 with GCC or
 // clang, an AVX2+FMA version (intrinsics for the contact kernels, where the auto-vectorizer shuffled the
 // wrong dimension; the QP's loops compiled for AVX2), chosen once from __builtin_cpu_supports. The
@@ -175,10 +176,10 @@ struct Avx2Reg<float> {
 template <class T>
 __attribute__((target("avx2,fma"))) void OuterAvx2(PetscInt M, PetscInt rp, PetscInt nc, const T *W, const T *X, PetscReal *K)
 {
-  using R           = Avx2Reg<T>;
-  using V           = typename R::V;
-  constexpr int w   = R::width;
-  PetscInt      c0  = 0;
+  using R         = Avx2Reg<T>;
+  using V         = typename R::V;
+  constexpr int w = R::width;
+  PetscInt      c0 = 0;
   for (; c0 + 4 <= nc; c0 += 4) {
     const T *x0 = X + (size_t)c0 * M, *x1 = x0 + M, *x2 = x1 + M, *x3 = x2 + M;
     PetscInt i0 = 0;

@@ -865,7 +865,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   if (!sol->converged) {
     sol->message = "reduced model: " + loop.NotConverged(false);
     // the float dof sum leaves a noise floor on the changes (about 1e-6 on u, 1e-5 on lambda: docs/online.md)
-    if (cSingle_) sol->message += "; -rom_ecsw_precision single (stored in the ROM file) bounds the attainable changes to about 1e-6 (u) and 1e-5 (lambda): use -rom_ecsw_precision double for tighter tolerances";
+    if (cSingle_) sol->message += "; -rom_ecsw_precision single (the ROM file's or the option's) bounds the attainable changes to about 1e-6 (u) and 1e-5 (lambda): use -rom_ecsw_precision double for tighter tolerances";
     PetscFunctionReturn(0);
   }
   const PetscReal kkt = std::max(std::max(sol->qp.primal, sol->qp.dual), std::max(sol->qp.complementarity, sol->qp.stationarity));
