@@ -121,7 +121,7 @@ int main(int argc, char **argv)
   for (PetscInt M : {0, 1, 7, 202, 631})
     for (PetscInt r : {1, 5, 8, 9, 24, 30, 33, 44})
       for (PetscInt nc : {1, 3, 4, 5, 44}) {
-        const PetscInt      rps = (r + 7) / 8 * 8;
+        const PetscInt      rps = PaddedRows(r, 8);
         std::vector<float>  W((size_t)M * rps, 0.0f), X((size_t)nc * M);
         std::vector<double> K((size_t)rps * nc, -7.0);
         for (PetscInt p = 0; p < M; ++p)
@@ -146,7 +146,7 @@ int main(int argc, char **argv)
       }
   for (PetscInt M : {0, 1, 7, 202})
     for (PetscInt r : {1, 5, 8, 9, 24, 30, 45, 96, 97, 120}) {
-      const PetscInt        rps = (r + 7) / 8 * 8, nd = 13, maxT = 36;
+      const PetscInt        rps = PaddedRows(r, 8), nd = 13, maxT = 36;
       std::vector<float>    W((size_t)M * rps, 0.0f), Q((size_t)nd * rps, 0.5f);
       std::vector<double>   coef((size_t)M * maxT, 99.0), Qr(Q.size(), 0.5), Qa(Q.size(), 0.5);
       std::vector<PetscInt> nt(M), row((size_t)M * maxT, -1), count(Q.size(), 1);

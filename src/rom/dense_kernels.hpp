@@ -24,8 +24,8 @@ void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms,
 void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q);
 void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K);
 
-// out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major): the patch's nodal displacement
-// U = uD + theta v (ContactPatch::SetReduced).
+// out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major; b and out may be the same array): the patch's
+// nodal displacement U = uD + theta v (ContactPatch::SetReduced), the cubature points' multipliers (ResultantForce).
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out);
 
 // The reduced QP's set-up (src/rom/reduced_qp.cpp): X = D L^{-T} (D, X: r x n column-major, leading
@@ -33,7 +33,7 @@ void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, 
 void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X);
 void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S);
 
-// rp for r rows: r rounded up to the kernel's block (4).
-inline PetscInt PaddedRows(PetscInt r) { return (r + 3) / 4 * 4; }
+// rp for r rows: r rounded up to the kernel's block (4 doubles; 8 floats for the single-precision dof sum).
+inline PetscInt PaddedRows(PetscInt r, PetscInt block = 4) { return (r + block - 1) / block * block; }
 
 } // namespace rbc

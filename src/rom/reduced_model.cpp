@@ -516,7 +516,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     cPwTs_.clear();
     cThetaTs_.clear();
     if (cSingle_) {
-      const PetscInt rps = (r + 7) / 8 * 8;
+      const PetscInt rps = PaddedRows(r, 8);
       cPwTs_.assign((size_t)Mc * rps, 0.0f);
       for (PetscInt p = 0; p < Mc; ++p)
         for (PetscInt i = 0; i < r; ++i) cPwTs_[(size_t)p * rps + i] = (float)cPwT_[(size_t)p * rp + i];
@@ -662,7 +662,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     out = cDofs_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
                  : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
     if (cSingle_) {
-      const PetscInt rps = (r + 7) / 8 * 8, nd = cNd_;
+      const PetscInt rps = PaddedRows(r, 8), nd = cNd_;
       cQs_.assign((size_t)nd * rps, 0.0f);
       cK_.resize((size_t)rps * Na);
       ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
@@ -728,14 +728,14 @@ PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolu
 
 // F = sum_i lambda_i int psi_i n2 (the FOM's resultant) through the contact terms' last evaluation:
 // lambda(x_p) times the point's weight and cubature weight = (Pw(:, p)' lambda^) and w_p n2(x_p) (wn_).
-// F (d entries) = sum_p (sum_i P(i, p) lambda_i) wn(p, :) over M points and r rows, P(i, p) = P[i * si + p * sp]:
-// the multipliers' weight at each point times w_p n2(x_p)
-static void ForceAtPoints(PetscInt M, PetscInt r, const PetscReal *P, size_t si, size_t sp, const PetscReal *lambda, const PetscReal *wn, PetscInt d, PetscReal *F)
+// F (d entries) = sum_p (sum_i P(i, p) lambda_i) wn(p, :) over M points and r rows, P r x M row-major: the
+// multipliers' weight at each point times w_p n2(x_p) (the cubature's point-major weights: ResultantForce)
+static void ForceAtPoints(PetscInt M, PetscInt r, const PetscReal *P, const PetscReal *lambda, const PetscReal *wn, PetscInt d, PetscReal *F)
 {
   for (PetscInt k = 0; k < d; ++k) F[k] = 0;
   for (PetscInt p = 0; p < M; ++p) {
     PetscReal l = 0;
-    for (PetscInt i = 0; i < r; ++i) l += P[i * si + p * sp] * lambda[i];
+    for (PetscInt i = 0; i < r; ++i) l += P[(size_t)i * M + p] * lambda[i];
     for (PetscInt k = 0; k < d; ++k) F[k] += l * wn[(size_t)p * d + k];
   }
 }
@@ -749,14 +749,13 @@ void ReducedModel::ResultantForce(const std::vector<PetscReal> &lambda, std::vec
   const PetscInt M     = exact ? (PetscInt)(Pact_.size() / std::max<PetscInt>(r, 1)) : (PetscInt)cPoint.size(), rp = PaddedRows(r);
   if ((PetscInt)wn_.size() != M * d || (PetscInt)lambda.size() != r) return;
   F->assign(d, 0.0);
-  if (exact) ForceAtPoints(M, r, Pact_.data(), M, 1, lambda.data(), wn_.data(), d, F->data());
+  if (exact) ForceAtPoints(M, r, Pact_.data(), lambda.data(), wn_.data(), d, F->data());
   else { // the points' multipliers l = PwT lambda in one vectorized kernel (rows of PwT contiguous), then sum_p l_p wn_p
-    thread_local std::vector<PetscReal> lpad, zero, l;
+    thread_local std::vector<PetscReal> lpad, l;
     lpad.assign(rp, 0.0);
     std::copy(lambda.begin(), lambda.end(), lpad.begin());
-    zero.assign(M, 0.0);
-    l.resize(M);
-    RowDots(M, rp, cPwT_.data(), lpad.data(), zero.data(), l.data());
+    l.assign(M, 0.0);
+    RowDots(M, rp, cPwT_.data(), lpad.data(), l.data(), l.data()); // l = 0 + PwT lambda (b and out may alias)
     for (PetscInt p = 0; p < M; ++p)
       for (PetscInt k = 0; k < d; ++k) (*F)[k] += l[p] * wn_[(size_t)p * d + k];
   }
@@ -958,7 +957,7 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   // the resultant force of the enriched multipliers at the same points
   if (!sol->force.empty() && (PetscInt)wn_.size() == M * dim) {
     PetscReal F2[3] = {0, 0, 0};
-    ForceAtPoints(M, Rf, Pw, M, 1, el_.data(), wn_.data(), dim, F2);
+    ForceAtPoints(M, Rf, Pw, el_.data(), wn_.data(), dim, F2);
     PetscReal df = 0, nf = 0;
     for (PetscInt k = 0; k < dim; ++k) {
       df += PetscSqr(F2[k] - sol->force[k]);
