@@ -5,7 +5,8 @@
               the size of the mesh; online on 1 and 2 ranks gives the same answer; the TAO QP agrees with
               the active-set QP; validate on 20 random radii meets the accuracy targets (u <= 1e-3,
               lambda <= 1e-2, N, R <= 30) on 1 and 2 ranks with the same errors; the sweep table; the
-              reconstructed fields against the FOM at the same radius.
+              reconstructed fields against the FOM at the same radius; the hierarchical cubature
+              (-ecsw_group_points) within its tolerances and as accurate.
   bad_input   missing/corrupt/mismatched ROM files, a bases-only file, mu outside the box, truncation
               out of range: clear errors naming the file, dataset, option or value.
   infeasible  a dual basis too rich for the primal one (no supremizers) is refused with a hint.
@@ -124,6 +125,21 @@ def pipeline(args):
     rms = np.sqrt(np.mean(eKt ** 2 + egt ** 2) / 2)
     check(ct["fit"] == "terms" and ct["residual"] <= ct["tol"] and min(ct["weights"]) > 0, "-ecsw_fit terms: residual %.2e <= tol %.0e, %d points, weights > 0" % (ct["residual"], ct["tol"], ct["M"]))
     check(abs(rms - ct["residual"]) <= 1e-3 * ct["residual"], "training states: RMS of the K^, g^ errors %.4e = reported residual %.4e" % (rms, ct["residual"]))
+    # the hierarchical cubature (-ecsw_group_points, docs/hyper_reduction.md): groups of at most 100 points, each
+    # within its tolerance, the final fit within -ecsw_tol against every point's terms, and the ROM as accurate
+    # as the one-Gram fit's on 20 random radii (validate, 2 ranks)
+    os.makedirs(d + "/groups")
+    romg, offg = offline(args, d + "/groups", extra=["-ecsw_group_points", "100"])
+    cg = offg["ecsw"]
+    Q = offg["eim"]["quadrature_points"]
+    check(cg["groups"] == -(-Q // 100) > 1 and c["groups"] == 1 and c["candidates"] == Q,
+          "-ecsw_group_points 100: %d groups of the %d points (default: one Gram matrix)" % (cg["groups"], Q))
+    check(max(cg["group_residuals"]) <= cg["group_tol"] <= cg["tol"] and cg["residual"] <= cg["tol"] and min(cg["weights"]) > 0 and cg["M"] <= cg["candidates"],
+          "groups within their tolerance %.2e, final residual %.2e <= %.0e among %d candidates, %d points, weights > 0" % (cg["group_tol"], cg["residual"], cg["tol"], cg["candidates"], cg["M"]))
+    run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", romg, "-validate_repeat", "1", "-report", d + "/groups/val.json"])
+    tg = report(d + "/groups/val.json")["test"]
+    check(tg["max_rel_err_u"] <= 1e-4 and tg["max_rel_err_lambda"] <= 1e-2 and tg["max_rel_err_force"] <= 1e-3,
+          "hierarchical cubature's ROM, 20 random radii: u %.2e <= 1e-4, lambda %.2e <= 1e-2, force %.2e <= 1e-3" % (tg["max_rel_err_u"], tg["max_rel_err_lambda"], tg["max_rel_err_force"]))
     # the same offline stage on 1 rank: the same ROM
     d2 = d + "/np1"
     os.makedirs(d2)

@@ -9,8 +9,11 @@
 //     residual <= 1e-9) and the moments it gives match the full rule's.
 //  3. Random reduced terms (R = 4, N = 3, 12 states, Q = 80): weights >= 0, the final residual <= tol,
 //     the residual recomputed from the fitted terms state by state equals the reported one, the history
-//     decreases to it, and fewer points than Q are used.
+//     decreases to it, and fewer points than Q are used; the hierarchical fit (4 groups, -ecsw_group_points):
+//     every group within its tolerance, the residual against the exact terms over all points <= tol; the Gram
+//     system on candidates (H_CC, b_C, c) against the explicit rows (1b).
 #include "rbcontact/empirical_cubature.hpp"
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -170,6 +173,35 @@ int main(int argc, char **argv)
     CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HB, Sw, dim, 2);
     const PetscReal dB = GramMismatch(GG, Q, HB);
     Check(ms > 2 && dB <= 1e-13, "CubatureActionGram with the states in blocks of 2 = G'G of the explicit rows", dB, 1e-13);
+    // on candidate points C (every third point): H_CC, (H 1)_C and 1'H1 of the explicit rows over every point,
+    // with the states in one block and in blocks of 2
+    CubatureCandidates cand;
+    for (PetscInt p = 1; p < Q; p += 3) cand.points.push_back(p);
+    for (PetscInt blk : {0, 2}) {
+      std::vector<PetscReal> HC;
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HC, Sw, dim, blk, &cand);
+      PetscReal d = 0, sc = 0, db = 0, sb = 0, c = 0;
+      const size_t rows = GG.size() / Q, nc = cand.points.size();
+      std::vector<PetscReal> G1(rows, 0.0);
+      for (size_t i = 0; i < rows; ++i)
+        for (PetscInt p = 0; p < Q; ++p) G1[i] += GG[i * Q + p];
+      for (PetscReal t : G1) c += t * t;
+      for (size_t a = 0; a < nc; ++a) {
+        PetscReal b = 0;
+        for (size_t i = 0; i < rows; ++i) b += GG[i * Q + cand.points[a]] * G1[i];
+        db = std::max(db, std::abs(b - cand.b[a]));
+        sb = std::max(sb, std::abs(b));
+        for (size_t k = 0; k < nc; ++k) {
+          PetscReal h = 0;
+          for (size_t i = 0; i < rows; ++i) h += GG[i * Q + cand.points[a]] * GG[i * Q + cand.points[k]];
+          d  = std::max(d, std::abs(h - HC[a * nc + k]));
+          sc = std::max(sc, std::abs(h));
+        }
+      }
+      Check(HC.size() == nc * nc && d <= 1e-13 * sc, blk ? "candidates, blocks of 2: H_CC = (G'G)_CC (max |diff| / max)" : "candidates: H_CC = (G'G)_CC of the explicit rows (max |diff| / max)", d / sc, 1e-13);
+      Check(db <= 1e-13 * sb, blk ? "candidates, blocks of 2: b_C = (G'G 1)_C over every point" : "candidates: b_C = (G'G 1)_C over every point (max |diff| / max)", db / sb, 1e-13);
+      Check(std::abs(c - cand.c) <= 1e-13 * c, "candidates: c = |G 1|^2 over every point (rel diff)", std::abs(c - cand.c) / c, 1e-13);
+    }
   }
 
   { // 2. moments 0..4 of a 60-point rule: a nonnegative rule on <= 5 of its points
@@ -238,6 +270,39 @@ int main(int argc, char **argv)
     Check(std::abs(rec - res.residual) <= 1e-6 * opt.tol + 1e-3 * res.residual, "random terms: residual recomputed from the fitted terms (|diff|)", std::abs(rec - res.residual), 1e-3 * res.residual);
     Check((PetscInt)res.points.size() < Q, "random terms: points used (< Q)", (double)res.points.size(), Q);
     Check(res.history.back() == res.residual && res.history.front() == 1.0, "random terms: history from 1 to the final residual (last - residual)", res.history.back() - res.residual, 0);
+
+    // the hierarchical fit (4 groups of 20 points): points weights > 0, every group within its tolerance, and the
+    // reported residual <= tol is the error against the exact terms over all 80 points (recomputed state by state)
+    CubatureOptions oh = opt;
+    oh.groupPoints     = 20;
+    CubatureResult    rc;
+    CubatureHierarchy hi;
+    PetscCall(HierarchicalCubature(Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &rc, &hi));
+    std::vector<PetscReal> xc(Q, 0.0);
+    bool                   pos = !rc.points.empty(), groupsOk = hi.groups == 4 && hi.groupResiduals.size() == 4 && hi.groupTol > 0 && hi.groupTol <= oh.tol;
+    for (size_t j = 0; j < rc.points.size(); ++j) {
+      pos = pos && rc.weights[j] > 0 && rc.points[j] >= 0 && rc.points[j] < Q;
+      xc[rc.points[j]] = rc.weights[j];
+    }
+    for (PetscReal r : hi.groupResiduals) groupsOk = groupsOk && r <= hi.groupTol;
+    PetscReal sumc = 0;
+    for (PetscInt s = 0; s < ms; ++s) {
+      Terms(P, R, Q, N, Sk, Sg, s, xc, &K, &g);
+      Terms(P, R, Q, N, Sk, Sg, s, one, &K0, &g0);
+      std::vector<PetscReal> dK(K.size()), dg(g.size());
+      for (size_t i = 0; i < K.size(); ++i) dK[i] = K[i] - K0[i];
+      for (size_t i = 0; i < g.size(); ++i) dg[i] = g[i] - g0[i];
+      sumc += Norm2(dK) / Norm2(K0) + Norm2(dg) / Norm2(g0);
+    }
+    const PetscReal recc = std::sqrt(sumc / (2 * ms));
+    Check(pos && (PetscInt)rc.points.size() <= hi.candidates, "hierarchical (4 groups of 20): weights > 0, points among the groups' union (points)", (double)rc.points.size(), (double)hi.candidates);
+    Check(groupsOk, "hierarchical: every group within its tolerance (group tol)", hi.groupTol, oh.tol);
+    Check(rc.residual <= opt.tol, "hierarchical: relative residual <= tol", rc.residual, opt.tol);
+    Check(std::abs(recc - rc.residual) <= 1e-6 * opt.tol + 1e-3 * rc.residual, "hierarchical: residual recomputed against the exact terms over all 80 points (|diff|)", std::abs(recc - rc.residual), 1e-3 * rc.residual);
+    CubatureResult r1;
+    oh.groupPoints = 80; // one group: the plain fit
+    PetscCall(HierarchicalCubature(Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &r1, &hi));
+    Check(hi.groups == 1 && r1.points == res.points && r1.weights == res.weights, "hierarchical with one group = the plain fit (groups)", (double)hi.groups, 1);
   }
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, failures ? "test_empirical_cubature FAILED (%d failure(s))\n" : "test_empirical_cubature passed\n", failures));
   PetscCall(PetscFinalize());

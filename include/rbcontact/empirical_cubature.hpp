@@ -11,11 +11,13 @@
 // Frobenius norm). Nonnegative weights keep every reduced row a nonnegative combination of pointwise
 // gaps, as in the full-order model. Dimension-generic (the points are patch points, 2D or 3D).
 // Solved in Gram form H = G'G (Q x Q, the Hadamard product of P'P with the states' kernel Grams) by
-// Lawson-Hanson's active-set method stopped at the tolerance (the greedy of ECSW). Serial dense code:
+// Lawson-Hanson's active-set method stopped at the tolerance (the greedy of ECSW); with more points than
+// -ecsw_group_points, hierarchically (HierarchicalCubature). Serial dense code:
 // every rank given the same data computes bitwise the same result.
 // Implementation: src/reduction/empirical_cubature.cpp; method, options, measurements: docs/hyper_reduction.md.
 #pragma once
 #include <petscsys.h>
+#include <functional>
 #include <vector>
 
 namespace rbc {
@@ -29,6 +31,8 @@ struct CubatureOptions {
   CubatureFit fit     = CubatureFit::Action; // -ecsw_fit (docs/hyper_reduction.md: fewer points for the same errors)
   PetscReal tol       = 1e-4;  // stop when ||G (xi - 1)|| <= tol ||G 1|| (relative RMS error of the fitted terms)
   PetscInt  maxPoints = 1000;  // at most this many points (the tolerance decides; a safeguard)
+  PetscInt  groupPoints = 8000; // -ecsw_group_points: more quadrature points than this: the hierarchical fit
+                                // (HierarchicalCubature); the Gram memory stays 3 x 8 bytes x (this or the union)^2
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
@@ -42,14 +46,24 @@ struct CubatureResult {
   PetscInt               iterations = 0; // Lawson-Hanson steps (inner removals included)
 };
 
-// Options with prefix pre (e.g. "ecsw_"): -<pre>fit, -<pre>fit_force, -<pre>tol, -<pre>max_points, -<pre>monitor.
+// The fit restricted to candidate points C (a subset of the Q points): the Gram matrix on C only (|C| x |C|) and the
+// target's pieces over every point, b_C = (H 1)_C and c = 1'H1 (H the Q x Q Gram matrix, never formed), so that the
+// residual still measures the selected points' terms against the exact ones (sums over all Q points).
+struct CubatureCandidates {
+  std::vector<PetscInt>  points; // candidate point indices (into 0..Q-1); empty: every point, the Q x Q Gram matrix
+  std::vector<PetscReal> b;      // (H 1)_C, filled by CubatureGram / CubatureActionGram
+  PetscReal              c = 0;  // 1'H1
+};
+
+// Options with prefix pre (e.g. "ecsw_"): -<pre>fit, -<pre>fit_force, -<pre>tol, -<pre>max_points, -<pre>group_points, -<pre>monitor.
 PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, CubatureOptions *opt);
 
 // The Gram matrix H (Q x Q, row-major) of the fitting problem from ms states: kappa snapshots Sk (ms
 // blocks of Q x N, row-major per block, as ContactPatch::Evaluate returns them), gamma snapshots Sg
 // (ms blocks of Q) and P (R x Q row-major). Each state's K^ and g^ enter scaled to unit norm (a state
 // whose K^ or g^ vanishes contributes nothing for that term).
-void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H);
+// With cand (points nonempty): H is the Gram matrix on the candidates (|C| x |C|) and cand->b, cand->c are filled.
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand = nullptr);
 
 // The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
 // and Vs (nt x N, row-major),
@@ -62,8 +76,8 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
 // (P' lam_j)(p) w_p n2(x_p), the output of interest the online stage computes from the cubature (docs/online.md):
 //   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
 // Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
-// they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding.
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0);
+// they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding. With cand, as CubatureGram.
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);
@@ -72,6 +86,28 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
 // gradient) until the relative residual sqrt((xi - 1)' H (xi - 1) / 1' H 1) <= opt.tol.
 // Errors: H not Q x Q or non-finite -> PETSC_ERR_ARG_*; tolerance not reached within maxPoints or
 // before the gradient vanishes -> result returned with its residual (the caller decides).
-PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res);
+// With cand (points nonempty): H is the candidates' Gram matrix, b and c come from cand, the selected points are
+// returned as indices into 0..Q-1.
+PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand = nullptr);
+
+// The Gram system of the fit on candidates (nullptr: every point, H Q x Q): CubatureGram or CubatureActionGram bound to
+// their data.
+using CubatureGramFunction = std::function<void(CubatureCandidates *, std::vector<PetscReal> *)>;
+
+struct CubatureHierarchy {
+  PetscInt               groups = 1;     // 1: one Gram matrix of every point
+  PetscInt               candidates = 0; // points of the final fit (the union of the groups' points)
+  PetscReal              groupTol = 0;   // the groups' tolerance
+  std::vector<PetscReal> groupResiduals;
+};
+
+// The cubature of Q points. Q <= opt.groupPoints (or 0): EmpiricalCubature on the Gram matrix of every point. Otherwise
+// hierarchically, with Gram matrices of at most opt.groupPoints points (memory |group|^2, not Q^2): the points split
+// into K contiguous groups (the patch points come facet by facet: groups are pieces of the surface); each group fitted
+// to its own terms G_g 1 at tol_g = opt.tol |G 1| / sum_g |G_g 1|, so that the groups' weights together fit the whole
+// terms within opt.tol (triangle inequality); then the fit of the whole terms (every point's) among the union of the
+// groups' points, which therefore reaches opt.tol. The reported residual is against the exact terms of every point.
+// Errors: a group not reaching tol_g (PETSC_ERR_NOT_CONVERGED, naming -ecsw_max_points and -ecsw_group_points).
+PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info = nullptr);
 
 } // namespace rbc

@@ -388,6 +388,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   CubatureOptions co;
   CubatureResult  cr;
   std::vector<PetscReal> errK, errG;
+  CubatureHierarchy      hier;
   if (hyper.ecsw) {
     std::vector<PetscReal> H;
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
@@ -405,22 +406,27 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       fitAll = f == 1 ? PETSC_TRUE : PETSC_FALSE;
     }
     const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
+    CubatureGramFunction gram;
+    std::vector<PetscReal> PA, SkA, LA, VA;
     if ((nDefault > 0 || rDefault > 0) && !fitAll) {
       const PetscInt        rA = rDefault > 0 ? rDefault : R, nA = nDefault > 0 ? nDefault : Npod;
       const std::vector<PetscInt> cols = ReducedColumns(Npod, nsup, nA, rA);
       const PetscInt         Na = (PetscInt)cols.size();
-      std::vector<PetscReal> PA(P.begin(), P.begin() + (size_t)rA * Q), SkA((size_t)ms * Q * Na), LA((size_t)nt * rA), VA((size_t)nt * Na);
+      PA.assign(P.begin(), P.begin() + (size_t)rA * Q);
+      SkA.resize((size_t)ms * Q * Na);
+      LA.resize((size_t)nt * rA);
+      VA.resize((size_t)nt * Na);
       for (size_t sp = 0; sp < (size_t)ms * Q; ++sp)
         for (PetscInt c = 0; c < Na; ++c) SkA[sp * Na + c] = Sk[sp * N + cols[c]];
       for (PetscInt j = 0; j < nt; ++j) {
         for (PetscInt i = 0; i < rA; ++i) LA[(size_t)j * rA + i] = rm.warmL[(size_t)j * R + i];
         for (PetscInt c = 0; c < Na; ++c) VA[(size_t)j * Na + c] = rm.warmV[(size_t)j * N + cols[c]];
       }
-      if (co.fit == CubatureFit::Action) CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, &H, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim);
-      else CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, &H);
-    } else if (co.fit == CubatureFit::Action) CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, &H, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim);
-    else CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
-    PetscCall(EmpiricalCubature(H, Q, co, &cr));
+      if (co.fit == CubatureFit::Action) gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c); };
+      else gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, Hc, c); };
+    } else if (co.fit == CubatureFit::Action) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c); };
+    else gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); };
+    PetscCall(HierarchicalCubature(Q, co, gram, &cr, &hier));
     PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
     rm.cPoint.clear();
     rm.cPw.assign((size_t)R * cr.points.size(), 0.0);
@@ -531,6 +537,13 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     c["fit"]          = co.fit == CubatureFit::Action ? "action" : "terms";
     c["fit_force"]    = co.fit == CubatureFit::Action && co.fitForce;
     c["residual"]     = (double)cr.residual;
+    c["quadrature_points"] = (long long)Q;
+    c["groups"]       = (long long)hier.groups;     // > 1: the hierarchical fit (-ecsw_group_points)
+    c["candidates"]   = (long long)hier.candidates; // the final fit's candidate points (Q with one group)
+    if (hier.groups > 1) {
+      c["group_tol"]       = (double)hier.groupTol;
+      c["group_residuals"] = hier.groupResiduals;
+    }
     c["history"]      = cr.history;
     c["iterations"]   = (long long)cr.iterations;
     c["weights"]      = cr.weights;

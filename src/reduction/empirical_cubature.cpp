@@ -26,12 +26,14 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   opt->fitForce = flg;
   PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
   PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
+  PetscCall(PetscOptionsInt("-group_points", "more quadrature points than this: fit groups of at most this many points, then their union against every point's terms (0: one Gram matrix of every point)", "", opt->groupPoints, &opt->groupPoints, NULL));
   flg = opt->monitor ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-monitor", "print the residual per added point", "", flg, &flg, NULL));
   opt->monitor = flg;
   PetscOptionsEnd();
   PetscCheck(opt->tol > 0 && opt->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%stol %g must lie in (0, 1)", pre, (double)opt->tol);
   PetscCheck(opt->maxPoints >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%smax_points %" PetscInt_FMT " must be >= 1", pre, opt->maxPoints);
+  PetscCheck(opt->groupPoints == 0 || opt->groupPoints >= 100, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sgroup_points %" PetscInt_FMT " must be 0 (one group) or >= 100", pre, opt->groupPoints);
   PetscFunctionReturn(0);
 }
 
@@ -60,11 +62,25 @@ PetscReal SumSquares(const std::vector<PetscReal> &v)
   return s;
 }
 
+// States per block: the block's columns within about 64 MB (at least one state), or all when block > 0 says so.
+PetscInt StatesPerBlock(PetscInt Q, PetscInt per, PetscInt ms, PetscInt block)
+{
+  if (block > 0) return std::min(block, std::max<PetscInt>(ms, 1));
+  const size_t bytes = (size_t)Q * std::max<PetscInt>(per, 1) * sizeof(PetscReal);
+  return std::max<PetscInt>(1, std::min<PetscInt>(std::max<PetscInt>(ms, 1), (PetscInt)((64u << 20) / std::max<size_t>(bytes, 1))));
+}
+
 // H += (A A') o (B B') for A (Q x ka) and B (Q x kb), column-major: the Gram matrix of the fitting rows
 // whose coefficient of point p is A(p, a) B(p, b) (a Hadamard product of two Gram matrices, two GEMMs).
-void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscReal *B, PetscInt kb, std::vector<PetscReal> *H)
+void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand);
+
+void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscReal *B, PetscInt kb, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
   if (ka <= 0 || kb <= 0) return;
+  if (cand && !cand->points.empty()) { // one block holding every column
+    AddHadamardGramBlocks(Q, A, ka, kb, 1, StatesPerBlock(Q, 1, kb, 0), [&](PetscInt c0, PetscInt cnt, PetscReal *Bb) { std::copy(B + (size_t)Q * c0, B + (size_t)Q * (c0 + cnt), Bb); }, H, cand);
+    return;
+  }
   std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q);
   const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka, b = (PetscBLASInt)kb;
   const PetscReal        one = 1, zero = 0;
@@ -76,9 +92,44 @@ void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscRea
 // H += (A A') o (sum_b B_b B_b'), the columns B_b produced a block at a time by fill(first, count, B_b) (column-major
 // Q x (count * per)): the same Gram matrix as AddHadamardGram on all the columns at once (to rounding) without
 // holding them: the states' columns are the offline stage's largest objects in 3D (docs/rom3d.md).
-void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H)
+// On candidate points C (cand->points): H_CC += (A_C A_C') o (sum_b B_b,C B_b,C'), and over every point the
+// target's pieces b_C += ((A A') o (sum_b B_b B_b')) 1 restricted to C (= rows C of A o (B T), T = B'A) and
+// c += 1'((A A') o (B_b B_b'))1 = ||B_b'A||_F^2: memory |C|^2, not Q^2.
+static void AddHadamardGramCandidates(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand)
+{
+  const std::vector<PetscInt> &C  = cand->points;
+  const PetscInt               nc = (PetscInt)C.size();
+  std::vector<PetscReal>       AC((size_t)nc * ka), GA((size_t)nc * nc), GB((size_t)nc * nc, 0.0), B, BC, T, U;
+  for (PetscInt a = 0; a < ka; ++a)
+    for (PetscInt i = 0; i < nc; ++i) AC[i + (size_t)nc * a] = A[C[i] + (size_t)Q * a];
+  const PetscBLASInt q = (PetscBLASInt)Q, n = (PetscBLASInt)nc, a = (PetscBLASInt)ka;
+  const PetscReal    one = 1, zero = 0;
+  BLASgemm_("N", "T", &n, &n, &a, &one, AC.data(), &n, AC.data(), &n, &zero, GA.data(), &n);
+  cand->b.resize(nc, 0.0);
+  for (PetscInt s0 = 0; s0 < ms; s0 += block) {
+    const PetscInt cnt = std::min(block, ms - s0), kb = cnt * per;
+    B.assign((size_t)Q * kb, 0.0);
+    fill(s0, cnt, B.data());
+    BC.resize((size_t)nc * kb);
+    for (PetscInt c = 0; c < kb; ++c)
+      for (PetscInt i = 0; i < nc; ++i) BC[i + (size_t)nc * c] = B[C[i] + (size_t)Q * c];
+    const PetscBLASInt b = (PetscBLASInt)kb;
+    BLASgemm_("N", "T", &n, &n, &b, &one, BC.data(), &n, BC.data(), &n, &one, GB.data(), &n);
+    T.resize((size_t)kb * ka); // B'A
+    BLASgemm_("T", "N", &b, &a, &q, &one, B.data(), &q, A, &q, &zero, T.data(), &b);
+    for (PetscReal t : T) cand->c += t * t;
+    U.resize((size_t)nc * ka); // B_C T
+    BLASgemm_("N", "N", &n, &a, &b, &one, BC.data(), &n, T.data(), &b, &zero, U.data(), &n);
+    for (PetscInt k = 0; k < ka; ++k)
+      for (PetscInt i = 0; i < nc; ++i) cand->b[i] += AC[i + (size_t)nc * k] * U[i + (size_t)nc * k];
+  }
+  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
+}
+
+void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
   if (ka <= 0 || per <= 0 || ms <= 0) return;
+  if (cand && !cand->points.empty()) return AddHadamardGramCandidates(Q, A, ka, ms, per, block, fill, H, cand);
   std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q, 0.0), B;
   const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka;
   const PetscReal        one = 1, zero = 0;
@@ -93,12 +144,15 @@ void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt
   for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
 
-// States per block: the block's columns within about 64 MB (at least one state), or all when block > 0 says so.
-PetscInt StatesPerBlock(PetscInt Q, PetscInt per, PetscInt ms, PetscInt block)
+// H zeroed at its size (Q x Q, or the candidates' |C| x |C| with their target pieces b, c zeroed too).
+void ResetGram(PetscInt Q, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
-  if (block > 0) return std::min(block, std::max<PetscInt>(ms, 1));
-  const size_t bytes = (size_t)Q * std::max<PetscInt>(per, 1) * sizeof(PetscReal);
-  return std::max<PetscInt>(1, std::min<PetscInt>(std::max<PetscInt>(ms, 1), (PetscInt)((64u << 20) / std::max<size_t>(bytes, 1))));
+  const size_t n = cand && !cand->points.empty() ? cand->points.size() : (size_t)Q;
+  H->assign(n * n, 0.0);
+  if (cand) {
+    cand->b.assign(cand->points.size(), 0.0);
+    cand->c = 0;
+  }
 }
 } // namespace
 
@@ -119,7 +173,7 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
   }
 }
 
-void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H)
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
   const PetscInt         nc = N + 1;
   std::vector<PetscReal> Z((size_t)Q * ms * nc, 0.0), Kh, gh;
@@ -136,11 +190,11 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
     for (PetscInt p = 0; p < Q; ++p) z[p] = sg * gam[p];
   }
   // H = (P'P) o (Z Z') (P row-major R x Q = column-major Q x R)
-  H->assign((size_t)Q * Q, 0.0);
-  AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H);
+  ResetGram(Q, H, cand);
+  AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
   std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh;
@@ -173,7 +227,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
   }
   // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y', Zk (the scaled kappa columns) and Y(p, (s, j)) = s2 (kappa_s(p, :) v_j -
   // gamma_s(p)) formed a block of states at a time
-  H->assign((size_t)Q * Q, 0.0);
+  ResetGram(Q, H, cand);
   AddHadamardGramBlocks(Q, LP.data(), nt, ms, N, StatesPerBlock(Q, N, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Z) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
       const PetscReal *kap = &Sk[(size_t)s * Q * N];
@@ -182,7 +236,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
         for (PetscInt p = 0; p < Q; ++p) z[p] = s1[s] * kap[(size_t)p * N + n];
       }
     }
-  }, H);
+  }, H, cand);
   AddHadamardGramBlocks(Q, P.data(), R, ms, nt, StatesPerBlock(Q, nt, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
       const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
@@ -195,7 +249,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
         }
       }
     }
-  }, H);
+  }, H, cand);
   // the resultant force: F_s(lam_j)_d = sum_p LP(j, p) Sw_s(p, d), scaled to unit norm per state
   if (dim > 0 && Sw.size() == (size_t)ms * Q * dim) {
     std::vector<PetscReal> Zf((size_t)Q * ms * dim, 0.0);
@@ -214,7 +268,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
         for (PetscInt p = 0; p < Q; ++p) z[p] = s3 * wn[(size_t)p * dim + d];
       }
     }
-    AddHadamardGram(Q, LP.data(), nt, Zf.data(), ms * dim, H);
+    AddHadamardGram(Q, LP.data(), nt, Zf.data(), ms * dim, H, cand);
   }
 }
 
@@ -241,19 +295,26 @@ bool SolveOnSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vect
 }
 } // namespace
 
-PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res)
+PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand)
 {
   PetscFunctionBeginUser;
+  const bool     sub = cand && !cand->points.empty();
+  const PetscInt Q   = sub ? (PetscInt)cand->points.size() : Qall; // the points the fit may select
   PetscCheck(Q >= 1 && H.size() == (size_t)Q * Q, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "EmpiricalCubature: Gram matrix of %zu entries for Q = %" PetscInt_FMT " points", H.size(), Q);
+  PetscCheck(!sub || (cand->b.size() == (size_t)Q && std::isfinite(cand->c)), PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "EmpiricalCubature: %zu target entries for %" PetscInt_FMT " candidates", cand ? cand->b.size() : (size_t)0, Q);
   for (PetscReal v : H) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FP, "EmpiricalCubature: the Gram matrix of the contact terms holds a non-finite value");
   *res = CubatureResult();
-  // target b = H 1, c = 1' H 1 (= ||G 1||^2)
+  // target b = H 1, c = 1' H 1 (= ||G 1||^2); on candidates, given (the sums over every point)
   std::vector<PetscReal> b(Q, 0.0), x(Q, 0.0), grad, z, Hx(Q, 0.0);
   PetscReal              c = 0;
-  for (PetscInt p = 0; p < Q; ++p) {
-    for (PetscInt q = 0; q < Q; ++q) b[p] += H[(size_t)p * Q + q];
-    c += b[p];
-  }
+  if (sub) {
+    b = cand->b;
+    c = cand->c;
+  } else
+    for (PetscInt p = 0; p < Q; ++p) {
+      for (PetscInt q = 0; q < Q; ++q) b[p] += H[(size_t)p * Q + q];
+      c += b[p];
+    }
   if (!(c > 0)) { // nothing to fit: no contact term at any state
     res->residual = 0;
     res->history  = {0};
@@ -330,8 +391,68 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, co
   }
   res->residual = rel;
   res->points   = S;
+  if (sub)
+    for (auto &p : res->points) p = cand->points[p];
   res->weights.clear();
   for (PetscInt p : S) res->weights.push_back(x[p]);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info)
+{
+  std::vector<PetscReal> H;
+  CubatureHierarchy      hi;
+
+  PetscFunctionBeginUser;
+  if (opt.groupPoints <= 0 || Q <= opt.groupPoints) { // one Gram matrix of every point
+    gram(nullptr, &H);
+    PetscCall(EmpiricalCubature(H, Q, opt, res));
+    hi.groups = 1;
+    hi.candidates = Q;
+    if (info) *info = hi;
+    PetscFunctionReturn(0);
+  }
+  const PetscInt K = (Q + opt.groupPoints - 1) / opt.groupPoints;
+  auto group = [&](PetscInt g, CubatureCandidates *c) {
+    c->points.clear();
+    for (PetscInt p = (PetscInt)(((long long)g * Q) / K); p < (PetscInt)(((long long)(g + 1) * Q) / K); ++p) c->points.push_back(p);
+  };
+  // pass 1: each group's own target |G_g 1|^2 (the sum of its Gram matrix) and the whole one |G 1|^2
+  CubatureCandidates c;
+  PetscReal          sumRoot = 0, cAll = 0;
+  for (PetscInt g = 0; g < K; ++g) {
+    group(g, &c);
+    gram(&c, &H);
+    PetscReal cg = 0;
+    for (PetscReal h : H) cg += h;
+    sumRoot += std::sqrt(std::max<PetscReal>(cg, 0));
+    cAll = c.c;
+  }
+  // the groups' tolerance: their weights together then fit the whole terms within opt.tol (triangle inequality)
+  CubatureOptions og = opt;
+  og.tol             = sumRoot > 0 ? opt.tol * std::sqrt(cAll) / sumRoot : opt.tol;
+  og.monitor         = false;
+  og.groupPoints     = 0;
+  PetscCheck(og.tol > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
+  std::vector<PetscInt> U;
+  for (PetscInt g = 0; g < K; ++g) {
+    CubatureResult rg;
+    group(g, &c);
+    gram(&c, &H);
+    PetscCall(EmpiricalCubature(H, (PetscInt)c.points.size(), og, &rg)); // the group's own terms
+    PetscCheck(rg.residual <= og.tol, PETSC_COMM_SELF, PETSC_ERR_NOT_CONVERGED, "empirical cubature: group %" PetscInt_FMT " of %" PetscInt_FMT " reaches %g > its tolerance %g with %zu points (-ecsw_max_points %" PetscInt_FMT "; larger -ecsw_group_points: fewer groups)", g, K, (double)rg.residual, (double)og.tol, rg.points.size(), opt.maxPoints);
+    for (PetscInt p : rg.points) U.push_back(c.points[p]);
+    hi.groupResiduals.push_back(rg.residual);
+  }
+  // final fit: the union of the groups' points, against every point's terms
+  std::sort(U.begin(), U.end());
+  c.points = U;
+  gram(&c, &H);
+  PetscCall(EmpiricalCubature(H, Q, opt, res, &c));
+  hi.groups     = K;
+  hi.candidates = (PetscInt)U.size();
+  hi.groupTol   = og.tol;
+  if (info) *info = hi;
   PetscFunctionReturn(0);
 }
 
