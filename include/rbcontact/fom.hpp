@@ -42,7 +42,12 @@ public:
   void SetSchurDofs(const std::vector<PetscInt> &D) { schurDofs_ = D; }
   // Factorless: AssembleAndFactor only assembles, and A is factored on the first ApplyInverse (the contact
   // solve on the saddle point, -fom_dual_matrix saddle, factors its own matrix and never needs A's factor).
-  void SetFactorless(bool on) { factorless_ = on; }
+  // Factorless (the saddle-point contact solve, which needs no A^{-1}): A is factored only when something asks for
+  // A^{-1} (the offline stage's supremizers). iterative (-fom_saddle_solver gamg: memory linear in the dofs): that
+  // solve is CG + GAMG to rtol 1e-10 as well, unless -fom_ksp_type or -fom_pc_type choose (a MUMPS factor of A at
+  // 5.4e5 3D dofs outgrew the machine, docs/rom3d.md). The solver in use: ElasticSolverName().
+  PetscErrorCode SetFactorless(bool on, bool iterative = false);
+  std::string    ElasticSolverName() const; // "<ksp type>+<pc type>" of the elastic solves A^{-1}
   const std::vector<PetscInt> &SchurDofs() const { return schurDofs_; }
   // The Schur complement S_A = A_DD - A_DI A_II^{-1} A_ID of the last factorization (a sequential
   // dense copy), or null when A was factored by the KSP alone (or this rank holds no dof of D).

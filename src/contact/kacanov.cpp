@@ -279,7 +279,7 @@ PetscErrorCode KacanovSolver::ShareFactor(ElasticFOM &fom, const ContactMap &map
   PetscFunctionBeginUser;
   PetscCall(ChooseDualMatrix(PetscObjectComm((PetscObject)fom.dm), map, &mode, &D));
   fom.SetSchurDofs(D);
-  fom.SetFactorless(mode == "saddle");
+  PetscCall(fom.SetFactorless(mode == "saddle", saddle_.solver == "gamg"));
   PetscFunctionReturn(0);
 }
 

@@ -79,6 +79,34 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ElasticFOM::SetFactorless(bool on, bool iterative)
+{
+  PetscBool kset = PETSC_FALSE, pset = PETSC_FALSE;
+  PC        pc;
+
+  PetscFunctionBeginUser;
+  factorless_ = on;
+  if (!on || !iterative) PetscFunctionReturn(0);
+  PetscCall(PetscOptionsHasName(NULL, "fom_", "-ksp_type", &kset));
+  PetscCall(PetscOptionsHasName(NULL, "fom_", "-pc_type", &pset));
+  if (kset || pset) PetscFunctionReturn(0); // the user's choice
+  PetscCall(KSPSetType(ksp, KSPCG));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCGAMG)); // AssembleAndFactor attaches the rigid-body near-null space
+  PetscCall(KSPSetTolerances(ksp, 1e-10, 1e-50, PETSC_DEFAULT, 5000));
+  PetscCall(KSPSetFromOptions(ksp)); // -fom_ksp_rtol etc. still refine it
+  PetscFunctionReturn(0);
+}
+
+std::string ElasticFOM::ElasticSolverName() const
+{
+  KSPType kt = NULL;
+  PCType  pt = NULL;
+  PC      pc;
+  if (KSPGetType(ksp, &kt) || KSPGetPC(ksp, &pc) || PCGetType(pc, &pt)) return "unknown";
+  return std::string(kt ? kt : "?") + "+" + (pt ? pt : "?");
+}
+
 PetscErrorCode ElasticFOM::SetupAffine()
 {
   PetscLogDouble t0, t1;

@@ -406,6 +406,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     ps["inf_sup_all"]         = (double)enr.beta.back();
     ps["inf_sup_by_kept"]     = enr.beta;
     ps["sigma"]               = enr.sigma;
+    ps["elastic_solver"]      = fom.ElasticSolverName(); // the supremizers' A^{-1}: a MUMPS factor, or CG + GAMG (-fom_saddle_solver gamg)
   }
   if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
   rep->root["time_s"]["pod"]  = (double)bs.seconds[0];
