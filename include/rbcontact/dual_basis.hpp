@@ -124,7 +124,8 @@ struct DualBasisResult {
 
 // Builds the dual basis of the snapshot matrix L (R x m, nonnegative) with the options above.
 // Collective on PETSC_COMM_WORLD only for reading options; the computation is local and identical on every rank.
-PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res);
+// tolOverride >= 0: this tolerance instead of -dual_tol (offline -estimate's enriched space; relative with -dual_tol_relative).
+PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res, PetscReal tolOverride = -1);
 // -dual_tol's default (read by BuildDualBasis, and by offline -estimate).
 constexpr PetscReal kDualDefaultTol = 1e-3;
 

@@ -50,7 +50,8 @@ const char    *PODInnerName(PODInner inner);
 //   -pod_sv_out <file>        rank 0 writes the singular values (one per line, %.17e) to <file>
 //   -pod_view                 prints a summary on the snapshots' communicator
 // Collective on the snapshots' communicator. Replaces any previous content of *res.
-PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res);
+// tol >= 0: this relative energy instead of -pod_tol (offline -estimate's enriched space; -pod_n still wins).
+PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res, PetscReal tol = -1);
 // The N that -pod_tol tol would have chosen from res's singular values (smallest N with the energy left out
 // <= tol, within [1, rank]): the answer's size inside a POD computed to a smaller tolerance (offline -estimate).
 PetscInt PODSizeForTolerance(const PODResult &res, PetscReal tol);

@@ -98,20 +98,6 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     PetscCheck(estPodTol >= 0 && estPodTol <= podTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_pod_tol %g must lie in [0, -pod_tol = %g]", (double)estPodTol, (double)podTol);
     PetscCheck(estDualTol > 0 && estDualTol <= dualTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_dual_tol %g must lie in (0, -dual_tol = %g]", (double)estDualTol, (double)dualTol);
   }
-  // runs f with the option name set to value, the user's value (or none) restored after
-  auto withOption = [&](const char *name, PetscReal value, auto &&f) -> PetscErrorCode {
-    char      old[64], val[64];
-    PetscBool had;
-    PetscFunctionBeginUser;
-    PetscCall(PetscOptionsGetString(NULL, NULL, name, old, sizeof old, &had));
-    PetscCall(PetscSNPrintf(val, sizeof val, "%.17g", (double)value));
-    PetscCall(PetscOptionsSetValue(NULL, name, val));
-    PetscErrorCode ierr = f();
-    if (had) PetscCall(PetscOptionsSetValue(NULL, name, old));
-    else PetscCall(PetscOptionsClearValue(NULL, name));
-    PetscCall(ierr);
-    PetscFunctionReturn(0);
-  };
   // --- primal: POD in the chosen inner product of the reference configuration
   PetscCall(PetscTime(&t0));
   PetscOptionsBegin(world, "pod_", "Primal basis (offline)", "OfflineBases");
@@ -145,7 +131,7 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PODResult &pod = b->pod;
   PetscCall(BVDestroy(&pod.modes));
   if (estimate && !podNSet) { // -pod_n fixes the size: no primal enrichment then
-    PetscCall(withOption("-pod_tol", estPodTol, [&]() { return ComputePOD(X, M, &pod); }));
+    PetscCall(ComputePOD(X, M, &pod, estPodTol));
     const PetscInt n = PODSizeForTolerance(pod, podTol);
     b->nDefault      = n < pod.N ? n : -1;
   } else PetscCall(ComputePOD(X, M, &pod));
@@ -178,7 +164,7 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
         for (PetscInt i = 0; i < R; ++i) L(i, j) *= sw[i];
     }
     if (estimate && strcmp(dualType, "nmf")) { // a greedy: its first vectors are those of the looser tolerance
-      PetscCall(withOption("-dual_tol", estDualTol, [&]() { return BuildDualBasis(L, &dual); }));
+      PetscCall(BuildDualBasis(L, &dual, estDualTol));
       const PetscReal tolAbs = dual.tolAbs * dualTol / estDualTol; // the answer's absolute tolerance
       PetscInt        r      = dual.W.cols;
       for (size_t k = 0; k < dual.history.size(); ++k)

@@ -350,7 +350,7 @@ static PetscErrorCode BuildNMF(const DenseMatrix &L, PetscInt r, PetscInt seed, 
 
 // --- BuildDualBasis --------------------------------------------------------------------------------
 
-PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
+PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res, PetscReal tolOverride)
 {
   const char *types[] = {"nmf", "angle", "cpg", "mcpg"};
   const char *norms[] = {"linf", "l2"};
@@ -375,6 +375,7 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res)
   PetscCall(PetscOptionsReal("-max_cond", "Greedy: a pick that would make cond(W^T W) exceed this is skipped (a vector in the span of W but outside its cone)", "BuildDualBasis", maxCond, &maxCond, NULL));
   PetscCall(PetscOptionsBool("-monitor", "Print step, selected snapshot, largest error, cond(W^T W)", "BuildDualBasis", monitor, &monitor, NULL));
   PetscOptionsEnd();
+  if (tolOverride >= 0) tol = tolOverride; // the caller's tolerance (offline -estimate's enriched space), relative with -dual_tol_relative
   PetscCheck(R > 0 && m > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Dual basis: empty snapshot matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", R, m);
   PetscCheck(tol >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be >= 0", (double)tol);
   PetscCheck(maxCond >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_cond %g must be >= 1", (double)maxCond);

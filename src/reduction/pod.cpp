@@ -336,7 +336,7 @@ PetscErrorCode PODInnerFromOptions(MPI_Comm comm, PODInner *inner)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res)
+PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *res, PetscReal tol)
 {
   MPI_Comm   comm;
   PODOptions o;
@@ -348,6 +348,10 @@ PetscErrorCode ComputePOD(const std::vector<Vec> &snapshots, Mat M, PODResult *r
   PetscCall(BVInitializePackage());
   if (!POD_Event) PetscCall(PetscLogEventRegister("RBCPOD", BV_CLASSID, &POD_Event));
   PetscCall(ReadOptions(comm, m, M, &o));
+  if (tol >= 0) {
+    PetscCheck(tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "ComputePOD: tolerance %g must lie in [0, 1)", (double)tol);
+    o.tol = tol; // the caller's tolerance instead of -pod_tol (offline -estimate's enriched space)
+  }
   if (M) {
     PetscInt mr, mc, nv;
     PetscCall(MatGetSize(M, &mr, &mc));
