@@ -7,7 +7,8 @@
 // closing (fork on rank 0, two snapshots, _exit(9)) leaves a file that restarts with exactly those
 // two done and readable; a writer killed by SIGKILL at an arbitrary moment of a loop of rewrites
 // leaves a file that reopens, every done row complete. ImportSnapshotMatrix: HDF5 (rows = dofs,
-// and -import_transpose), PETSc binary dense and AIJ, and its errors. Scratch files live in /tmp/rbc_test_snapshot_file.<pid>.
+// and -import_transpose), PETSc binary dense and AIJ, and its errors. The contact matrix (dense in the file) is
+// kept by its nonzeros after ReadAll (CompactContactMatrix), bit for bit; a wrong length is refused. Scratch files live in /tmp/rbc_test_snapshot_file.<pid>.
 #include "rbcontact/snapshot_file.hpp"
 #include <hdf5.h>
 #include <petscmat.h>
@@ -363,6 +364,42 @@ int main(int argc, char **argv)
     PetscCall(f.Close());
   }
   PetscCall(ReadAllChecked(path, h, {0, 1, 2, 3, 4}, "after the restart"));
+  { // the contact matrix: dense in the file (/snapshots/extra/contact_K), its nonzeros by rows after ReadAll
+    const std::string     kpath = dir + "/contact_k.h5";
+    const PetscInt        nD    = 5, R = h.nmult;
+    Snapshot              s     = MakeSnapshot(h, 1);
+    std::vector<PetscReal> K((size_t)R * nD, 0.0);
+    for (PetscInt i = 0; i < R; ++i)
+      for (PetscInt c = 0; c < nD; ++c)
+        if ((i + 2 * c) % 3 == 0) K[(size_t)i * nD + c] = 1.0 + i - 0.25 * c; // includes a row without entries when R > 2
+    s.extra["contact_K"]    = K;
+    s.extra["contact_dofs"] = {4, 9, 11, 20, 21};
+    {
+      SnapshotFile f;
+      PetscCall(f.Open(PETSC_COMM_WORLD, kpath, h, false));
+      PetscCall(f.Write(s));
+      PetscCall(f.Close());
+    }
+    std::vector<Snapshot> snaps;
+    PetscCall(SnapshotFile::ReadAll(kpath, &snaps));
+    bool ok = snaps.size() == 1 && !snaps[0].extra.count("contact_K") && snaps[0].extra.count("contact_dofs") && snaps[0].contactK.rows == R && snaps[0].contactK.cols == nD && (PetscInt)snaps[0].contactK.ptr.size() == R + 1;
+    std::vector<PetscReal> back((size_t)R * nD, 0.0);
+    if (ok)
+      for (PetscInt i = 0; i < R; ++i)
+        for (PetscInt e = snaps[0].contactK.ptr[i]; e < snaps[0].contactK.ptr[i + 1]; ++e) {
+          ok = ok && snaps[0].contactK.val[e] != 0;
+          back[(size_t)i * nD + snaps[0].contactK.col[e]] = snaps[0].contactK.val[e];
+        }
+    Check(ok && SameBits(back, K), "contact_K: ReadAll keeps its nonzeros by rows (the dense copy dropped), equal bit for bit");
+    Snapshot bad = MakeSnapshot(h, 1);
+    bad.extra["contact_K"]    = std::vector<PetscReal>((size_t)R * nD + 1, 1.0);
+    bad.extra["contact_dofs"] = {4, 9, 11, 20, 21};
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    PetscErrorCode code = CompactContactMatrix(&bad);
+    PetscCall(PetscPopErrorHandler());
+    CheckError(code, "a contact matrix of the wrong length", {"contact matrix of", "contact dofs"});
+    PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
+  }
   {
     SnapshotHeader r;
     PetscCall(SnapshotFile::ReadHeader(path, &r));

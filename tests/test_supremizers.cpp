@@ -85,6 +85,8 @@ int main(int argc, char **argv)
     snaps[j].extra["contact_K"]    = K[j];
     snaps[j].extra["contact_dofs"] = std::vector<double>(n);
     for (PetscInt d = 0; d < n; ++d) snaps[j].extra["contact_dofs"][d] = d;
+    snaps[j].lambda.assign(R, 0.0);
+    PetscCall(rbc::CompactContactMatrix(&snaps[j])); // as SnapshotFile::ReadAll keeps it
   }
   rbc::DenseMatrix W;
   W.Resize(R, r);

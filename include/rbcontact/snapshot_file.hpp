@@ -30,6 +30,13 @@ struct SnapshotHeader {
   PetscInt                             nmult = 0;      // length of lambda (R)
 };
 
+// A sparse matrix by rows (CSR).
+struct SparseRows {
+  PetscInt               rows = 0, cols = 0;
+  std::vector<PetscInt>  ptr{0}, col; // row i: entries [ptr[i], ptr[i + 1])
+  std::vector<PetscReal> val;
+};
+
 // Per-snapshot data (all arrays in canonical ordering, identical on any rank count).
 struct Snapshot {
   PetscInt                                 index = -1; // position in the training set
@@ -42,7 +49,14 @@ struct Snapshot {
   // Named extra arrays (EIM data: contact map and gap at the converged state, ...), fixed length
   // per name across snapshots (the first snapshot written fixes it).
   std::map<std::string, std::vector<PetscReal>> extra;
+  // The contact matrix on the contact dofs (nmult x contact_dofs, canonical orders) by rows: the file holds it dense
+  // (/snapshots/extra/contact_K, 421 MB a snapshot at 5.4e5 3D dofs, nearly all zeros); ReadAll keeps this instead.
+  SparseRows contactK;
 };
+
+// Moves extra["contact_K"] (dense, nmult x contact_dofs row-major) into s->contactK (its nonzeros) and drops the dense
+// copy; nothing without it. Errors: a length that is not nmult x contact_dofs.
+PetscErrorCode CompactContactMatrix(Snapshot *s);
 
 class SnapshotFile {
 public:
@@ -68,7 +82,7 @@ public:
 
   // Reading (any rank, independent; for the basis builders and the tests).
   static PetscErrorCode ReadHeader(const std::string &path, SnapshotHeader *header);
-  // All done snapshots, ordered by training index.
+  // All done snapshots, ordered by training index; the contact matrix compacted (CompactContactMatrix) as each is read.
   static PetscErrorCode ReadAll(const std::string &path, std::vector<Snapshot> *snaps);
 
 private:

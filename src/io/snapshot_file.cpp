@@ -506,6 +506,31 @@ PetscErrorCode SnapshotFile::ReadHeader(const std::string &path, SnapshotHeader 
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode CompactContactMatrix(Snapshot *s)
+{
+  PetscFunctionBeginUser;
+  const auto k = s->extra.find("contact_K"), d = s->extra.find("contact_dofs");
+  if (k == s->extra.end()) PetscFunctionReturn(0);
+  PetscCheck(d != s->extra.end(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": a contact matrix (contact_K) without its dofs (contact_dofs)", s->index);
+  const size_t nD = d->second.size(), R = s->lambda.size();
+  PetscCheck(k->second.size() == R * nD, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": contact matrix of %zu entries for %zu multipliers x %zu contact dofs", s->index, k->second.size(), R, nD);
+  SparseRows &K = s->contactK;
+  K      = SparseRows();
+  K.rows = (PetscInt)R;
+  K.cols = (PetscInt)nD;
+  for (size_t i = 0; i < R; ++i) {
+    for (size_t c = 0; c < nD; ++c) {
+      const PetscReal v = k->second[i * nD + c];
+      if (v == 0) continue;
+      K.col.push_back((PetscInt)c);
+      K.val.push_back(v);
+    }
+    K.ptr.push_back((PetscInt)K.col.size());
+  }
+  s->extra.erase(k);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapshot> *snaps)
 {
   std::string err;
@@ -575,7 +600,10 @@ PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapsh
       };
       ok = ok && finite("/snapshots/mu", s.mu) && finite("/snapshots/u", s.u) && finite("/snapshots/lambda", s.lambda);
       for (const auto &e : s.extra) ok = ok && finite("/snapshots/extra/" + e.first, e.second);
-      if (ok) snaps->push_back(std::move(s));
+      if (ok) {
+        PetscCall(CompactContactMatrix(&s)); // one dense row at a time in memory
+        snaps->push_back(std::move(s));
+      }
     }
     if (ok) ok = CloseFile(c, &f);
     if (!ok) err = c.err;

@@ -221,14 +221,17 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
           if (nrm > 0 && dot / std::sqrt(nrm) > best) { best = dot / std::sqrt(nrm); j = q; }
         }
       }
-      const auto &KD = snaps[j].extra.at("contact_K"), &Dc = snaps[j].extra.at("contact_dofs");
-      const PetscInt nD = (PetscInt)Dc.size();
+      const SparseRows &KD = snaps[j].contactK;
+      const auto       &Dc = snaps[j].extra.at("contact_dofs");
+      const PetscInt    nD = (PetscInt)Dc.size();
+      PetscCheck(KD.rows == R && KD.cols == nD, world, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact matrix %" PetscInt_FMT " x %" PetscInt_FMT " for %" PetscInt_FMT " x %" PetscInt_FMT, snaps[j].index, KD.rows, KD.cols, R, nD);
+      std::vector<PetscReal> y(nD, 0.0); // K_D^T xi, K_D by rows (R x nD, canonical orders)
+      for (PetscInt i = 0; i < R; ++i)
+        for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) y[KD.col[e]] += KD.val[e] * dual.W(i, k);
       PetscCall(VecSet(rhs, 0.0));
       for (PetscInt c = 0; c < nD; ++c) {
-        PetscReal y = 0; // (K_D^T xi)_c, K_D row-major R x nD in canonical orders
-        for (PetscInt i = 0; i < R; ++i) y += KD[(size_t)i * nD + c] * dual.W(i, k);
         const PetscInt g = globalOf[(PetscInt)Dc[c]];
-        if (g >= 0) PetscCall(VecSetValue(rhs, g, y, INSERT_VALUES));
+        if (g >= 0) PetscCall(VecSetValue(rhs, g, y[c], INSERT_VALUES));
       }
       PetscCall(VecAssemblyBegin(rhs));
       PetscCall(VecAssemblyEnd(rhs));

@@ -116,7 +116,7 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
   PetscInt               nu = 0;
   for (const auto &s : snaps) {
     const auto it = s.extra.find("contact_dofs");
-    PetscCheck(it != s.extra.end() && s.extra.count("contact_K"), comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT " holds no contact matrix (contact_K, contact_dofs)", s.index);
+    PetscCheck(it != s.extra.end() && s.contactK.rows > 0, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT " holds no contact matrix (contact_K, contact_dofs)", s.index);
     for (PetscReal c : it->second) {
       const PetscInt ci = (PetscInt)c;
       PetscCheck(ci >= 0 && ci < ndofs, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact dof %" PetscInt_FMT " out of range", s.index, ci);
@@ -158,14 +158,15 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
   info->beta.assign(q + 1, PETSC_MAX_REAL);
   std::vector<PetscReal> T, B, E, Ek, w;
   for (const auto &s : snaps) {
-    const auto    &KD = s.extra.at("contact_K"), &Dc = s.extra.at("contact_dofs");
-    const PetscInt nD = (PetscInt)Dc.size();
-    PetscCheck((PetscInt)KD.size() == R * nD, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact matrix of %zu entries for %" PetscInt_FMT " x %" PetscInt_FMT, s.index, KD.size(), R, nD);
+    const SparseRows &KD = s.contactK;
+    const auto       &Dc = s.extra.at("contact_dofs");
+    const PetscInt    nD = (PetscInt)Dc.size();
+    PetscCheck(KD.rows == R && KD.cols == nD, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact matrix %" PetscInt_FMT " x %" PetscInt_FMT " for %" PetscInt_FMT " x %" PetscInt_FMT, s.index, KD.rows, KD.cols, R, nD);
     T.assign((size_t)r * nD, 0.0); // W^T K_D, r x nD column-major
     for (PetscInt i = 0; i < R; ++i)
-      for (PetscInt c = 0; c < nD; ++c) {
-        const PetscReal kv = KD[(size_t)i * nD + c];
-        if (kv == 0) continue;
+      for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) {
+        const PetscReal kv = KD.val[e];
+        const PetscInt  c  = KD.col[e];
         for (PetscInt a = 0; a < r; ++a) T[a + (size_t)r * c] += W(i, a) * kv;
       }
     if (nD > 0) {
