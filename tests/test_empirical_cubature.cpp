@@ -62,6 +62,23 @@ static PetscReal Norm2(const std::vector<PetscReal> &v)
   return s;
 }
 
+// The terms fit's residual recomputed state by state from the fitted terms (weights xi) against the exact ones:
+// sqrt(sum_s (|dK_s|^2 / |K_s|^2 + |dg_s|^2 / |g_s|^2) / (2 ms)).
+static PetscReal TermsFitResidual(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &xi)
+{
+  std::vector<PetscReal> one(Q, 1.0), K, g, K0, g0;
+  PetscReal              sum = 0;
+  for (PetscInt s = 0; s < ms; ++s) {
+    Terms(P, R, Q, N, Sk, Sg, s, xi, &K, &g);
+    Terms(P, R, Q, N, Sk, Sg, s, one, &K0, &g0);
+    std::vector<PetscReal> dK(K.size()), dg(g.size());
+    for (size_t i = 0; i < K.size(); ++i) dK[i] = K[i] - K0[i];
+    for (size_t i = 0; i < g.size(); ++i) dg[i] = g[i] - g0[i];
+    sum += Norm2(dK) / Norm2(K0) + Norm2(dg) / Norm2(g0);
+  }
+  return std::sqrt(sum / (2 * ms));
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PetscInitialize(&argc, &argv, NULL, "test_empirical_cubature"));
@@ -249,22 +266,13 @@ int main(int argc, char **argv)
     opt.tol = 1e-5;
     CubatureResult res;
     PetscCall(EmpiricalCubature(H, Q, opt, &res));
-    std::vector<PetscReal> xi(Q, 0.0), one(Q, 1.0), K, g, K0, g0;
+    std::vector<PetscReal> xi(Q, 0.0);
     PetscReal              wmin = PETSC_MAX_REAL;
     for (size_t j = 0; j < res.points.size(); ++j) {
       xi[res.points[j]] = res.weights[j];
       wmin              = std::min(wmin, res.weights[j]);
     }
-    PetscReal sum = 0;
-    for (PetscInt s = 0; s < ms; ++s) {
-      Terms(P, R, Q, N, Sk, Sg, s, xi, &K, &g);
-      Terms(P, R, Q, N, Sk, Sg, s, one, &K0, &g0);
-      std::vector<PetscReal> dK(K.size()), dg(g.size());
-      for (size_t i = 0; i < K.size(); ++i) dK[i] = K[i] - K0[i];
-      for (size_t i = 0; i < g.size(); ++i) dg[i] = g[i] - g0[i];
-      sum += Norm2(dK) / Norm2(K0) + Norm2(dg) / Norm2(g0);
-    }
-    const PetscReal rec = std::sqrt(sum / (2 * ms));
+    const PetscReal rec = TermsFitResidual(P, R, Q, N, Sk, Sg, ms, xi);
     Check(wmin > 0, "random terms: every weight > 0 (min weight)", wmin, 0);
     Check(res.residual <= opt.tol, "random terms: relative residual <= tol", res.residual, opt.tol);
     Check(std::abs(rec - res.residual) <= 1e-6 * opt.tol + 1e-3 * res.residual, "random terms: residual recomputed from the fitted terms (|diff|)", std::abs(rec - res.residual), 1e-3 * res.residual);
@@ -285,16 +293,7 @@ int main(int argc, char **argv)
       xc[rc.points[j]] = rc.weights[j];
     }
     for (PetscReal r : hi.groupResiduals) groupsOk = groupsOk && r <= hi.groupTol;
-    PetscReal sumc = 0;
-    for (PetscInt s = 0; s < ms; ++s) {
-      Terms(P, R, Q, N, Sk, Sg, s, xc, &K, &g);
-      Terms(P, R, Q, N, Sk, Sg, s, one, &K0, &g0);
-      std::vector<PetscReal> dK(K.size()), dg(g.size());
-      for (size_t i = 0; i < K.size(); ++i) dK[i] = K[i] - K0[i];
-      for (size_t i = 0; i < g.size(); ++i) dg[i] = g[i] - g0[i];
-      sumc += Norm2(dK) / Norm2(K0) + Norm2(dg) / Norm2(g0);
-    }
-    const PetscReal recc = std::sqrt(sumc / (2 * ms));
+    const PetscReal recc = TermsFitResidual(P, R, Q, N, Sk, Sg, ms, xc);
     Check(pos && (PetscInt)rc.points.size() <= hi.candidates, "hierarchical (4 groups of 20): weights > 0, points among the groups' union (points)", (double)rc.points.size(), (double)hi.candidates);
     Check(groupsOk, "hierarchical: every group within its tolerance (group tol)", hi.groupTol, oh.tol);
     Check(rc.residual <= opt.tol, "hierarchical: relative residual <= tol", rc.residual, opt.tol);
