@@ -9,10 +9,11 @@
 //     residual <= 1e-9) and the moments it gives match the full rule's.
 //  3. Random reduced terms (R = 4, N = 3, 12 states, Q = 80): weights >= 0, the final residual <= tol,
 //     the residual recomputed from the fitted terms state by state equals the reported one, the history
-//     decreases to it, and fewer points than Q are used; the hierarchical fit (4 groups, -ecsw_group_points):
+//     decreases to it, and fewer points than Q are used; the incremental Cholesky factor gives the same fit; the hierarchical fit (4 groups, -ecsw_group_points):
 //     every group within its tolerance, the residual against the exact terms over all points <= tol; the Gram
 //     system on candidates (H_CC, b_C, c) against the explicit rows (1b).
 #include "rbcontact/empirical_cubature.hpp"
+#include <petscblaslapack.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -278,6 +279,26 @@ int main(int argc, char **argv)
     Check(std::abs(rec - res.residual) <= 1e-6 * opt.tol + 1e-3 * res.residual, "random terms: residual recomputed from the fitted terms (|diff|)", std::abs(rec - res.residual), 1e-3 * res.residual);
     Check((PetscInt)res.points.size() < Q, "random terms: points used (< Q)", (double)res.points.size(), Q);
     Check(res.history.back() == res.residual && res.history.front() == 1.0, "random terms: history from 1 to the final residual (last - residual)", res.history.back() - res.residual, 0);
+
+    // the incremental Cholesky factor (the hierarchical fit's): the same points, weights to rounding
+    CubatureOptions oi = opt;
+    oi.incremental     = true;
+    CubatureResult ri;
+    PetscCall(EmpiricalCubature(H, Q, oi, &ri));
+    PetscReal dw = ri.points == res.points ? 0 : 1;
+    for (size_t j = 0; dw < 1 && j < ri.weights.size(); ++j) dw = std::max(dw, std::abs(ri.weights[j] - res.weights[j]) / res.weights[j]);
+    // rounding bound: 10 cond(H(S, S)) eps (the two factorizations differ in the order of their operations)
+    PetscReal bound = 1;
+    {
+      const PetscInt         k = (PetscInt)res.points.size();
+      std::vector<PetscReal> A((size_t)k * k), w(k), work(8 * k + 8);
+      for (PetscInt i = 0; i < k; ++i)
+        for (PetscInt j = 0; j < k; ++j) A[i + (size_t)k * j] = H[(size_t)res.points[i] * Q + res.points[j]];
+      PetscBLASInt n = (PetscBLASInt)k, lw = (PetscBLASInt)work.size(), info = 0;
+      LAPACKsyev_("N", "L", &n, A.data(), &n, w.data(), work.data(), &lw, &info);
+      if (info == 0 && w[0] > 0) bound = 10 * (w[k - 1] / w[0]) * PETSC_MACHINE_EPSILON;
+    }
+    Check(dw <= bound && std::abs(ri.residual - res.residual) <= 1e-6 * res.residual, "incremental Cholesky: the same points, weights within 10 cond(H_SS) eps (max rel diff)", dw, bound);
 
     // the hierarchical fit (4 groups of 20 points): points weights > 0, every group within its tolerance, and the
     // reported residual <= tol is the error against the exact terms over all 80 points (recomputed state by state)

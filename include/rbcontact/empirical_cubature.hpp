@@ -34,6 +34,9 @@ struct CubatureOptions {
   PetscInt  groupPoints = 8000; // -ecsw_group_points: more quadrature points than this: the hierarchical fit
                                 // (HierarchicalCubature); the Gram memory stays 3 x 8 bytes x (this or the union)^2
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
+  bool      incremental = false; // the Cholesky factor of H(S, S) updated as points enter (O(k^2) a step) instead of
+                                 // refactored (O(k^3)); the hierarchical fit's groups and union use it, the one-Gram
+                                 // fit keeps the refactoring (its points and weights as before, bit for bit)
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
 };

@@ -293,6 +293,69 @@ bool SolveOnSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vect
   LAPACKpotrs_("L", &n, &one, A.data(), &n, z->data(), &n, &info);
   return info == 0;
 }
+// The Cholesky factor of H(S, S) kept along Lawson-Hanson's steps: a point appended to S adds a row (O(k^2):
+// L l = H(S, j), d^2 = H(j, j) - l'l), points leaving S refactor it. The same pivot test as SolveOnSupport on the new
+// pivot (d^2 > 1e-13 max diag H(S, S)). O(k^2) a step instead of O(k^3): the groups of the hierarchical fit select
+// thousands of points (CubatureOptions::incremental).
+class SupportCholesky {
+public:
+  // Factor of H(S, S) for the current S (appending when S is the factored set plus one point); false: not
+  // (numerically) positive definite, the factor left as it was.
+  bool Update(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S)
+  {
+    const size_t k = S_.size();
+    if (S == S_) return true;
+    if (S.size() == k + 1 && std::equal(S_.begin(), S_.end(), S.begin())) return Append(H, Q, S.back());
+    std::vector<PetscInt> T = S; // refactor: rebuild by appending (the same arithmetic as a sequence of Appends)
+    S_.clear();
+    L_.clear();
+    dmax_ = 0;
+    for (PetscInt p : T)
+      if (!Append(H, Q, p)) return false;
+    return true;
+  }
+  // z = H(S, S)^{-1} b(S) (forward and back substitution)
+  void Solve(const std::vector<PetscReal> &b, std::vector<PetscReal> *z) const
+  {
+    const size_t k = S_.size();
+    z->resize(k);
+    for (size_t i = 0; i < k; ++i) {
+      PetscReal t = b[S_[i]];
+      for (size_t m = 0; m < i; ++m) t -= L_[Row(i) + m] * (*z)[m];
+      (*z)[i] = t / L_[Row(i) + i];
+    }
+    for (size_t i = k; i-- > 0;) {
+      PetscReal t = (*z)[i];
+      for (size_t m = i + 1; m < k; ++m) t -= L_[Row(m) + i] * (*z)[m];
+      (*z)[i] = t / L_[Row(i) + i];
+    }
+  }
+
+private:
+  static size_t Row(size_t i) { return i * (i + 1) / 2; } // packed lower triangle by rows
+  bool Append(const std::vector<PetscReal> &H, PetscInt Q, PetscInt j)
+  {
+    const size_t k = S_.size();
+    std::vector<PetscReal> l(k);
+    PetscReal              ll = 0;
+    for (size_t i = 0; i < k; ++i) {
+      PetscReal t = H[(size_t)S_[i] * Q + j];
+      for (size_t m = 0; m < i; ++m) t -= L_[Row(i) + m] * l[m];
+      l[i] = t / L_[Row(i) + i];
+      ll += l[i] * l[i];
+    }
+    const PetscReal hjj = H[(size_t)j * Q + j], dmax = std::max(dmax_, hjj), d2 = hjj - ll;
+    if (!(d2 > 1e-13 * dmax)) return false;
+    L_.insert(L_.end(), l.begin(), l.end());
+    L_.push_back(std::sqrt(d2));
+    S_.push_back(j);
+    dmax_ = dmax;
+    return true;
+  }
+  std::vector<PetscInt>  S_;
+  std::vector<PetscReal> L_;
+  PetscReal              dmax_ = 0;
+};
 } // namespace
 
 PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand)
@@ -322,6 +385,7 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   }
   std::vector<PetscInt> S;
   std::vector<char>     in(Q, 0), banned(Q, 0);
+  SupportCholesky       chol; // opt.incremental
   grad                   = b;
   PetscReal        rel   = 1;
   const PetscReal  gtiny = 1e-14 * *std::max_element(b.begin(), b.end());
@@ -347,7 +411,9 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
     in[j] = 1;
     for (;;) {
       ++res->iterations;
-      if (!SolveOnSupport(H, Q, S, b, &z)) { // j adds nothing independent: drop it for good
+      const bool ok = opt.incremental ? chol.Update(H, Q, S) : SolveOnSupport(H, Q, S, b, &z);
+      if (ok && opt.incremental) chol.Solve(b, &z);
+      if (!ok) { // j adds nothing independent: drop it for good
         S.erase(std::find(S.begin(), S.end(), j));
         in[j] = 0;
         banned[j] = 1;
@@ -433,6 +499,7 @@ PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, cons
   og.tol             = sumRoot > 0 ? opt.tol * std::sqrt(cAll) / sumRoot : opt.tol;
   og.monitor         = false;
   og.groupPoints     = 0;
+  og.incremental     = true; // thousands of points per group: O(k^2) steps
   PetscCheck(og.tol > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
   std::vector<PetscInt> U;
   for (PetscInt g = 0; g < K; ++g) {
@@ -448,7 +515,9 @@ PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, cons
   std::sort(U.begin(), U.end());
   c.points = U;
   gram(&c, &H);
-  PetscCall(EmpiricalCubature(H, Q, opt, res, &c));
+  CubatureOptions of = opt;
+  of.incremental     = true;
+  PetscCall(EmpiricalCubature(H, Q, of, res, &c));
   hi.groups     = K;
   hi.candidates = (PetscInt)U.size();
   hi.groupTol   = og.tol;
