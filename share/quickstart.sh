@@ -150,6 +150,11 @@ print("3D ROM sphere_block3d (%d random points, %d dofs): N %d R %d Mc %d" % (t[
 print("  max rel err u %.2e (target 1e-3), lambda %.2e (target 2e-2), force %.2e (target 1e-3); online median %.2e s, FOM median %.2e s, speedup %.0f"
       % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], r["online_time_s"]["median"], r["fom_time_s"]["median"], r["speedup_median"]))
 PY
+  # one online answer of the 3D ROM on the mesh: the deformed bodies and the pressure on the slave surface
+  rbc online "results/sphere_block3d/online.json" -rom "results/sphere_block3d/rom.h5" -mu 1.1,0.045 -online_repeat 1000 -options_file runs/sphere_block3d.opts -rom_reconstruct "results/sphere_block3d/online_fields.h5"
+  echo "+ $PYTHON share/plot_bodies3d.py results/sphere_block3d/online_fields.h5 -o results/sphere_block3d/bodies_rom.png"
+  "$PYTHON" share/plot_bodies3d.py "results/sphere_block3d/online_fields.h5" -o "results/sphere_block3d/bodies_rom.png" --title "sphere_block3d ROM, radius 1.1, displacement 0.045" || die "plotting the 3D ROM's bodies failed"
+  PICTURES+=("results/sphere_block3d/bodies_rom.png")
 }
 # ============================ END MAIN JOB ============================
 
@@ -158,7 +163,7 @@ main_job
 step "done: outputs"
 for r in "${REPORTS[@]}"; do echo "report:  $ROOT/$r"; done
 echo "fields:  $ROOT/$OUT/fom.h5, $ROOT/$OUT/online_fields.h5 (ROM)"
-echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf, $ROOT/results/hertz3d/fom.xmf (open them in ParaView)"
+echo "fields:  $ROOT/$OUT/fom.xmf, $ROOT/$OUT/online_fields.xmf, $ROOT/results/hertz3d/fom.xmf, $ROOT/results/sphere_block3d/online_fields.xmf (open them in ParaView)"
 echo "bases:   $ROOT/$OUT/basis_view.xmf (POD modes, supremizers and the dual basis on the mesh, for ParaView)"
 echo "ROM:     $ROOT/$OUT/rom.h5 (online data), rom.basis.h5, rom.snapshots.h5"
 echo "sweep:   $ROOT/$OUT/sweep.csv, sweep_eim.csv, refine2/sweep.csv, refine2/sweep_eim.csv"
