@@ -5,7 +5,8 @@
               the size of the mesh; online on 1 and 2 ranks gives the same answer; the TAO QP agrees with
               the active-set QP; validate on 20 random radii meets the accuracy targets (u <= 1e-3,
               lambda <= 1e-2, N, R <= 30) on 1 and 2 ranks with the same errors; the sweep table; the
-              reconstructed fields against the FOM at the same radius; the hierarchical cubature
+              reconstructed fields against the FOM at the same radius; the best approximation of u in the
+              basis (below the ROM's error, within the POD tolerance at the training radii); the hierarchical cubature
               (-ecsw_group_points) within its tolerances and as accurate.
   bad_input   missing/corrupt/mismatched ROM files, a bases-only file, mu outside the box, truncation
               out of range: clear errors naming the file, dataset, option or value.
@@ -190,6 +191,16 @@ def pipeline(args):
         a, b = val[1]["test"][k], val[2]["test"][k]
         check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
     check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
+    # the best approximation of u in the primal basis (energy norm): no reduced solution in the basis is closer
+    best, ru = np.array(val[1]["test_best_approximation"]["rel_err_u"]), np.array(t["rel_err_u"])
+    check(len(best) == 20 and np.all(best <= ru * (1 + 1e-8) + 1e-12) and best.max() > 0,
+          "best approximation of u in the basis <= the ROM's u error at every test radius (max %.2e against %.2e)" % (best.max(), ru.max()))
+    bd = np.abs(best - np.array(val[2]["test_best_approximation"]["rel_err_u"])).max()
+    check(bd <= 1e-9, "best approximation on 1 and 2 ranks: the same to %.1e" % bd)
+    # at the training radii (the POD's snapshots, -pod_tol 1e-11: sqrt(1e-11) = 3.2e-6 of the energy left out)
+    run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_type", "grid", "-test_size", "21", "-validate_repeat", "1", "-report", d + "/val_train.json"])
+    bt = report(d + "/val_train.json")["test_best_approximation"]["max_rel_err_u"]
+    check(bt <= 3.2e-6, "at the 21 training radii the best approximation is within the POD tolerance: %.2e <= sqrt(1e-11)" % bt)
     e = val[1]["test"]
     x = val[1]["test_exact"]
     check(val[1]["rom"]["hyper"] == "ecsw" and e["max_rel_err_u"] <= 1.5 * x["max_rel_err_u"] and e["max_rel_err_lambda"] <= 1.5 * x["max_rel_err_lambda"],
