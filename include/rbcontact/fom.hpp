@@ -41,11 +41,10 @@ public:
   // own block with the Schur complement on its dofs of D (SchurIsLocal).
   void SetSchurDofs(const std::vector<PetscInt> &D) { schurDofs_ = D; }
   // Factorless: AssembleAndFactor only assembles, and A is factored on the first ApplyInverse (the contact
-  // solve on the saddle point, -fom_dual_matrix saddle, factors its own matrix and never needs A's factor).
-  // Factorless (the saddle-point contact solve, which needs no A^{-1}): A is factored only when something asks for
-  // A^{-1} (the offline stage's supremizers). iterative (-fom_saddle_solver gamg: memory linear in the dofs): that
-  // solve is CG + GAMG to rtol 1e-10 as well, unless -fom_ksp_type or -fom_pc_type choose (a MUMPS factor of A at
-  // 5.4e5 3D dofs outgrew the machine, docs/rom3d.md). The solver in use: ElasticSolverName().
+  // solve on the saddle point, -fom_dual_matrix saddle, factors its own matrix and never needs A's factor; what
+  // asks for A^{-1} then is the offline stage's supremizers). iterative (-fom_saddle_solver gamg: memory linear in
+  // the dofs): that solve is CG + GAMG to rtol 1e-10 as well, unless -fom_ksp_type or -fom_pc_type choose (a MUMPS
+  // factor of A at 5.4e5 3D dofs outgrew the machine, docs/rom3d.md). The solver in use: ElasticSolverName().
   PetscErrorCode SetFactorless(bool on, bool iterative = false);
   std::string    ElasticSolverName() const; // "<ksp type>+<pc type>" of the elastic solves A^{-1}
   const std::vector<PetscInt> &SchurDofs() const { return schurDofs_; }
