@@ -390,7 +390,6 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   std::vector<PetscReal> errK, errG;
   CubatureHierarchy      hier;
   if (hyper.ecsw) {
-    std::vector<PetscReal> H;
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
     // with the error estimate's enrichment (offline -estimate) the points are fitted to every stored basis function

@@ -306,11 +306,10 @@ public:
     const size_t k = S_.size();
     if (S == S_) return true;
     if (S.size() == k + 1 && std::equal(S_.begin(), S_.end(), S.begin())) return Append(H, Q, S.back());
-    std::vector<PetscInt> T = S; // refactor: rebuild by appending (the same arithmetic as a sequence of Appends)
-    S_.clear();
+    S_.clear(); // refactor: rebuild by appending (the same arithmetic as a sequence of Appends)
     L_.clear();
     dmax_ = 0;
-    for (PetscInt p : T)
+    for (PetscInt p : S)
       if (!Append(H, Q, p)) return false;
     return true;
   }
