@@ -10,6 +10,9 @@
   greedy      -train_type greedy on ring_on_block: the same picks on 1 and 2 ranks, each round's first pick
               the largest indicator, the separation, the snapshot file holding exactly the picks, a
               resumed run continuing where the budget stopped, the ROM validated against the targets.
+  sensitivities  -snapshots_sensitivities on half_disks: du/dmu against central differences of FOM solutions,
+              the dense, saddle and CG solves, 1 and 2 ranks, the POD and dual basis enriched (on a 3 x 3 grid: the best
+              approximation of u, the ROM's u and lambda errors smaller), a file without them and a bad step refused.
 """
 import argparse
 import atexit
@@ -322,9 +325,80 @@ def greedy(args):
         check(p.returncode != 0 and needle in p.stdout, "refused with a message naming '%s'" % needle)
 
 
+def sensitivities(args):
+    d = workdir("rbc_off_")
+    # a point and its neighbours 1e-3 of each parameter's range away (the active set is the same at all five)
+    w = np.array([0.6, 0.06])
+    mu0 = np.array([0.9, 0.1])
+    pts = [mu0] + [mu0 + sg * 1e-3 * w[i] * np.eye(2)[i] for i in range(2) for sg in (1, -1)]
+    np.savetxt(d + "/fd.txt", np.array(pts), fmt="%.17g")
+    base = ["-train_type", "file", "-train_file", d + "/fd.txt", "-snapshots_sensitivities"]
+    run(args, 1, "runs/half_disks.opts", base + ["-snapshots", d + "/dense.h5", "-report", d + "/dense.json"])
+    run(args, 1, "runs/half_disks.opts", base + ["-snapshots", d + "/cg.h5", "-report", d + "/cg.json", "-fom_dual_matrix", "shell"])
+    run(args, 2, "runs/half_disks.opts", base + ["-snapshots", d + "/np2.h5", "-snapshots_subcomm", "1"])
+    run(args, 2, "runs/half_disks.opts", base + ["-snapshots", d + "/saddle.h5", "-report", d + "/saddle.json", "-snapshots_subcomm", "1", "-fom_dual_matrix", "saddle"])
+    rd, rc, rs = (report(d + "/%s.json" % k)["sensitivities"] for k in ("dense", "cg", "saddle"))
+    print("  dense: %s\n  cg: %s\n  saddle: %s" % (rd, rc, rs))
+    check(rd["enabled"] and rd["method"] == "dense" and rc["method"] == "cg" and rc["cg_iterations_max"] > 0 and rs["method"] == "saddle",
+          "the dense dual path factors S_AA, the shell path runs CG, the saddle path solves its saddle point")
+    a, c, n2, sd = arrays(d + "/dense.h5"), arrays(d + "/cg.h5"), arrays(d + "/np2.h5"), arrays(d + "/saddle.h5")
+    nd, R = a["u"].shape[1], a["lambda"].shape[1]
+    su, sl = a["extra/sensitivity_u"], a["extra/sensitivity_lambda"]
+    check(su.shape == (5, 2 * nd) and sl.shape == (5, 2 * R), "the file holds du/dmu (2 x %d) and dlambda/dmu (2 x %d) per snapshot" % (nd, R))
+    for other, what in ((c, "CG on the Schur complement"), (n2, "2 ranks"), (sd, "the saddle point, 2 ranks")):
+        for k in ("extra/sensitivity_u", "extra/sensitivity_lambda"):
+            e = np.max(np.abs(other[k] - a[k])) / np.max(np.abs(a[k]))
+            check(e <= 1e-6, "%s: %s equal to the dense 1-rank one within 1e-6 (%.1e)" % (what, k, e))
+    # against central differences of the FOM solutions (the derivative scaled by the range)
+    U, M = a["u"], a["mu"]
+    for i, name in ((1, "displacement"), (0, "radius")):
+        fd = (U[1 + 2 * i] - U[2 + 2 * i]) / (M[1 + 2 * i, i] - M[2 + 2 * i, i]) * w[i]
+        s = su[0, i * nd:(i + 1) * nd]
+        rel = np.linalg.norm(s - fd) / np.linalg.norm(fd)
+        cos = s @ fd / np.linalg.norm(s) / np.linalg.norm(fd)
+        print("  d u / d %s: |sens| %.4e, |central difference| %.4e, rel. difference %.2e, cosine %.5f" % (name, np.linalg.norm(s), np.linalg.norm(fd), rel, cos))
+        if name == "displacement":
+            check(rel <= 1e-2, "du/d displacement = the FOM's central difference within 1e-2 (%.1e)" % rel)
+        else:  # the frozen-geometry tangent: the geometric stiffness of the sliding contact is left out (docs/greedy_training.md)
+            check(rel <= 0.3 and cos >= 0.97, "du/d radius: the frozen-geometry tangent within 0.3 of the central difference (%.2f), cosine >= 0.97 (%.4f)" % (rel, cos))
+    L = a["lambda"]
+    fdl = (L[3] - L[4]) / (M[3, 1] - M[4, 1]) * w[1]
+    el = np.linalg.norm(sl[0, R:] - fdl) / np.linalg.norm(fdl)
+    check(el <= 2e-2, "dlambda/d displacement = the FOM's central difference within 2e-2 (%.1e)" % el)
+    # the bases: a 3 x 3 grid with and without, best approximation of u on the 20 test points
+    val = {}
+    for tag, extra in (("plain", []), ("sens", ["-snapshots_sensitivities"])):
+        rom = "%s/%s.h5" % (d, tag)
+        for stage, more in (("offline", ["-train_size", "3", "-rom", rom, "-report", "%s/%s_off.json" % (d, tag)]),
+                            ("validate", ["-rom", rom, "-report", "%s/%s_val.json" % (d, tag)])):
+            c_ = ["mpirun", "-n", "2", args.exe, stage, "-options_file", "runs/half_disks.opts"] + extra + more
+            p = subprocess.run(c_, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            if p.returncode != 0:
+                print(p.stdout[-4000:])
+                sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c_)))
+        val[tag] = (report("%s/%s_off.json" % (d, tag)), report("%s/%s_val.json" % (d, tag)))
+    (op, vp), (os_, vs) = val["plain"], val["sens"]
+    bp, bs = vp["test_best_approximation"]["max_rel_err_u"], vs["test_best_approximation"]["max_rel_err_u"]
+    print("  3 x 3 grid: N %d / %d, R %d / %d; best approximation of u %.2e / %.2e; ROM u %.2e / %.2e, lambda %.2e / %.2e (plain / with sensitivities)"
+          % (vp["rom"]["N"], vs["rom"]["N"], vp["rom"]["R"], vs["rom"]["R"], bp, bs, vp["test"]["max_rel_err_u"], vs["test"]["max_rel_err_u"], vp["test"]["max_rel_err_lambda"], vs["test"]["max_rel_err_lambda"]))
+    check(os_["pod"]["sensitivity_vectors"] == 18 and os_["dual"]["predicted_columns"] == 36 and op["pod"]["sensitivity_vectors"] == 0,
+          "the POD saw 9 snapshots + 18 derivatives, the dual greedy 9 + 36 predicted multipliers")
+    check(bs <= 0.8 * bp, "the derivatives in the POD: best approximation of u %.2e <= 0.8 x the plain grid's %.2e" % (bs, bp))
+    check(vs["test"]["max_rel_err_u"] <= 0.8 * vp["test"]["max_rel_err_u"] and vs["test"]["max_rel_err_lambda"] <= 0.5 * vp["test"]["max_rel_err_lambda"],
+          "and the reduced model's errors fall with them: u by 0.8x at least, lambda by 0.5x (the predicted multipliers in the dual basis)")
+    # refused: the option on a file solved without it; a step out of range
+    run(args, 1, "runs/half_disks.opts", ["-train_size", "2", "-snapshots", d + "/old.h5"])
+    c_ = ["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/half_disks.opts", "-train_size", "2", "-snapshots", d + "/old.h5", "-rom", d + "/x.h5", "-snapshots_sensitivities"]
+    p = subprocess.run(c_, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "old.h5" in p.stdout and "without -snapshots_sensitivities" in p.stdout, "a snapshot file solved without the option is refused, naming the file")
+    c_ = ["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/half_disks.opts", "-train_size", "2", "-snapshots", d + "/bad.h5", "-rom", d + "/y.h5", "-snapshots_sensitivities", "-dual_sensitivity_step", "2"]
+    p = subprocess.run(c_, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "-dual_sensitivity_step 2" in p.stdout, "-dual_sensitivity_step 2 is refused, naming the option")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "sensitivities"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

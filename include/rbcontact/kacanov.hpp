@@ -78,6 +78,9 @@ public:
   // The -fom_dual_matrix choice (auto: by R and the number of contact dofs) and, when dense, the contact dofs D.
   PetscErrorCode ChooseDualMatrix(MPI_Comm comm, const ContactMap &map, std::string *mode, std::vector<PetscInt> *D) const;
 
+  // -fom_dual_matrix saddle, after a Solve: the saddle point of the last Kacanov iterate's K and converged active set
+  // with the right-hand side (f, g) (SaddleActiveSetSolver::SolveFixedSet; the parameter sensitivities).
+  PetscErrorCode SolveSaddleFixedSet(Vec f, Vec g, Vec u, Vec lam) { return saddle_.SolveFixedSet(f, g, u, lam); }
   Vec            lambda = nullptr;
   ContactSystem  sys;
   KacanovHistory history;

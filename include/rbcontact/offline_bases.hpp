@@ -36,9 +36,17 @@ struct OfflineBasisSet {
   // rest is the online error estimate's enrichment (-1: none of that kind)
   bool                 estimate = false;
   PetscInt             nDefault = -1, rDefault = -1;
+  PetscInt             sensitivityVectors = 0; // -snapshots_sensitivities: the scaled du/dmu_i among the POD's vectors
+  PetscInt             dualPredicted      = 0; // and the predicted multipliers [lambda +- step dlambda_i]_+ among the dual greedy's
 };
-// POD (-pod_*), dual basis (-dual_*), supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no
-// contact). Collective on fom's communicator; world names the stage in messages.
+// POD (-pod_*; with -snapshots_sensitivities of the snapshots and their derivatives), dual basis (-dual_*),
+// supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no contact). Collective on fom's communicator; world names the stage in messages.
+// -dual_sensitivity_step (default 0.1, in [0, 1], else an error naming it): with -snapshots_sensitivities the dual
+// greedy also sees [lambda +- step (range_i dlambda/dmu_i)]_+ for every snapshot and parameter.
+PetscErrorCode DualSensitivityStepFromOptions(MPI_Comm comm, PetscReal *step);
+// -snapshots_sensitivities: every snapshot holds its derivatives (the extra "sensitivity_u", nparams x ndofs, not
+// all zero), else an error naming path (empty: "the snapshot file") and the snapshot.
+PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snapshot> &snaps, const std::string &path);
 PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b);
 
 // The multiplier snapshots of `rbcontact dualbasis -snapshots spec` as a matrix (rows = multipliers, columns =

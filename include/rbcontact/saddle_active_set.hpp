@@ -51,6 +51,12 @@ public:
   // else one step (info->changed > 0: the set moved, the QP at this K, g is not solved yet).
   // Out: u, lambda of the last step's set (lambda = 0 off it).
   PetscErrorCode Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info);
+  // One solve with the set and the matrix of the last step, no set update:
+  //   [A  K_P'] [u     ]   [f  ]
+  //   [K_P  0 ] [lambda] = [g_P],  P the set, lambda = 0 off it
+  // (the parameter sensitivities of the converged solution, snapshot_sensitivity.hpp), with the last step's
+  // preconditioner reused (GMRES to the exact solve's rtol). Errors: no step yet, or a solve that fails.
+  PetscErrorCode SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda);
   // Forget the set and the factorization.
   PetscErrorCode Reset();
   // The rigid-body modes of A (for a PCFIELDSPLIT's GAMG on the u block; kept by reference), wanted only when

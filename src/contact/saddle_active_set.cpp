@@ -294,6 +294,40 @@ PetscErrorCode SaddleActiveSetSolver::Fill(Mat A, Mat K)
 }
 
 // One step: factor and solve with the current set, then the next set from lambda and K u - g
+PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda)
+{
+  const PetscScalar *fa, *ga, *xa;
+  PetscScalar       *ba, *ua, *la;
+  KSPConvergedReason reason;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ksp_ && M_, PetscObjectComm((PetscObject)f), PETSC_ERR_ORDER, "SaddleActiveSetSolver::SolveFixedSet: no active-set step to reuse (Solve first)");
+  PetscCall(VecGetArrayRead(f, &fa));
+  PetscCall(VecGetArrayRead(g, &ga));
+  PetscCall(VecGetArray(b_, &ba));
+  for (PetscInt j = 0; j < nu_; ++j) ba[j] = fa[j];
+  for (PetscInt i = 0; i < nl_; ++i) ba[nu_ + i] = active_[i] ? kScale_ * ga[i] : 0.0;
+  PetscCall(VecRestoreArray(b_, &ba));
+  PetscCall(VecRestoreArrayRead(g, &ga));
+  PetscCall(VecRestoreArrayRead(f, &fa));
+  PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
+  PetscCall(KSPSetTolerances(ksp_, exactRtol_, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+  PetscCall(KSPSolve(ksp_, b_, x_));
+  PetscCall(KSPGetConvergedReason(ksp_, &reason));
+  PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
+  PetscCheck(reason > 0, PetscObjectComm((PetscObject)f), PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve with the converged set failed (%s): -%sksp_* / -%spc_type", KSPConvergedReasons[reason], prefix_.c_str(), prefix_.c_str());
+  PetscCall(VecGetArrayRead(x_, &xa));
+  PetscCall(VecGetArray(u, &ua));
+  PetscCall(VecGetArray(lambda, &la));
+  for (PetscInt j = 0; j < nu_; ++j) ua[j] = xa[j];
+  for (PetscInt i = 0; i < nl_; ++i) la[i] = active_[i] ? kScale_ * xa[nu_ + i] : 0.0;
+  PetscCall(VecRestoreArray(lambda, &la));
+  PetscCall(VecRestoreArray(u, &ua));
+  PetscCall(VecRestoreArrayRead(x_, &xa));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal rtol, Vec u, Vec lambda, SaddleInfo *info)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)A);

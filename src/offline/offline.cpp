@@ -15,6 +15,7 @@
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/snapshot_sensitivity.hpp"
 #include "rbcontact/training_set.hpp"
 #include <algorithm>
 #include <cstring>
@@ -28,7 +29,7 @@ static PetscLogEvent OFF_Snapshots = 0, OFF_SnapshotSolve = 0, OFF_SnapshotIO = 
 PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
 {
   char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64];
-  PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE;
+  PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE, sens = s->sensitivities ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(romPath, s->rom.c_str(), sizeof romPath));
@@ -57,6 +58,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   restart = strcmp(stop, "snapshots") ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-snapshots_restart", "resume from an existing snapshot file of this problem", "", restart, &restart, NULL));
   PetscCall(PetscOptionsBool("-snapshots_monitor", "print one line per solved snapshot", "", monitor, &monitor, NULL));
+  PetscCall(PetscOptionsBool("-snapshots_sensitivities", "store du/dmu_i, dlambda/dmu_i with every contact snapshot (linear solves with its factor) for the POD and the dual greedy (docs/greedy_training.md)", "", sens, &sens, NULL));
   PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
   PetscCall(PetscOptionsString("-offline_basis_output", "write the POD modes, supremizers and dual basis on the mesh to this HDF5 file (+ .xmf for ParaView)", "", viewPath, viewPath, sizeof viewPath, NULL));
   PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));
@@ -68,6 +70,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   s->snapshots = snapPath;
   s->restart   = restart;
   s->monitor   = monitor;
+  s->sensitivities = sens;
   s->trainType = trainType;
   s->basisView = viewPath;
   PetscFunctionReturn(0); // the files are checked by RunOffline, before any work
@@ -146,8 +149,9 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
   { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
-    PetscReal supRatio;
+    PetscReal supRatio, step;
     PetscCall(SupremizerRatioFromOptions(world, &supRatio));
+    PetscCall(DualSensitivityStepFromOptions(world, &step));
   }
   if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
     EIMOptions  eo;
@@ -238,8 +242,14 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
     if (!restart) PetscCheck(done.empty(), world, PETSC_ERR_PLIB, "new snapshot file with done entries");
 
-    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], K_D[R*nD]
-    const size_t           L = 7 + np + ndofs + 2 * R + (size_t)R * nD;
+    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], K_D[R*nD], and with
+    // -snapshots_sensitivities the scaled derivatives (mu_i range) du/dmu_i [np*ndofs], dlambda/dmu_i [np*R]
+    PetscCheck(!s.sensitivities || scene.contact, world, PETSC_ERR_SUP, "-snapshots_sensitivities: the derivatives are those of a contact solution (-contact_slave, -contact_master)");
+    const bool             sensOn = s.sensitivities;
+    const size_t           L0 = 7 + np + ndofs + 2 * R + (size_t)R * nD, L = L0 + (sensOn ? (size_t)np * (ndofs + R) : 0);
+    PetscLogDouble         sensSeconds = 0;
+    PetscInt               sensIts = 0, sensActive = 0;
+    std::string            sensMethod;
     std::vector<PetscReal> pack(L), gathered(wrank == 0 ? L * wsize : 0);
     std::vector<PetscInt>  itsSolved;
     bool                   multOrderBuilt = false;
@@ -275,6 +285,27 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           PetscCall(order.DofsToCanonical(fom.u, &u));
           PetscCall(PetscTime(&s1));
           PetscCall(PetscLogEventEnd(OFF_SnapshotSolve, 0, 0, 0, 0));
+          std::vector<std::vector<PetscReal>> dus, dls;
+          if (sensOn) { // after the solve's time: the snapshot's seconds stay the FOM's
+            std::vector<Vec> dv, dl;
+            SensitivityInfo  si;
+            PetscCall(ParameterSensitivities(fom, cmap, kac, &dv, &dl, &si));
+            for (PetscInt i = 0; i < np; ++i) {
+              dus.emplace_back();
+              dls.emplace_back();
+              PetscCall(order.DofsToCanonical(dv[i], &dus.back()));
+              PetscCall(order.MultipliersToCanonical(dl[i], &dls.back()));
+              const PetscReal w = scene.params[i].max - scene.params[i].min; // the derivative over the whole range
+              for (auto &x : dus.back()) x *= w;
+              for (auto &x : dls.back()) x *= w;
+              PetscCall(VecDestroy(&dv[i]));
+              PetscCall(VecDestroy(&dl[i]));
+            }
+            sensSeconds += si.seconds;
+            sensIts    = std::max(sensIts, si.cgIterations);
+            sensActive = std::max(sensActive, si.active);
+            sensMethod = si.method;
+          }
           if (grank == 0) {
             size_t o = 1;
             pack[o++] = kac.iterations;
@@ -292,6 +323,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
               const PetscInt c = order.CanonicalMultiplier(g);
               for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
             }
+            o = L0;
+            for (const auto &d : dus)
+              for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = d[j];
+            for (const auto &d : dls)
+              for (PetscInt j = 0; j < R; ++j) pack[o++] = d[j];
           }
           itsSolved.push_back(kac.iterations);
         }
@@ -322,6 +358,10 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
               o += R;
               s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
               s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
+            }
+            if (sensOn) {
+              s.extra["sensitivity_u"].assign(p + L0, p + L0 + (size_t)np * ndofs);
+              s.extra["sensitivity_lambda"].assign(p + L0 + (size_t)np * ndofs, p + L);
             }
             snaps.push_back(s);
           }
@@ -394,6 +434,21 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     rep.root["subcomms"]              = (long long)k;
     rep.root["mesh_nodes"]            = (long long)nnodes; // the default -snapshots_subcomm reads it
     rep.root["snapshots"]             = snapPath;
+    { // -snapshots_sensitivities: over the snapshots solved in this run (group roots' sums and maxima)
+      JsonValue &sj = rep.root["sensitivities"];
+      sj["enabled"] = sensOn;
+      if (sensOn) {
+        double   secs = grank == 0 ? (double)sensSeconds : 0.0;
+        PetscInt mx[2] = {sensIts, sensActive};
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &secs, 1, MPI_DOUBLE, MPI_SUM, world));
+        PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mx, 2, MPIU_INT, MPI_MAX, world));
+        sj["seconds"]          = secs;
+        sj["cg_iterations_max"] = (long long)mx[0];
+        sj["active_rows_max"]   = (long long)mx[1];
+        PetscCall(BcastString(world, &sensMethod)); // rank 0 solved a snapshot in this run, or nothing was solved
+        sj["method"] = sensMethod.empty() ? "none" : sensMethod;
+      }
+    }
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
       PetscCall(OfflineBases(world, fom, order, s.snapshots, s.rom, h, &rep, scene.contact ? &cmap : nullptr, full, s.basis, greedy));

@@ -69,6 +69,31 @@ static std::string RelativeTo(const std::string &path, const std::string &file)
   return ec || r.empty() ? path : r.string();
 }
 
+PetscErrorCode DualSensitivityStepFromOptions(MPI_Comm comm, PetscReal *step)
+{
+  PetscFunctionBeginUser;
+  *step = 0.1;
+  PetscOptionsBegin(comm, "dual_", "Predicted multipliers of the sensitivity snapshots (offline)", "OfflineBases");
+  PetscCall(PetscOptionsReal("-sensitivity_step", "with -snapshots_sensitivities: the dual greedy also sees [lambda +- step range_i dlambda/dmu_i]_+ (a fraction of the range; 0: not)", "", *step, step, NULL));
+  PetscOptionsEnd();
+  PetscCheck(*step >= 0 && *step <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_sensitivity_step %g must lie in [0, 1] (a fraction of the parameter's range; 0: no predicted multipliers)", (double)*step);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snapshot> &snaps, const std::string &path)
+{
+  PetscFunctionBeginUser;
+  for (const auto &sn : snaps) {
+    const auto it = sn.extra.find("sensitivity_u");
+    const auto il = sn.extra.find("sensitivity_lambda");
+    PetscCheck(it != sn.extra.end() && it->second.size() == sn.mu.size() * sn.u.size() && il != sn.extra.end() && il->second.size() == sn.mu.size() * sn.lambda.size(), world, PETSC_ERR_FILE_UNEXPECTED, "-snapshots_sensitivities: snapshot %" PetscInt_FMT " of %s has no sensitivities (solved without -snapshots_sensitivities): drop the option or solve the snapshots again in a new file", sn.index, path.empty() ? "the snapshot file" : path.c_str());
+    bool any = false; // a file whose first sensitivity snapshot came after this one reads zeros here
+    for (PetscReal x : it->second) any = any || x != 0;
+    PetscCheck(any, world, PETSC_ERR_FILE_UNEXPECTED, "-snapshots_sensitivities: snapshot %" PetscInt_FMT " of %s has no sensitivities (all zero: solved without -snapshots_sensitivities): drop the option or solve the snapshots again in a new file", sn.index, path.empty() ? "the snapshot file" : path.c_str());
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b)
 {
   PetscLogDouble t0, t1, t2;
@@ -113,17 +138,30 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     PetscCall(VecDestroy(&fref));
   } else if (!strcmp(inner, "h1")) PetscCall(fom.elas.AssembleH1(&M));
   else PetscCheck(!strcmp(inner, "l2"), world, PETSC_ERR_ARG_UNKNOWN_TYPE, "-pod_inner: unknown value '%s' (energy, h1 or l2)", inner);
-  std::vector<Vec> X(m);
+  // -snapshots_sensitivities: every snapshot's scaled derivatives du/dmu_i (the extra "sensitivity_u", np x ndofs)
+  // join the POD's vectors (docs/greedy_training.md "Sensitivity snapshots")
+  PetscBool sens = PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_sensitivities", &sens, NULL));
+  const PetscInt np = (PetscInt)snaps[0].mu.size(), ndofs = (PetscInt)snaps[0].u.size();
+  if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, ""));
+  b->dualPredicted = 0;
+  std::vector<const PetscReal *> cols;
+  for (PetscInt j = 0; j < m; ++j) cols.push_back(snaps[j].u.data());
+  if (sens)
+    for (PetscInt j = 0; j < m; ++j)
+      for (PetscInt i = 0; i < np; ++i) cols.push_back(snaps[j].extra.at("sensitivity_u").data() + (size_t)i * ndofs);
+  b->sensitivityVectors = sens ? m * np : 0;
+  std::vector<Vec> X(cols.size());
   {
     PetscInt lo, hi;
     Vec      tmpl;
     PetscCall(DMCreateGlobalVector(fom.dm, &tmpl));
     PetscCall(VecGetOwnershipRange(tmpl, &lo, &hi));
-    for (PetscInt j = 0; j < m; ++j) {
+    for (size_t j = 0; j < cols.size(); ++j) {
       PetscScalar *a;
       PetscCall(VecDuplicate(tmpl, &X[j]));
       PetscCall(VecGetArray(X[j], &a));
-      for (PetscInt i = lo; i < hi; ++i) a[i - lo] = snaps[j].u[order.CanonicalDof(i)];
+      for (PetscInt i = lo; i < hi; ++i) a[i - lo] = cols[j][order.CanonicalDof(i)];
       PetscCall(VecRestoreArray(X[j], &a));
     }
     PetscCall(VecDestroy(&tmpl));
@@ -142,10 +180,28 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   DualBasisResult &dual = b->dual;
   dual                  = DualBasisResult();
   if (R > 0) {
+    // -snapshots_sensitivities: besides every snapshot's multipliers, their first-order predictions a step
+    // -dual_sensitivity_step (a fraction of each parameter's range) away along +-mu_i, [lambda +- step dlambda_i]_+
+    // (nonnegative, so that the cone can hold the tangent of the multipliers; docs/greedy_training.md)
+    PetscReal step;
+    PetscCall(DualSensitivityStepFromOptions(world, &step));
+    std::vector<PetscInt> srcOf; // the snapshot of each column of L
+    for (PetscInt j = 0; j < m; ++j) srcOf.push_back(j);
+    if (sens && step > 0)
+      for (PetscInt j = 0; j < m; ++j)
+        for (PetscInt i = 0; i < np; ++i)
+          for (int sg = 0; sg < 2; ++sg) srcOf.push_back(j);
     DenseMatrix L;
-    L.Resize(R, m);
+    L.Resize(R, (PetscInt)srcOf.size());
     for (PetscInt j = 0; j < m; ++j)
       for (PetscInt i = 0; i < R; ++i) L(i, j) = snaps[j].lambda[i];
+    for (PetscInt c = m; c < (PetscInt)srcOf.size(); ++c) {
+      const PetscInt   j = srcOf[c], i = (c - m) / 2 % np;
+      const PetscReal  sgn = (c - m) % 2 ? -step : step;
+      const PetscReal *dl  = snaps[j].extra.at("sensitivity_lambda").data() + (size_t)i * R;
+      for (PetscInt r = 0; r < R; ++r) L(r, c) = std::max<PetscReal>(0, snaps[j].lambda[r] + sgn * dl[r]);
+    }
+    b->dualPredicted = (PetscInt)srcOf.size() - m;
     // -dual_mass_weighted (default off; needs the contact map): the greedy's errors in the slave-mass
     // weighted norm of the reported lambda error, ||x||_M^2 = sum_i int psi_i x_i^2 (reference
     // configuration): rows scaled by sqrt(int psi_i), the basis unscaled after (nonnegativity kept).
@@ -160,7 +216,7 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
       PetscCall(ReferenceSlaveMass(fom, *cmap, order, &w));
       PetscCheck((PetscInt)w.size() == R, world, PETSC_ERR_PLIB, "slave mass of %zu entries for %" PetscInt_FMT " multipliers", w.size(), R);
       for (PetscInt i = 0; i < R; ++i) sw[i] = std::sqrt(std::max<PetscReal>(w[i], 0));
-      for (PetscInt j = 0; j < m; ++j)
+      for (PetscInt j = 0; j < L.cols; ++j)
         for (PetscInt i = 0; i < R; ++i) L(i, j) *= sw[i];
     }
     if (estimate && strcmp(dualType, "nmf")) { // a greedy: its first vectors are those of the looser tolerance
@@ -174,6 +230,8 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
         }
       b->rDefault = r < dual.W.cols ? r : -1;
     } else PetscCall(BuildDualBasis(L, &dual));
+    for (auto &j : dual.selected)
+      if (j >= 0) j = srcOf[j]; // a predicted column counts as its snapshot's (the supremizers' K)
     if (massWeighted)
       for (PetscInt k = 0; k < dual.W.cols; ++k)
         for (PetscInt i = 0; i < R; ++i) dual.W(i, k) = sw[i] > 0 ? dual.W(i, k) / sw[i] : 0.0;
@@ -295,6 +353,11 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   std::vector<Snapshot> snaps;
   PetscCall(SnapshotFile::ReadAll(snapPath, &snaps));
+  {
+    PetscBool sens = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_sensitivities", &sens, NULL));
+    if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, snapPath));
+  }
   const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size(), R = header.nmult;
   PetscCheck(m == ntrain || (partial && m > 0), world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
   PetscCall(BuildBases(world, fom, order, snaps, R, cmap, &bs));
@@ -308,10 +371,11 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     rep->root["dual_mass_weighted"] = bs.massWeighted;
     // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
     // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
-    const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols;
-    const bool     tooCoarse = rAnswer >= m - 1 && m > 2;
+    // (-snapshots_sensitivities: the candidates are the snapshots' multipliers and their predicted neighbours)
+    const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols, cand = m + bs.dualPredicted;
+    const bool     tooCoarse = rAnswer >= cand - 1 && cand > 2;
     rep->root["dual_kept_all_snapshots"] = tooCoarse;
-    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", rAnswer, m));
+    if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", rAnswer, cand));
   }
 
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
@@ -385,6 +449,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   p["energy_captured"] = (double)pod.energyCaptured;
   p["orthonormality_error"] = (double)pod.orthonormalityError;
   p["supremizers"]     = (long long)nsup;
+  p["sensitivity_vectors"] = (long long)bs.sensitivityVectors;
+  rep->root["dual"]["predicted_columns"] = (long long)bs.dualPredicted;
   if (enr.candidates > 0) {
     JsonValue &ps             = p["supremizer_enrichment"];
     ps["candidates"]          = (long long)enr.candidates;
