@@ -38,6 +38,8 @@ public:
   // A(mu), f(mu) from the terms; creates A and f on the first call (same pattern as A_q).
   PetscErrorCode Assemble(const std::vector<PetscReal> &mu, Mat *A, Vec *f) const;
   void Describe(JsonValue *out) const; // {"A": n, "f": m, "A_terms": [...], "f_terms": [...]}
+  // r = A(mu) u - f(mu) from the terms, without forming A(mu) (t: a work vector like u).
+  PetscErrorCode Residual(const std::vector<PetscReal> &mu, Vec u, Vec t, Vec r) const;
 
   std::vector<Mat>         Aq;
   std::vector<Vec>         fq;

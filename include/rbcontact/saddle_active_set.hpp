@@ -79,6 +79,8 @@ private:
   PetscErrorCode CreateKSP();
   PetscErrorCode Fill(Mat A, Mat K);
   PetscErrorCode Step(Mat A, Vec f, Mat K, Vec g, PetscReal rtol, Vec u, Vec lambda, SaddleInfo *info);
+  PetscErrorCode SetRhs(Vec f, Vec g);                   // b_ = [f; c P g]
+  PetscErrorCode GetSolution(Vec u, Vec lambda) const;   // u, lambda = c lambda~ (0 off the set) from x_
   std::string            prefix_;
   KSP                    ksp_ = nullptr;
   Mat                    M_   = nullptr; // the saddle-point matrix

@@ -294,14 +294,13 @@ PetscErrorCode SaddleActiveSetSolver::Fill(Mat A, Mat K)
 }
 
 // One step: factor and solve with the current set, then the next set from lambda and K u - g
-PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda)
+// b_ = [f; c P g] (P the set)
+PetscErrorCode SaddleActiveSetSolver::SetRhs(Vec f, Vec g)
 {
-  const PetscScalar *fa, *ga, *xa;
-  PetscScalar       *ba, *ua, *la;
-  KSPConvergedReason reason;
+  const PetscScalar *fa, *ga;
+  PetscScalar       *ba;
 
   PetscFunctionBeginUser;
-  PetscCheck(ksp_ && M_, PetscObjectComm((PetscObject)f), PETSC_ERR_ORDER, "SaddleActiveSetSolver::SolveFixedSet: no active-set step to reuse (Solve first)");
   PetscCall(VecGetArrayRead(f, &fa));
   PetscCall(VecGetArrayRead(g, &ga));
   PetscCall(VecGetArray(b_, &ba));
@@ -310,13 +309,16 @@ PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lam
   PetscCall(VecRestoreArray(b_, &ba));
   PetscCall(VecRestoreArrayRead(g, &ga));
   PetscCall(VecRestoreArrayRead(f, &fa));
-  PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
-  PetscCall(KSPSetTolerances(ksp_, exactRtol_, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
-  PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
-  PetscCall(KSPSolve(ksp_, b_, x_));
-  PetscCall(KSPGetConvergedReason(ksp_, &reason));
-  PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
-  PetscCheck(reason > 0, PetscObjectComm((PetscObject)f), PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve with the converged set failed (%s): -%sksp_* / -%spc_type", KSPConvergedReasons[reason], prefix_.c_str(), prefix_.c_str());
+  PetscFunctionReturn(0);
+}
+
+// u, lambda from x_ (lambda = c lambda~ on the set, 0 off it)
+PetscErrorCode SaddleActiveSetSolver::GetSolution(Vec u, Vec lambda) const
+{
+  const PetscScalar *xa;
+  PetscScalar       *ua, *la;
+
+  PetscFunctionBeginUser;
   PetscCall(VecGetArrayRead(x_, &xa));
   PetscCall(VecGetArray(u, &ua));
   PetscCall(VecGetArray(lambda, &la));
@@ -328,24 +330,33 @@ PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lam
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda)
+{
+  KSPConvergedReason reason;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ksp_ && M_, PetscObjectComm((PetscObject)f), PETSC_ERR_ORDER, "SaddleActiveSetSolver::SolveFixedSet: no active-set step to reuse (Solve first)");
+  PetscCall(SetRhs(f, g));
+  PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
+  PetscCall(KSPSetTolerances(ksp_, exactRtol_, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+  PetscCall(KSPSolve(ksp_, b_, x_));
+  PetscCall(KSPGetConvergedReason(ksp_, &reason));
+  PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
+  PetscCheck(reason > 0, PetscObjectComm((PetscObject)f), PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve with the converged set failed (%s): -%sksp_* / -%spc_type", KSPConvergedReasons[reason], prefix_.c_str(), prefix_.c_str());
+  PetscCall(GetSolution(u, lambda));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal rtol, Vec u, Vec lambda, SaddleInfo *info)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)A);
-  const PetscScalar *fa, *ga, *xa;
-  PetscScalar       *ba, *ua, *la;
   KSPConvergedReason reason;
   PetscLogDouble     t0, t1;
 
   PetscFunctionBeginUser;
   PetscCall(Fill(A, K));
-  PetscCall(VecGetArrayRead(f, &fa));
-  PetscCall(VecGetArrayRead(g, &ga));
-  PetscCall(VecGetArray(b_, &ba));
-  for (PetscInt j = 0; j < nu_; ++j) ba[j] = fa[j];
-  for (PetscInt i = 0; i < nl_; ++i) ba[nu_ + i] = active_[i] ? kScale_ * ga[i] : 0.0;
-  PetscCall(VecRestoreArray(b_, &ba));
-  PetscCall(VecRestoreArrayRead(g, &ga));
-  PetscCall(VecRestoreArrayRead(f, &fa));
+  PetscCall(SetRhs(f, g));
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
   bool     fresh = !(factored_ && canReuse_ && changedSinceFactor_ <= reuseMaxChanges);
@@ -388,14 +399,7 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
   PetscCall(KSPGetConvergedReason(ksp_, &reason));
   PetscCheck(reason > 0, comm, PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve failed (%s) at active-set step %" PetscInt_FMT ": a failed factorization (-%spc_type, -%spc_factor_mat_solver_type; MUMPS workspace: -%smat_mumps_icntl_14) or the iterative solver's -%sksp_* settings",
              KSPConvergedReasons[reason], info->steps + 1, prefix_.c_str(), prefix_.c_str(), prefix_.c_str(), prefix_.c_str());
-  PetscCall(VecGetArrayRead(x_, &xa));
-  PetscCall(VecGetArray(u, &ua));
-  PetscCall(VecGetArray(lambda, &la));
-  for (PetscInt j = 0; j < nu_; ++j) ua[j] = xa[j];
-  for (PetscInt i = 0; i < nl_; ++i) la[i] = active_[i] ? kScale_ * xa[nu_ + i] : 0.0;
-  PetscCall(VecRestoreArray(lambda, &la));
-  PetscCall(VecRestoreArray(u, &ua));
-  PetscCall(VecRestoreArrayRead(x_, &xa));
+  PetscCall(GetSolution(u, lambda));
   PetscReal nx;
   PetscCall(VecNorm(x_, NORM_INFINITY, &nx));
   PetscCheck(std::isfinite(nx), comm, PETSC_ERR_FP, "Contact saddle-point solve gave non-finite values at active-set step %" PetscInt_FMT " (-%spc_type)", info->steps + 1, prefix_.c_str());

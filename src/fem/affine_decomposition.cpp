@@ -272,6 +272,19 @@ std::vector<PetscReal> AffineDecomposition::ThetaF(const std::vector<PetscReal> 
   return t;
 }
 
+PetscErrorCode AffineDecomposition::Residual(const std::vector<PetscReal> &mu, Vec u, Vec t, Vec r) const
+{
+  PetscFunctionBeginUser;
+  const std::vector<PetscReal> ta = ThetaA(mu), tf = ThetaF(mu);
+  PetscCall(VecSet(r, 0.0));
+  for (size_t q = 0; q < ta.size(); ++q) {
+    PetscCall(MatMult(Aq[q], u, t));
+    PetscCall(VecAXPY(r, ta[q], t));
+  }
+  for (size_t q = 0; q < tf.size(); ++q) PetscCall(VecAXPY(r, -tf[q], fq[q]));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode AffineDecomposition::Assemble(const std::vector<PetscReal> &mu, Mat *A, Vec *f) const
 {
   PetscFunctionBeginUser;

@@ -39,13 +39,7 @@ PetscErrorCode ResidualAt(ElasticFOM &fom, ContactMap &cmap, Vec u, Vec lam, con
 {
   PetscFunctionBeginUser;
   PetscCall(fom.SetMu(mu)); // the Dirichlet values at mu (no assembly)
-  const std::vector<PetscReal> ta = fom.affine.ThetaA(mu), tf = fom.affine.ThetaF(mu);
-  PetscCall(VecSet(ru, 0.0));
-  for (size_t q = 0; q < ta.size(); ++q) {
-    PetscCall(MatMult(fom.affine.Aq[q], u, t));
-    PetscCall(VecAXPY(ru, ta[q], t));
-  }
-  for (size_t q = 0; q < tf.size(); ++q) PetscCall(VecAXPY(ru, -tf[q], fom.affine.fq[q]));
+  PetscCall(fom.affine.Residual(mu, u, t, ru));
   cmap.SetGeometry(&fom.map, mu);
   PetscCall(fom.elas.GlobalToLocalWithBC(u, uloc));
   PetscCall(cmap.Assemble(fom.elas, uloc, sys));

@@ -57,14 +57,7 @@ PetscErrorCode GreedyIndicator::Evaluate(ElasticFOM &fom, ContactMap &cmap, cons
   PetscCheck(ksp_, comm, PETSC_ERR_ORDER, "GreedyIndicator: call Setup first");
   PetscCheck((PetscInt)lamCanon.size() == order.NumMultipliers(), comm, PETSC_ERR_ARG_SIZ, "GreedyIndicator: %zu multipliers for %" PetscInt_FMT, lamCanon.size(), order.NumMultipliers());
   PetscCall(fom.SetMu(mu)); // the Dirichlet values at mu (no assembly)
-  // A(mu) u - f(mu) through the affine terms
-  const std::vector<PetscReal> ta = fom.affine.ThetaA(mu), tf = fom.affine.ThetaF(mu);
-  PetscCall(VecSet(r_, 0.0));
-  for (size_t q = 0; q < ta.size(); ++q) {
-    PetscCall(MatMult(fom.affine.Aq[q], u, t_));
-    PetscCall(VecAXPY(r_, ta[q], t_));
-  }
-  for (size_t q = 0; q < tf.size(); ++q) PetscCall(VecAXPY(r_, -tf[q], fom.affine.fq[q]));
+  PetscCall(fom.affine.Residual(mu, u, t_, r_)); // A(mu) u - f(mu) through the affine terms
   // + K(u)' lam: the contact constraint at u in the geometry of mu
   cmap.SetGeometry(&fom.map, mu);
   PetscCall(fom.elas.GlobalToLocalWithBC(u, uloc_));
