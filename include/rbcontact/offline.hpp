@@ -25,7 +25,7 @@ struct OfflineSettings {
   std::string trainType = "grid";      // -train_type grid|random|lhs|file|greedy
   PetscInt    subcomms  = 0;           // -snapshots_subcomm: groups of ranks (0: one per rank below 200k dofs, else 1)
   std::string basisView;               // -offline_basis_output: the bases on the mesh for ParaView (rom_fields.hpp, WriteBasisView)
-  bool        sensitivities = false;   // -snapshots_sensitivities: every contact snapshot with du/dmu_i (snapshot_sensitivity.hpp), the POD's too
+  bool        sensitivities = false;   // -snapshots_sensitivities: every contact snapshot with du/dmu_i, dlambda/dmu_i (snapshot_sensitivity.hpp) for the bases
 };
 
 // Reads the settings above (one PetscOptionsBegin block: `rbcontact offline -help` lists them) and checks

@@ -22,10 +22,12 @@ struct SensitivityInfo {
 // the right-hand side by central differences of that residual (step 1e-6 of the parameter's range, one-sided at
 // the box's edges; the contact map reassembled at mu +- h), the system through its Schur complement on the
 // active rows: with the dense dual path (-fom_dual_matrix dense) S_AA = K_AD G K_AD' from its compliance G, formed
-// and factored (Cholesky) once; otherwise CG (prefix sensitivity_, rtol 1e-10) on K_A A^-1 K_A' with fom's A^-1. The Kacanov
+// and factored (Cholesky) once; with the saddle path (saddle) the saddle point of the converged set itself, with that
+// solver's factor or preconditioner (SaddleActiveSetSolver::SolveFixedSet: one solve a parameter, no factorization of
+// A alone); on the shell path CG (prefix sensitivity_, rtol 1e-10) on K_A A^-1 K_A' with fom's A^-1. The Kacanov
 // solution is the fixed point of this linearization, so du is the tangent of u(mu) up to the variation of the
 // contact geometry with u (checked against central differences of FOM solutions: tests/offline_checks.py
-// `sensitivities`). A non-converged CG is an error naming the option. Needs the affine decomposition
+// `sensitivities`). A non-converged solve is an error naming its options. Needs the affine decomposition
 // (fom.SetupAffine). On return fom.mu and cmap's geometry are those of the call; du: global vectors of fom.dm,
 // dlam: vectors of the multipliers' layout (zero on the inactive rows), created here (the caller destroys them).
 PetscErrorCode ParameterSensitivities(ElasticFOM &fom, ContactMap &cmap, KacanovSolver &kac, std::vector<Vec> *du, std::vector<Vec> *dlam, SensitivityInfo *info);
