@@ -18,8 +18,8 @@ namespace rbc {
 // them). onlineRom false: bases only (-offline_stop bases), written to romPath (format_version 1);
 // true: the bases go to basisPath and the online ROM (format_version 2, src/offline/offline_rom.cpp) to romPath.
 // partial: the training set is the done snapshots of the file (a greedy run declares its candidate pool);
-// otherwise every training point must be done.
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "", bool partial = false);
+// otherwise every training point must be done. sensitivities: BuildBases' (the file's derivatives, checked and used).
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap = nullptr, bool onlineRom = false, const std::string &basisPath = "", bool partial = false, bool sensitivities = false);
 
 // The bases of a set of snapshots, in memory (the bases step, and every round of the greedy training).
 struct OfflineBasisSet {
@@ -39,15 +39,17 @@ struct OfflineBasisSet {
   PetscInt             sensitivityVectors = 0; // -snapshots_sensitivities: the scaled du/dmu_i among the POD's vectors
   PetscInt             dualPredicted      = 0; // and the predicted multipliers [lambda +- step dlambda_i]_+ among the dual greedy's
 };
-// POD (-pod_*; with -snapshots_sensitivities of the snapshots and their derivatives), dual basis (-dual_*),
-// supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no contact). Collective on fom's communicator; world names the stage in messages.
+// POD (-pod_*; with sensitivities of the snapshots and their derivatives), dual basis (-dual_*; with sensitivities
+// also the predicted multipliers), supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no contact).
+// sensitivities (OfflineSettings::sensitivities): the snapshots' derivatives are checked (CheckSnapshotSensitivities,
+// source names the snapshot file in its errors) and used. Collective on fom's communicator; world names the stage in messages.
 // -dual_sensitivity_step (default 0.1, in [0, 1], else an error naming it): with -snapshots_sensitivities the dual
 // greedy also sees [lambda +- step (range_i dlambda/dmu_i)]_+ for every snapshot and parameter.
 PetscErrorCode DualSensitivityStepFromOptions(MPI_Comm comm, PetscReal *step);
 // -snapshots_sensitivities: every snapshot holds its derivatives (the extra "sensitivity_u", nparams x ndofs, not
 // all zero), else an error naming path (empty: "the snapshot file") and the snapshot.
 PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snapshot> &snaps, const std::string &path);
-PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b);
+PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b, bool sensitivities = false, const std::string &source = "");
 
 // The multiplier snapshots of `rbcontact dualbasis -snapshots spec` as a matrix (rows = multipliers, columns =
 // snapshots): "file.h5:/dataset" or a PETSc binary matrix (ImportSnapshotMatrix), or an offline snapshot file

@@ -32,6 +32,7 @@ struct GreedyOptions {
   PetscInt  batch      = 0;
   PetscReal separation = 2;
   PetscBool monitor    = PETSC_FALSE;
+  bool      sensitivities = false; // the snapshots carry their derivatives (OfflineSettings::sensitivities): the rounds' bases use them
 };
 PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o);
 

@@ -145,6 +145,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCheck(scene.contact, world, PETSC_ERR_SUP, "-train_type greedy: the indicator is that of a contact scene (-contact_slave, -contact_master)");
     PetscCheck(full, world, PETSC_ERR_ARG_INCOMP, "-train_type greedy builds the reduced model while it trains: it runs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
     PetscCall(GreedyOptionsFromOptions(world, &gopt));
+    gopt.sensitivities = s.sensitivities;
     PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
   } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
@@ -451,7 +452,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     }
     if (bases) {
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
-      PetscCall(OfflineBases(world, fom, order, s.snapshots, s.rom, h, &rep, scene.contact ? &cmap : nullptr, full, s.basis, greedy));
+      PetscCall(OfflineBases(world, fom, order, s.snapshots, s.rom, h, &rep, scene.contact ? &cmap : nullptr, full, s.basis, greedy, s.sensitivities));
       if (full && !s.basisView.empty()) PetscCall(WriteBasisView(world, scene, s.rom, s.basisView, &rep));
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);

@@ -94,7 +94,7 @@ PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snap
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b)
+PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b, bool sensitivities, const std::string &source)
 {
   PetscLogDouble t0, t1, t2;
   char           inner[32] = "energy";
@@ -140,10 +140,9 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   else PetscCheck(!strcmp(inner, "l2"), world, PETSC_ERR_ARG_UNKNOWN_TYPE, "-pod_inner: unknown value '%s' (energy, h1 or l2)", inner);
   // -snapshots_sensitivities: every snapshot's scaled derivatives du/dmu_i (the extra "sensitivity_u", np x ndofs)
   // join the POD's vectors (docs/greedy_training.md "Sensitivity snapshots")
-  PetscBool sens = PETSC_FALSE;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_sensitivities", &sens, NULL));
+  const bool     sens = sensitivities;
   const PetscInt np = (PetscInt)snaps[0].mu.size(), ndofs = (PetscInt)snaps[0].u.size();
-  if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, ""));
+  if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, source));
   b->dualPredicted = 0;
   std::vector<const PetscReal *> cols;
   for (PetscInt j = 0; j < m; ++j) cols.push_back(snaps[j].u.data());
@@ -344,7 +343,7 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath, bool partial)
+PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath, bool partial, bool sensitivities)
 {
   PetscMPIInt     wrank;
   OfflineBasisSet bs;
@@ -353,14 +352,9 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   std::vector<Snapshot> snaps;
   PetscCall(SnapshotFile::ReadAll(snapPath, &snaps));
-  {
-    PetscBool sens = PETSC_FALSE;
-    PetscCall(PetscOptionsGetBool(NULL, NULL, "-snapshots_sensitivities", &sens, NULL));
-    if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, snapPath));
-  }
   const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size(), R = header.nmult;
   PetscCheck(m == ntrain || (partial && m > 0), world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
-  PetscCall(BuildBases(world, fom, order, snaps, R, cmap, &bs));
+  PetscCall(BuildBases(world, fom, order, snaps, R, cmap, &bs, sensitivities, snapPath));
   PODResult            &pod   = bs.pod;
   DualBasisResult      &dual  = bs.dual;
   const PetscInt        nsup  = bs.nsup;

@@ -107,7 +107,7 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     std::shared_ptr<ContactPatch> full;
     std::vector<PetscReal>        P;
     PetscInt                      nsub;
-    PetscCall(BuildBases(world, fom, order, snaps, h.nmult, &cmap, &bs));
+    PetscCall(BuildBases(world, fom, order, snaps, h.nmult, &cmap, &bs, go.sensitivities, path));
     PetscCall(BuildExactReducedModel(world, fom, cmap, order, bs.pod.modes, bs.modes, bs.pod.N - bs.nsup, bs.nsup, bs.dual, &rm, &full, &P, &nsub));
     rm.warmStart      = PETSC_FALSE;
     rm.loop.monitor   = PETSC_FALSE;

@@ -58,8 +58,8 @@ PetscErrorCode ParameterSensitivities(ElasticFOM &fom, ContactMap &cmap, Kacanov
   ActiveSchur                  ctx;
   ContactSystem                sys;
   Vec                          uloc, t, rup, rum, rcp, rcm, bu, du0, rhs, yv;
-  Mat                          S;
-  KSP                          ksp;
+  Mat                          S   = nullptr;
+  KSP                          ksp = nullptr;
   PC                           pc;
   PetscLogDouble               t0, t1;
 
@@ -89,28 +89,29 @@ PetscErrorCode ParameterSensitivities(ElasticFOM &fom, ContactMap &cmap, Kacanov
     PetscCall(VecRestoreArrayRead(kac.lambda, &l));
     PetscCallMPI(MPI_Allreduce(&nact, &info->active, 1, MPIU_INT, MPI_SUM, comm));
   }
-  ctx.fom = &fom;
-  ctx.K   = kac.sys.K;
-  {
-    PetscInt nl, Nl;
-    PetscCall(VecGetLocalSize(kac.lambda, &nl));
-    PetscCall(VecGetSize(kac.lambda, &Nl));
-    PetscCall(MatCreateShell(comm, nl, nl, Nl, Nl, &ctx, &S));
-    PetscCall(MatShellSetOperation(S, MATOP_MULT, (void (*)(void))ActiveSchurMult));
-  }
-  PetscCall(KSPCreate(comm, &ksp));
-  PetscCall(KSPSetOptionsPrefix(ksp, "sensitivity_"));
-  PetscCall(KSPSetType(ksp, KSPCG));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCNONE));
-  PetscCall(KSPSetTolerances(ksp, 1e-10, 1e-300, PETSC_DEFAULT, 10 * info->active + 100));
-  PetscCall(KSPSetOperators(ksp, S, S));
-  PetscCall(KSPSetFromOptions(ksp));
-
   // The dense dual path (-fom_dual_matrix dense) holds the compliance G = (A^-1)_DD of this parameter: then
   // S_AA = K_AD G K_AD' is formed and factored (Cholesky) once, every rank the same, instead of CG.
   const bool             dense = kac.dualMatrix == "dense" && !kac.compliance.D.empty() && kac.compliance.G.size() == kac.compliance.D.size() * kac.compliance.D.size();
   info->method = dense ? "dense" : kac.dualMatrix == "saddle" ? "saddle" : "cg";
+  if (info->method == "cg") { // the shell path: CG on the active rows' Schur complement
+    ctx.fom = &fom;
+    ctx.K   = kac.sys.K;
+    {
+      PetscInt nl, Nl;
+      PetscCall(VecGetLocalSize(kac.lambda, &nl));
+      PetscCall(VecGetSize(kac.lambda, &Nl));
+      PetscCall(MatCreateShell(comm, nl, nl, Nl, Nl, &ctx, &S));
+      PetscCall(MatShellSetOperation(S, MATOP_MULT, (void (*)(void))ActiveSchurMult));
+    }
+    PetscCall(KSPCreate(comm, &ksp));
+    PetscCall(KSPSetOptionsPrefix(ksp, "sensitivity_"));
+    PetscCall(KSPSetType(ksp, KSPCG));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCSetType(pc, PCNONE));
+    PetscCall(KSPSetTolerances(ksp, 1e-10, 1e-300, PETSC_DEFAULT, 10 * info->active + 100));
+    PetscCall(KSPSetOperators(ksp, S, S));
+    PetscCall(KSPSetFromOptions(ksp));
+  }
   std::vector<PetscInt>  act; // the active rows (global), dense path
   std::vector<PetscReal> SA;  // their Schur complement's Cholesky factor
   PetscInt               rlo = 0, rhi = 0;
@@ -151,7 +152,7 @@ PetscErrorCode ParameterSensitivities(ElasticFOM &fom, ContactMap &cmap, Kacanov
     // right-hand side: -(d residual / d mu_i)
     PetscCall(VecAXPBYPCZ(bu, -1.0 / step, 1.0 / step, 0.0, rup, rum));
     PetscCall(VecAXPBYPCZ(rhs, -1.0 / step, 1.0 / step, 0.0, rcp, rcm)); // b_c
-    if (kac.dualMatrix == "saddle") { // the saddle point of the converged set, with the solver's own factor
+    if (info->method == "saddle") { // the saddle point of the converged set, with the solver's own factor
       PetscCall(VecDuplicate(t, &(*du)[i]));
       PetscCall(VecDuplicate(yv, &(*dlam)[i]));
       PetscCall(kac.SolveSaddleFixedSet(bu, rhs, (*du)[i], (*dlam)[i]));
