@@ -141,6 +141,20 @@ def pipeline(args):
     tg = report(d + "/groups/val.json")["test"]
     check(tg["max_rel_err_u"] <= 1e-4 and tg["max_rel_err_lambda"] <= 1e-2 and tg["max_rel_err_force"] <= 1e-3,
           "hierarchical cubature's ROM, 20 random radii: u %.2e <= 1e-4, lambda %.2e <= 1e-2, force %.2e <= 1e-3" % (tg["max_rel_err_u"], tg["max_rel_err_lambda"], tg["max_rel_err_force"]))
+    # the contact states split over the 2 ranks (the default without the EIM) against every state on every rank
+    # (-ecsw_distribute_states 0), the same snapshots: the Gram system is the same sum in another order, so the same
+    # points and the weights to its rounding times the conditioning of H(S, S) (docs/hyper_reduction.md, "Memory")
+    check(cg["states_distributed"] and cg["states_per_rank_max"] == -(-cg["states"] // 2) < cg["states"],
+          "2 ranks without the EIM: the %d contact states split over the ranks (at most %d a rank)" % (cg["states"], cg["states_per_rank_max"]))
+    os.makedirs(d + "/groups_whole")
+    _, offw = offline(args, d + "/groups_whole", extra=["-ecsw_group_points", "100", "-ecsw_distribute_states", "0", "-snapshots", d + "/groups/rom.snapshots.h5", "-snapshots_restart"])
+    cw = offw["ecsw"]
+    wd, ww = np.array(cg["weights"]), np.array(cw["weights"])
+    same_pts = not cw["states_distributed"] and cw["states_per_rank_max"] == cw["states"] == cg["states"] and wd.shape == ww.shape
+    dw = np.abs(wd - ww).max() / ww.max() if same_pts else np.inf
+    dek = np.abs(np.array(cg["train_err_K"]) - np.array(cw["train_err_K"])).max() if same_pts else np.inf
+    check(same_pts and dw <= 1e-5 and abs(cg["residual"] - cw["residual"]) <= 1e-6 * cw["residual"] and dek <= 1e-6 * max(cw["train_err_K"]),
+          "states split over the ranks = whole on every rank: %d points, weights to %.1e (<= 1e-5), residual %.6e vs %.6e, per-state errors to %.1e" % (cg["M"], dw, cg["residual"], cw["residual"], dek))
     # the same offline stage on 1 rank: the same ROM
     d2 = d + "/np1"
     os.makedirs(d2)
@@ -191,6 +205,30 @@ def pipeline(args):
         a, b = val[1]["test"][k], val[2]["test"][k]
         check(abs(a - b) <= 1e-6 * max(a, 1e-300) + 1e-12, "validate %s on 1 and 2 ranks: %.6e vs %.6e" % (k, a, b))
     check(all(np.isfinite(val[1]["test_no_eim"][k]) for k in ("max_rel_err_u", "max_rel_err_lambda")), "test_no_eim reported")
+    # the FOM test solutions from a snapshot file (-test_snapshots; docs/online.md "Validation"): the same test set
+    # solved by the checkpointed snapshot stage (one group of 2 ranks, as validate solves), then validate reading it:
+    # the same errors (its contact system assembled at the stored u), the FOM times those stored
+    ts = d + "/test.snapshots.h5"
+    run(args, 2, "offline", ["-options_file", "runs/ring_on_block.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
+                             "-snapshots_subcomm", "1", "-snapshots", ts])
+    run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "10", "-test_snapshots", ts, "-report", d + "/val_ts.json"])
+    vts = report(d + "/val_ts.json")
+    with h5py.File(ts, "r") as f:
+        secs = np.array(f["snapshots/seconds"])
+    dts = max(abs(vts["test"][k] - val[2]["test"][k]) / val[2]["test"][k] for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force", "mean_rel_err_u"))
+    check(vts["test_snapshots"] == ts and vts["test"]["n"] == 20 and np.allclose(vts["test"]["mu"], val[2]["test"]["mu"], rtol=0, atol=1e-14) and dts <= 1e-6,
+          "validate -test_snapshots: the 20 test radii, the errors of the FOM solved in validate to %.1e (<= 1e-6)" % dts)
+    check(np.array_equal(np.array(vts["fom_time_s"]["all"]), secs), "validate -test_snapshots: fom_time_s = the stored seconds of the snapshot stage")
+    part = d + "/test_part.h5"
+    shutil.copy(ts, part)
+    with h5py.File(part, "a") as f:
+        f["snapshots/done"][5] = 0
+    p = run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_snapshots", part], expect_ok=False)
+    check(p.returncode != 0 and "holds 19 of its 20 solutions" in p.stdout and part in p.stdout, "validate -test_snapshots with a snapshot unsolved: refused naming the file and the count")
+    other = d + "/test_other.h5"
+    run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-offline_stop", "snapshots", "-train_size", "2", "-body_E", "200,100", "-snapshots", other])
+    p = run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_snapshots", other], expect_ok=False)
+    check(p.returncode != 0 and "another configuration" in p.stdout and other in p.stdout, "validate -test_snapshots solved with other materials: refused naming the file")
     # the best approximation of u in the primal basis (energy norm): no reduced solution in the basis is closer
     best, ru = np.array(val[1]["test_best_approximation"]["rel_err_u"]), np.array(t["rel_err_u"])
     check(len(best) == 20 and np.all(best <= ru * (1 + 1e-8) + 1e-12) and best.max() > 0,

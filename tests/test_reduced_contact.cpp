@@ -7,8 +7,10 @@
 //      master shifted tangentially, flags the projections that left it);
 //   3. ReducedParametrization::FromFOM gives the FOM's affine coefficients, survives a ROM-file
 //      roundtrip, and CheckBox rejects a parameter outside the box;
-//   4. a patch serialized to a ROM file and read back evaluates bitwise identically.
+//   4. a patch serialized to a ROM file and read back evaluates bitwise identically;
+//   and the offline store of contact states by their terms (ContactStates) gives Evaluate's values bit for bit.
 #include "rbcontact/canonical_order.hpp"
+#include "rbcontact/contact_states.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/reduced_contact.hpp"
@@ -336,6 +338,33 @@ static PetscErrorCode Run()
     PetscCall(PetscPrintf(comm, "     rings 2: out of range %" PetscInt_FMT ", rel. diff kappa %.3e gamma %.3e (information)\n", f2.outside, (double)dk2, (double)dg2));
     const bool exact0 = dk0 <= 1e-14 && dg0 <= 1e-14;
     PetscCall(Check(comm, f0.outside > 0 || exact0, "rings 0, shifted master: flagged out of range, or exact (count)", (double)f0.outside, 0));
+  }
+
+  // the offline stage's store of contact states by their terms (ContactStates): each state's kappa block, gamma,
+  // w n2 and hits bit for bit those of Evaluate at that state (two states: v at mu, 2 v at 1.01 mu)
+  {
+    const PetscReal              v2[3] = {2.0, 0.6, -0.4};
+    const std::vector<PetscReal> mu2   = {mu[0] * 1.01};
+    const std::vector<PetscInt>  all   = Iota(Q);
+    ContactStates                cs(full, 2);
+    std::vector<PetscInt>        hs;
+    bool                         same = true;
+    std::vector<Eval>            ref(2);
+    std::vector<std::vector<PetscReal>> wref(2, std::vector<PetscReal>((size_t)Q * dim));
+    for (int s = 0; s < 2; ++s) {
+      full.SetGeometry(&fom.map, s ? mu2 : mu);
+      full.SetReduced(s ? v2 : v);
+      EvaluatePatch(full, all, &ref[s]);
+      (void)full.Evaluate(all.data(), Q, nullptr, nullptr, nullptr, wref[s].data());
+      cs.Append(&hs);
+      same = same && hs == ref[s].hit;
+    }
+    for (int s = 0; s < 2 && same; ++s) {
+      same = std::memcmp(cs.Kappa(s), ref[s].kappa.data(), (size_t)Q * N * sizeof(PetscReal)) == 0;
+      same = same && std::memcmp(&cs.Gamma()[(size_t)s * Q], ref[s].gamma.data(), (size_t)Q * sizeof(PetscReal)) == 0;
+      same = same && std::memcmp(&cs.ForceWeights()[(size_t)s * Q * dim], wref[s].data(), (size_t)Q * dim * sizeof(PetscReal)) == 0;
+    }
+    PetscCall(Check(comm, cs.Size() == 2 && same, "ContactStates: kappa blocks, gamma, w n2, hits of 2 states bit for bit those of Evaluate", same ? 0.0 : 1.0, 0));
   }
 
   // ---------------------------------------------------------------- 3. parametrization

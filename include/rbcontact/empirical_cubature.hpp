@@ -58,6 +58,11 @@ struct CubatureCandidates {
   PetscReal              c = 0;  // 1'H1
 };
 
+// A state's kappa block (Q x N, row-major, as ContactPatch::Evaluate returns it) by the state's index among the ms
+// states. The pointer may be to a buffer that the next call overwrites: the offline stage forms the blocks from the
+// points' terms (ContactStates) instead of holding them. The std::vector overloads below read ms contiguous blocks.
+using KappaBlocks = std::function<const PetscReal *(PetscInt s)>;
+
 // Options with prefix pre (e.g. "ecsw_"): -<pre>fit, -<pre>fit_force, -<pre>tol, -<pre>max_points, -<pre>group_points, -<pre>monitor.
 PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, CubatureOptions *opt);
 
@@ -67,6 +72,7 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
 // whose K^ or g^ vanishes contributes nothing for that term).
 // With cand (points nonempty): H is the Gram matrix on the candidates (|C| x |C|) and cand->b, cand->c are filled.
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand = nullptr);
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand = nullptr);
 
 // The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
 // and Vs (nt x N, row-major),
@@ -81,9 +87,11 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
 // Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
 // they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding. With cand, as CubatureGram.
 void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr);
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);
+void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);
 
 // Sparse NNLS in Gram form: min over xi >= 0 of (xi - 1)' H (xi - 1), points added greedily (largest
 // gradient) until the relative residual sqrt((xi - 1)' H (xi - 1) / 1' H 1) <= opt.tol.

@@ -57,7 +57,9 @@ public:
   // The same before the combination with theta: kappa(i, :) = sum_{t < nt[i]} coef[i][t] theta(rowIdx[i][t], :)
   // (at most MaxTerms terms per point, stored with stride MaxTerms), and gamma. Same return value.
   static constexpr PetscInt MaxTerms = 36; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
-  PetscInt EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn = nullptr) const;
+  PetscInt EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn = nullptr, PetscInt *hit = nullptr) const;
+  // One point's kappa row (N) from its nt terms: the combination Evaluate makes (the same kernel, the same bits).
+  void KappaRow(PetscInt nt, const PetscInt *rowIdx, const PetscReal *coef, PetscReal *kappa) const;
   PetscInt NumPoints() const { return (PetscInt)points.size(); }
   // The dofs [0, TermDofs()) hold every node a term can fall on (slave facets, searchable master facets); the
   // rest serve the master vertex normals only. Restrict numbers the term nodes first (older files: up to nnode * dim).

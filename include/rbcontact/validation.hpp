@@ -18,6 +18,8 @@ struct ValidationSettings {
   std::string            sweepOutput;                         // -validate_sweep_output stem (default: the report's + _sweep)
   bool                   residual = false;                    // -validate_residual: the residual indicator and its effectivity
   bool                   print    = true;                     // the summary line (off for offline -estimate's calibration run)
+  std::string            testSnapshots;                       // -test_snapshots: the FOM test solutions from a snapshot file
+                                                              // (offline -offline_stop snapshots; its points are the test set)
   // when not null: the error estimate's raw changes and the true errors per test parameter (u, lambda, force), as in
   // the report's estimate block (empty when the ROM gives no estimate)
   std::vector<double>   *estimateRaw = nullptr, *estimateErr = nullptr; // arrays of 3
@@ -30,7 +32,8 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 // Report keys: stage, scene, rom_file, nranks, test and test_exact (= test_no_eim) {n, max_rel_err_u,
 // mean_rel_err_u, max_rel_err_lambda, mean_rel_err_lambda, max_rel_err_force, rel_err_*, max_rel_err_force_online,
 // failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat}, fom_time_s {median, all},
-// speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}; with the sweep
+// speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}, test_snapshots (the file or
+// ""; with it, the FOM solutions and fom_time_s come from the file: docs/online.md "Validation"); with the sweep
 // also sweep [rows] and sweep_files; with -validate_residual also residual {indicator, rel_err_u_energy,
 // effectivity, min_effectivity, max_effectivity, share_above_1, share_within_20} (docs/error_estimate.md: the
 // residual of the reduced solution assembled on the mesh, not an online quantity). An error if the ROM fails on a

@@ -10,30 +10,19 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/eim.hpp"
 #include "rbcontact/empirical_cubature.hpp"
+#include "rbcontact/contact_states.hpp"
 #include "rbcontact/eim_selection.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/training_set.hpp"
 #include <slepcbv.h>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <set>
 
 namespace rbc {
 
 static PetscLogEvent OFF_EIM = 0, OFF_Affine = 0;
-
-// kappa/gamma (and w n2, for the cubature's force term) of one evaluation appended as snapshot columns;
-// hits recorded per point.
-static void Append(const ContactPatch &P, std::vector<PetscReal> *Sk, std::vector<PetscReal> *Sg, std::vector<PetscReal> *Sw, std::vector<std::set<PetscInt>> *hits, std::vector<PetscInt> *all, std::vector<PetscReal> *kap, std::vector<PetscReal> *gam, std::vector<PetscReal> *wn, std::vector<PetscInt> *hit)
-{
-  const PetscInt Q = P.NumPoints();
-  wn->resize((size_t)Q * P.dim);
-  (void)P.Evaluate(all->data(), Q, kap->data(), gam->data(), hit->data(), wn->data());
-  Sk->insert(Sk->end(), kap->begin(), kap->end());
-  Sg->insert(Sg->end(), gam->begin(), gam->end());
-  Sw->insert(Sw->end(), wn->begin(), wn->end());
-  for (PetscInt p = 0; p < Q; ++p) (*hits)[p].insert((*hit)[p]);
-}
 
 // Position of p in list, appended if absent.
 static PetscInt Intern(std::vector<PetscInt> *list, PetscInt p)
@@ -44,15 +33,75 @@ static PetscInt Intern(std::vector<PetscInt> *list, PetscInt p)
   return (PetscInt)list->size() - 1;
 }
 
-// Is every snapshot (n x m, column-major) equal to the first one (to round-off)?
-static bool Constant(const std::vector<PetscReal> &S, size_t n, size_t m, PetscReal *spread)
+// Is every snapshot (n entries; the m held on this rank, by S(j)) equal to the first one of all, ref (to round-off)?
+// The spread max |S_j - ref| / max |S| over the snapshots of every rank.
+static PetscErrorCode Constant(MPI_Comm comm, const std::function<const PetscReal *(PetscInt)> &S, const PetscReal *ref, size_t n, PetscInt m, PetscReal *spread, bool *constant)
 {
-  PetscReal scale = 0, d = 0;
-  for (size_t i = 0; i < n * m; ++i) scale = std::max(scale, std::abs(S[i]));
-  for (size_t j = 1; j < m; ++j)
-    for (size_t i = 0; i < n; ++i) d = std::max(d, std::abs(S[i + j * n] - S[i]));
-  *spread = scale > 0 ? d / scale : 0;
-  return *spread <= 1e-13;
+  PetscReal md[2] = {0, 0}; // max |S|, max |S - ref|
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < n; ++i) md[0] = std::max(md[0], std::abs(ref[i]));
+  for (PetscInt j = 0; j < m; ++j) {
+    const PetscReal *x = S(j);
+    for (size_t i = 0; i < n; ++i) {
+      md[0] = std::max(md[0], std::abs(x[i]));
+      md[1] = std::max(md[1], std::abs(x[i] - ref[i]));
+    }
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, md, 2, MPIU_REAL, MPIU_MAX, comm));
+  *spread   = md[0] > 0 ? md[1] / md[0] : 0;
+  *constant = *spread <= 1e-13;
+  PetscFunctionReturn(0);
+}
+
+// x summed over the ranks, the same bits on every rank (reduced on rank 0, then broadcast: an all-reduce may round
+// differently on different ranks, and every rank must take the same cubature steps); in pieces below MPI's int counts.
+static PetscErrorCode SumOnEveryRank(MPI_Comm comm, PetscReal *x, size_t n)
+{
+  PetscMPIInt rank;
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  const size_t piece = (size_t)1 << 26;
+  for (size_t i0 = 0; i0 < n; i0 += piece) {
+    const PetscMPIInt c = (PetscMPIInt)std::min(piece, n - i0);
+    PetscCallMPI(MPI_Reduce(rank == 0 ? MPI_IN_PLACE : x + i0, x + i0, c, MPIU_REAL, MPIU_SUM, 0, comm));
+    PetscCallMPI(MPI_Bcast(x + i0, c, MPIU_REAL, 0, comm));
+  }
+  PetscFunctionReturn(0);
+}
+
+// The points' hit master facets of every rank's states (union).
+static PetscErrorCode UniteHits(MPI_Comm comm, std::vector<std::set<PetscInt>> *hits)
+{
+  PetscMPIInt size;
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<PetscInt> mine; // (point, facet) pairs
+  for (size_t p = 0; p < hits->size(); ++p)
+    for (PetscInt f : (*hits)[p]) mine.insert(mine.end(), {(PetscInt)p, f});
+  PetscMPIInt              n = (PetscMPIInt)mine.size();
+  std::vector<PetscMPIInt> counts(size), displs(size + 1, 0);
+  PetscCallMPI(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt r = 0; r < size; ++r) displs[r + 1] = displs[r] + counts[r];
+  std::vector<PetscInt> all(displs[size]);
+  PetscCallMPI(MPI_Allgatherv(mine.data(), n, MPIU_INT, all.data(), counts.data(), displs.data(), MPIU_INT, comm));
+  for (size_t i = 0; i < all.size(); i += 2) (*hits)[all[i]].insert(all[i + 1]);
+  PetscFunctionReturn(0);
+}
+
+// The per-state values of every rank, in rank order (the states are split in contiguous blocks).
+static PetscErrorCode GatherStates(MPI_Comm comm, std::vector<PetscReal> *v)
+{
+  PetscMPIInt size;
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscMPIInt              n = (PetscMPIInt)v->size();
+  std::vector<PetscMPIInt> counts(size), displs(size + 1, 0);
+  PetscCallMPI(MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt r = 0; r < size; ++r) displs[r + 1] = displs[r] + counts[r];
+  std::vector<PetscReal> all(displs[size]);
+  PetscCallMPI(MPI_Allgatherv(v->data(), n, MPIU_REAL, all.data(), counts.data(), displs.data(), MPIU_REAL, comm));
+  *v = std::move(all);
+  PetscFunctionReturn(0);
 }
 
 PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h)
@@ -179,14 +228,14 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
 
   // --- snapshots of kappa (Q x N per evaluation) and gamma (Q): training solutions and the iterates
   // of the reduced Kacanov loop with the exact reduced contact terms. First the reduced solves (they list the
-  // states), then the evaluations into storage reserved once: kappa's Q x N x states doubles are the offline
-  // stage's largest object in 3D (2.9 GB at 41k dofs, docs/rom3d.md), and appending reallocated them as they grew.
+  // states), then the evaluations, kept by the points' terms (ContactStates: kappa's Q x N x states doubles were
+  // the offline stage's largest object in 3D, 2.9 GB at 41k dofs, docs/rom3d.md).
   struct State {
     std::vector<PetscReal> mu, v; // v empty: the FOM training solution j
     PetscInt               j = -1;
   };
   std::vector<State>                states;
-  std::vector<PetscReal>            Sk, Sg, Sw, kap((size_t)Q * N), gam(Q), wnb, U;
+  std::vector<PetscReal>            kap((size_t)Q * N), gam(Q), U;
   std::vector<PetscInt>             all(Q), hit(Q);
   std::vector<std::set<PetscInt>>   hits(Q);
   PetscInt                          nRomIts = 0, maxRomIts = 0;
@@ -237,36 +286,57 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       ++nExtra;
     }
   }
-  Sk.reserve(states.size() * Q * N);
-  Sg.reserve(states.size() * Q);
-  Sw.reserve(states.size() * Q * full->dim);
-  for (size_t k = 0; k < states.size(); ++k) {
+  // the contact evaluations of the states: split over the ranks in contiguous blocks when only the cubature needs
+  // them (its Gram matrix is a sum over the states: each rank adds its own, SumOnEveryRank), whole on every rank when
+  // the EIM's greedy needs every snapshot (docs/hyper_reduction.md, "Memory")
+  HyperChoice hyper;
+  PetscCall(HyperChoiceFromOptions(world, &hyper));
+  PetscMPIInt wsize;
+  PetscBool   spread = PETSC_TRUE;
+  PetscCallMPI(MPI_Comm_size(world, &wsize));
+  PetscOptionsBegin(world, "ecsw_", "Empirical cubature (offline)", "OfflineReducedModel");
+  PetscCall(PetscOptionsBool("-distribute_states", "split the contact states' evaluations over the ranks (without the EIM)", "", spread, &spread, NULL));
+  PetscOptionsEnd();
+  const bool   distribute = spread && wsize > 1 && !hyper.eim;
+  const size_t msAll = states.size(), k0 = distribute ? msAll * wrank / wsize : 0, k1 = distribute ? msAll * (wrank + 1) / wsize : msAll;
+  ContactStates cs(*full, (PetscInt)(k1 - k0));
+  // the first state (a training solution) on every rank: the reference of the constant-term test and of kappa's
+  // dependence on u
+  std::vector<PetscReal> kap0((size_t)Q * N), gam0(Q);
+  {
+    const State &st = states[0];
+    std::vector<PetscReal> g0(Q), Z;
+    full->SetGeometry(&fom.map, st.mu);
+    full->NodalFromCanonical(std::vector<PetscReal>(snaps[st.j].u.size(), 0.0), &Z);
+    full->SetNodal(Z);
+    (void)full->Evaluate(all.data(), Q, kap.data(), g0.data(), nullptr); // u = 0
+    full->NodalFromCanonical(snaps[st.j].u, &U);
+    full->SetNodal(U);
+    (void)full->Evaluate(all.data(), Q, kap0.data(), gam0.data(), nullptr);
+    PetscReal sc = 0;
+    for (size_t i = 0; i < kap0.size(); ++i) {
+      uDep = std::max(uDep, std::abs(kap[i] - kap0[i]));
+      sc   = std::max(sc, std::abs(kap0[i]));
+    }
+    uDep = sc > 0 ? uDep / sc : 0;
+  }
+  for (size_t k = k0; k < k1; ++k) {
     const State &st = states[k];
-    if (k == 0 || st.mu != states[k - 1].mu) full->SetGeometry(&fom.map, st.mu);
+    if (k == k0 || st.mu != states[k - 1].mu) full->SetGeometry(&fom.map, st.mu);
     if (st.j >= 0) {
       full->NodalFromCanonical(snaps[st.j].u, &U);
       full->SetNodal(U);
     } else full->SetReduced(st.v.data());
-    Append(*full, &Sk, &Sg, &Sw, &hits, &all, &kap, &gam, &wnb, &hit);
-    if (k == 0 && st.j >= 0) { // does kappa depend on the displacement? (compare with u = 0)
-      std::vector<PetscReal> k0((size_t)Q * N), g0(Q), Z(U.size(), 0.0);
-      full->NodalFromCanonical(std::vector<PetscReal>(snaps[st.j].u.size(), 0.0), &Z);
-      full->SetNodal(Z);
-      (void)full->Evaluate(all.data(), Q, k0.data(), g0.data(), nullptr);
-      PetscReal sc = 0;
-      for (size_t i = 0; i < k0.size(); ++i) {
-        uDep = std::max(uDep, std::abs(k0[i] - kap[i]));
-        sc   = std::max(sc, std::abs(kap[i]));
-      }
-      uDep = sc > 0 ? uDep / sc : 0;
-    }
+    cs.Append(&hit);
+    for (PetscInt p = 0; p < Q; ++p) hits[p].insert(hit[p]);
   }
-  const PetscInt ms = (PetscInt)(Sg.size() / Q);
+  const std::vector<PetscReal> &Sg = cs.Gamma(), &Sw = cs.ForceWeights();
+  const KappaBlocks             Sk = [&cs](PetscInt s) { return cs.Kappa(s); };
+  if (distribute) PetscCall(UniteHits(world, &hits));
+  const PetscInt ms = (PetscInt)(k1 - k0); // the states held here (msAll: of every rank)
   PetscCall(PetscTime(&t1));
 
   // --- EIM of kappa and gamma (or their exact constant form)
-  HyperChoice hyper;
-  PetscCall(HyperChoiceFromOptions(world, &hyper));
   EIMOptions ok, og;
   ok.name = "kappa";
   og.name = "gap";
@@ -275,8 +345,11 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   if (wrank != 0) ok.monitor = og.monitor = false; // every rank runs the same greedy: one prints
   EIMResult  ek, eg;
   PetscReal  spreadK, spreadG;
-  rm.kappaConst = Constant(Sk, (size_t)Q * N, ms, &spreadK);
-  rm.gapConst   = Constant(Sg, Q, ms, &spreadG);
+  bool       constK, constG;
+  PetscCall(Constant(world, Sk, kap0.data(), (size_t)Q * N, ms, &spreadK, &constK));
+  PetscCall(Constant(world, [&](PetscInt j) { return &Sg[(size_t)j * Q]; }, gam0.data(), Q, ms, &spreadG, &constG));
+  rm.kappaConst = constK;
+  rm.gapConst   = constG;
   if (rm.kappaConst && rm.gapConst) hyper = {true, false, false}; // exact constant terms: nothing to hyper-reduce
   const bool eimKappa = hyper.eim && !rm.kappaConst, eimGap = hyper.eim && !rm.gapConst;
   std::vector<PetscInt> keep; // restricted patch points
@@ -286,11 +359,14 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     for (PetscInt n = 0; n < N; ++n)
       for (PetscInt r = 0; r < R; ++r) {
         PetscReal s = 0;
-        for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * Sk[(size_t)p * N + n];
+        for (PetscInt p = 0; p < Q; ++p) s += P[(size_t)r * Q + p] * kap0[(size_t)p * N + n];
         rm.kConstant[(size_t)n * R + r] = s;
       }
   } else if (eimKappa) {
-    PetscCall(EIMGreedy(Sk, Q * N, ms, ok, &ek));
+    std::vector<PetscReal> Skd; // the EIM's greedy on every snapshot, whole (not distributed)
+    Skd.reserve((size_t)ms * Q * N);
+    for (PetscInt j = 0; j < ms; ++j) Skd.insert(Skd.end(), Sk(j), Sk(j) + (size_t)Q * N);
+    PetscCall(EIMGreedy(Skd, Q * N, ms, ok, &ek));
     rm.MkFull = ek.M;
     rm.kB     = ek.B;
     rm.kC.assign((size_t)ek.M * N * R, 0.0);
@@ -308,7 +384,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   if (rm.gapConst) {
     rm.gConstant.assign(R, 0.0);
     for (PetscInt r = 0; r < R; ++r)
-      for (PetscInt p = 0; p < Q; ++p) rm.gConstant[r] += P[(size_t)r * Q + p] * Sg[p];
+      for (PetscInt p = 0; p < Q; ++p) rm.gConstant[r] += P[(size_t)r * Q + p] * gam0[p];
   } else if (eimGap) {
     PetscCall(EIMGreedy(Sg, Q, ms, og, &eg));
     rm.MgFull = eg.M;
@@ -406,17 +482,22 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
     const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
     CubatureGramFunction gram;
-    std::vector<PetscReal> PA, SkA, LA, VA;
+    std::vector<PetscReal> PA, LA, VA, blockA;
+    KappaBlocks            SkA;
     if ((nDefault > 0 || rDefault > 0) && !fitAll) {
       const PetscInt        rA = rDefault > 0 ? rDefault : R, nA = nDefault > 0 ? nDefault : Npod;
       const std::vector<PetscInt> cols = ReducedColumns(Npod, nsup, nA, rA);
       const PetscInt         Na = (PetscInt)cols.size();
       PA.assign(P.begin(), P.begin() + (size_t)rA * Q);
-      SkA.resize((size_t)ms * Q * Na);
       LA.resize((size_t)nt * rA);
       VA.resize((size_t)nt * Na);
-      for (size_t sp = 0; sp < (size_t)ms * Q; ++sp)
-        for (PetscInt c = 0; c < Na; ++c) SkA[sp * Na + c] = Sk[sp * N + cols[c]];
+      SkA = [&, cols, Na](PetscInt s) { // the answer's columns of a state's kappa block
+        const PetscReal *k = Sk(s);
+        blockA.resize((size_t)Q * Na);
+        for (size_t p = 0; p < (size_t)Q; ++p)
+          for (PetscInt c = 0; c < Na; ++c) blockA[p * Na + c] = k[p * N + cols[c]];
+        return (const PetscReal *)blockA.data();
+      };
       for (PetscInt j = 0; j < nt; ++j) {
         for (PetscInt i = 0; i < rA; ++i) LA[(size_t)j * rA + i] = rm.warmL[(size_t)j * R + i];
         for (PetscInt c = 0; c < Na; ++c) VA[(size_t)j * Na + c] = rm.warmV[(size_t)j * N + cols[c]];
@@ -425,6 +506,15 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       else gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, Hc, c); };
     } else if (co.fit == CubatureFit::Action) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c); };
     else gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); };
+    if (distribute) // this rank's states' share of the Gram system, summed over the ranks
+      gram = [&world, local = gram](CubatureCandidates *c, std::vector<PetscReal> *Hc) {
+        local(c, Hc);
+        PetscCallAbort(world, SumOnEveryRank(world, Hc->data(), Hc->size()));
+        if (c) {
+          PetscCallAbort(world, SumOnEveryRank(world, c->b.data(), c->b.size()));
+          PetscCallAbort(world, SumOnEveryRank(world, &c->c, 1));
+        }
+      };
     PetscCall(HierarchicalCubature(Q, co, gram, &cr, &hier));
     PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
     rm.cPoint.clear();
@@ -436,6 +526,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
     full->Restrict(keep, hitv, rings, &rm.patch);
     CubatureStateErrors(P, R, Q, N, Sk, Sg, ms, cr, &errK, &errG); // the fit on every training state
+    if (distribute) {
+      PetscCall(GatherStates(world, &errK));
+      PetscCall(GatherStates(world, &errG));
+    }
   }
   rm.hyperDefault = hyper.ecsw && (hyper.ecswFirst || !hyper.eim) ? ReducedModel::ContactMode::Cubature : ReducedModel::ContactMode::EIM;
   rm.SetContactMode(rm.hyperDefault);
@@ -504,7 +598,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   JsonValue &e = rep->root["eim"];
   e["quadrature_points"]    = (long long)Q;
   e["quadrature_subdivisions"] = (long long)nsub;
-  e["snapshots"]            = (long long)ms;
+  e["snapshots"]            = (long long)msAll;
   e["extra_parameters"]     = (long long)nExtra;
   e["repeated_training_parameters"] = (long long)nDuplicate; // taken once for the contact states and warm starts
   e["rom_kacanov_iterations"]["total"] = (long long)nRomIts;
@@ -546,7 +640,11 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     c["history"]      = cr.history;
     c["iterations"]   = (long long)cr.iterations;
     c["weights"]      = cr.weights;
-    c["states"]       = (long long)ms;
+    c["states"]       = (long long)msAll;
+    c["states_distributed"] = distribute; // the states' evaluations split over the ranks (-ecsw_distribute_states)
+    c["states_per_rank_max"] = (long long)(distribute ? (msAll + wsize - 1) / wsize : msAll);
+    c["states_bytes"]        = (double)cs.Bytes();               // rank 0's store of its states (ContactStates)
+    c["states_dense_bytes"]  = (double)ms * Q * N * sizeof(PetscReal); // the same kappa rows as a Q x N x states array
     c["train_err_K"]  = errK;
     c["train_err_g"]  = errG;
     c["train_max_err_K"] = errK.empty() ? 0.0 : (double)*std::max_element(errK.begin(), errK.end());

@@ -12,6 +12,8 @@
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/rom_file.hpp"
+#include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/mesh.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
 #include <numeric>
@@ -40,6 +42,12 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
   PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
   PetscCall(PetscOptionsBool("-validate_residual", "also the residual of each reduced solution on the mesh (the greedy indicator) and its effectivity against the energy error", "", residual, &residual, NULL));
+  {
+    char      path[PETSC_MAX_PATH_LEN] = "";
+    PetscBool tset                     = PETSC_FALSE;
+    PetscCall(PetscOptionsString("-test_snapshots", "the FOM solutions of the test set from this snapshot file (written by offline -offline_stop snapshots; its parameters are the test set)", "", path, path, sizeof path, &tset));
+    if (tset) s->testSnapshots = path;
+  }
   PetscOptionsEnd();
   s->residual = residual;
   PetscCheck(s->repeat >= 1 && s->repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", s->repeat);
@@ -54,6 +62,50 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
 
 namespace {
+// The FOM test solutions of -test_snapshots (a snapshot file of offline -offline_stop snapshots, every one solved),
+// checked against the scene as configured now and against the test set (its points, to 1e-14).
+PetscErrorCode ReadTestSnapshots(MPI_Comm comm, const std::string &path, const SceneSpec &scene, ElasticFOM &fom, const CanonicalOrder &order, const ContactMap &cmap, const ParameterSet &test, std::vector<Snapshot> *snaps)
+{
+  SnapshotHeader h;
+  PetscFunctionBeginUser;
+  PetscCall(SnapshotFile::ReadHeader(path, &h));
+  const char *file = path.c_str();
+  PetscCheck(h.sceneHash == Fnv1a(SceneFingerprint(scene, fom.map)), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s was solved for another configuration of the scene (file: scene '%s'; now '%s'): the options must be those of the ROM", file, h.scene.c_str(), scene.name.c_str());
+  PetscCheck(h.ndofs == order.NumDofs() && h.nmult == cmap.NumMultipliers(), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s has %" PetscInt_FMT " dofs and %" PetscInt_FMT " multipliers, the mesh now %" PetscInt_FMT " and %" PetscInt_FMT, file, h.ndofs, h.nmult, order.NumDofs(), cmap.NumMultipliers());
+  bool same = h.trainingPoints.size() == test.points.size();
+  for (size_t j = 0; same && j < test.points.size(); ++j) {
+    same = h.trainingPoints[j].size() == test.points[j].size();
+    for (size_t i = 0; same && i < test.points[j].size(); ++i) same = std::abs(h.trainingPoints[j][i] - test.points[j][i]) <= 1e-14 * std::max<PetscReal>(1, std::abs(test.points[j][i]));
+  }
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "validate: the parameters of -test_snapshots %s (%zu) are not the test set (%zu)", file, h.trainingPoints.size(), test.points.size());
+  PetscCall(SnapshotFile::ReadAll(path, snaps));
+  PetscCheck(snaps->size() == test.points.size(), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s holds %zu of its %zu solutions: finish it with offline -offline_stop snapshots -snapshots_restart -snapshots %s (and the options that wrote it)", file, snaps->size(), test.points.size(), file);
+  PetscFunctionReturn(0);
+}
+
+// A stored FOM solution as validate uses one: fom.u set from it (fom at its mu), the contact system assembled at that
+// u (sys), its multipliers in sys's layout (lambda, created here).
+PetscErrorCode StoredSolution(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const Snapshot &snap, ContactSystem *sys, Vec *lambda)
+{
+  PetscInt     lo, hi;
+  PetscScalar *a;
+  Vec          uloc;
+  PetscFunctionBeginUser;
+  if (!fom.u) PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
+  PetscCall(VecGetOwnershipRange(fom.u, &lo, &hi));
+  PetscCall(VecGetArray(fom.u, &a));
+  for (PetscInt i = lo; i < hi; ++i) a[i - lo] = snap.u[order.CanonicalDof(i)];
+  PetscCall(VecRestoreArray(fom.u, &a));
+  PetscCall(DMGetLocalVector(fom.dm, &uloc));
+  PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+  PetscCall(cmap.Assemble(fom.elas, uloc, sys));
+  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys->coordRef, fom.elas.dim));
+  PetscCall(VecDuplicate(sys->weight, lambda));
+  PetscCall(CanonicalToMultipliers(order, snap.lambda, *lambda));
+  PetscFunctionReturn(0);
+}
+
 // Effectivities (estimate / error, one per parameter; not empty) and their summary under j: effectivity,
 // min_effectivity, max_effectivity, share_above_1, share_within_20 (the shares of >= 1, and of [1, 20])
 void EffectivityStats(const std::vector<double> &eff, JsonValue *j)
@@ -267,26 +319,40 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     PetscCall(exact.Truncate((PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; }), model.R(), -1, -1));
   }
 
-  // FOM solutions of the test set (kept for the sweep)
+  // FOM solutions of the test set (kept for the sweep): solved here, or read from -test_snapshots (each one's u and
+  // lambda, its solve's seconds as stored; its contact system assembled at the stored u)
   const PetscInt           nt = (PetscInt)test.points.size();
   std::vector<FomSolution> F(nt);
   std::vector<double>      fomTimes;
   std::vector<std::shared_ptr<ContactSystem>> sysAt(nt);
+  std::vector<Snapshot>    stored;
+  PetscCheck(nt >= 1, comm, PETSC_ERR_ARG_SIZ, "validate: the test set is empty");
+  if (!settings.testSnapshots.empty()) PetscCall(ReadTestSnapshots(comm, settings.testSnapshots, scene, fom, order, cmap, test, &stored));
   for (PetscInt j = 0; j < nt; ++j) {
     F[j].mu = test.points[j];
+    ContactSystem  readSys;
+    ContactSystem *sys = &kac.sys;
+    Vec            lambda = nullptr;
     PetscCall(PetscLogEventBegin(VAL_FOM, 0, 0, 0, 0));
     PetscCall(PetscTime(&t0));
     PetscCall(fom.SetMu(F[j].mu));
-    PetscCall(fom.AssembleAndFactor());
     cmap.SetGeometry(&fom.map, F[j].mu);
-    PetscCall(kac.Solve(fom, cmap));
-    PetscCall(PetscTime(&t1));
+    if (stored.empty()) {
+      PetscCall(fom.AssembleAndFactor());
+      PetscCall(kac.Solve(fom, cmap));
+      lambda = kac.lambda;
+      PetscCall(PetscTime(&t1));
+      fomTimes.push_back(t1 - t0);
+    } else {
+      PetscCall(StoredSolution(fom, cmap, order, stored[j], &readSys, &lambda));
+      sys = &readSys;
+      fomTimes.push_back(stored[j].seconds);
+    }
     PetscCall(PetscLogEventEnd(VAL_FOM, 0, 0, 0, 0));
-    fomTimes.push_back(t1 - t0);
     PetscCall(VecDuplicate(fom.u, &F[j].u));
     PetscCall(VecCopy(fom.u, F[j].u));
-    PetscCall(VecDuplicate(kac.lambda, &F[j].lambda));
-    PetscCall(VecCopy(kac.lambda, F[j].lambda));
+    PetscCall(VecDuplicate(lambda, &F[j].lambda));
+    PetscCall(VecCopy(lambda, F[j].lambda));
     Vec       Au;
     PetscReal uAu;
     PetscCall(VecDuplicate(fom.u, &Au));
@@ -294,35 +360,37 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     PetscCall(VecDestroy(&Au));
     F[j].energyNorm = std::sqrt(uAu);
     Vec l2;
-    PetscCall(VecDuplicate(kac.lambda, &l2));
-    PetscCall(VecPointwiseMult(l2, kac.lambda, kac.lambda));
+    PetscCall(VecDuplicate(lambda, &l2));
+    PetscCall(VecPointwiseMult(l2, lambda, lambda));
     PetscScalar wl;
-    PetscCall(VecDot(l2, kac.sys.weight, &wl));
+    PetscCall(VecDot(l2, sys->weight, &wl));
     PetscCall(VecDestroy(&l2));
     F[j].lambdaNorm = std::sqrt(PetscRealPart(wl));
     ContactSummary cs;
-    PetscCall(SummarizeContact(kac.sys, kac.lambda, dim, &cs));
+    PetscCall(SummarizeContact(*sys, lambda, dim, &cs));
     for (PetscInt d = 0; d < 3; ++d) F[j].force[d] = cs.forceVec[d];
     F[j].maxPressure = cs.maxPressure;
     F[j].halfwidth   = cs.halfwidthMoment;
     // keep the contact system (weights, normals) of this solution
-    auto s = std::make_shared<ContactSystem>();
-    PetscCall(VecDuplicate(kac.sys.weight, &s->weight));
-    PetscCall(VecCopy(kac.sys.weight, s->weight));
+    auto c = std::make_shared<ContactSystem>();
+    PetscCall(VecDuplicate(sys->weight, &c->weight));
+    PetscCall(VecCopy(sys->weight, c->weight));
     for (PetscInt d = 0; d < dim; ++d) {
-      PetscCall(VecDuplicate(kac.sys.normal[d], &s->normal[d]));
-      PetscCall(VecCopy(kac.sys.normal[d], s->normal[d]));
-      PetscCall(VecDuplicate(kac.sys.coord[d], &s->coord[d]));
-      PetscCall(VecCopy(kac.sys.coord[d], s->coord[d]));
+      PetscCall(VecDuplicate(sys->normal[d], &c->normal[d]));
+      PetscCall(VecCopy(sys->normal[d], c->normal[d]));
+      PetscCall(VecDuplicate(sys->coord[d], &c->coord[d]));
+      PetscCall(VecCopy(sys->coord[d], c->coord[d]));
     }
-    PetscCall(VecDuplicate(kac.sys.g, &s->g));
-    s->R   = kac.sys.R;
-    sysAt[j] = s;
+    PetscCall(VecDuplicate(sys->g, &c->g));
+    c->R     = sys->R;
+    sysAt[j] = c;
+    if (!stored.empty()) PetscCall(VecDestroy(&lambda));
   }
+  stored.clear();
   Vec work, work2, lwork;
   PetscCall(VecDuplicate(fom.u, &work));
   PetscCall(VecDuplicate(fom.u, &work2));
-  PetscCall(VecDuplicate(kac.lambda, &lwork));
+  PetscCall(VecDuplicate(F[0].lambda, &lwork));
 
   // ROM (timed) and ROM without EIM on the test set, for one truncation of the model
   // sols (may be null): the converged reduced solutions, in the order of the test parameters
@@ -486,6 +554,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     rep.root["online_time_s"]["median_without_estimate"] = Median(mediansNoEstimate);
     rep.root["online_time_s"]["estimate_cost_ratio"]     = Median(mediansNoEstimate) > 0 ? onlineMedian / Median(mediansNoEstimate) : 0.0;
   }
+  rep.root["test_snapshots"]          = settings.testSnapshots; // "" : the FOM solved here; else fom_time_s as stored
   rep.root["fom_time_s"]["median"]    = fomMedian;
   rep.root["fom_time_s"]["all"]       = fomTimes;
   rep.root["speedup_median"]          = onlineMedian > 0 ? fomMedian / onlineMedian : 0.0;
@@ -576,7 +645,13 @@ PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &report
   PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
   PetscCall(ValidationSettingsFromOptions(comm, reportPath, &s));
   PetscCall(SceneSpecFromOptions(comm, &scene));
-  PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
+  if (s.testSnapshots.empty()) PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
+  else { // the test set is the file's
+    SnapshotHeader h;
+    PetscCall(SnapshotFile::ReadHeader(s.testSnapshots, &h));
+    test.points = h.trainingPoints;
+    for (const auto &p : scene.params) test.names.push_back(p.name);
+  }
   PetscCall(RunValidation(comm, scene, romPath, test, s, rep));
   PetscFunctionReturn(0);
 }

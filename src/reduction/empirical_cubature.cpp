@@ -156,13 +156,13 @@ void ResetGram(PetscInt Q, std::vector<PetscReal> *H, CubatureCandidates *cand)
 }
 } // namespace
 
-void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
+void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
 {
   std::vector<PetscReal> Ke, ge, Kc, gc;
   errK->clear();
   errG->clear();
   for (PetscInt s = 0; s < ms; ++s) {
-    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
     ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Ke, &ge);
     ReducedTerms(P, R, Q, N, kap, gam, res.points, res.weights, &Kc, &gc);
     for (size_t i = 0; i < Kc.size(); ++i) Kc[i] -= Ke[i];
@@ -173,12 +173,12 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
   }
 }
 
-void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand)
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
   const PetscInt         nc = N + 1;
   std::vector<PetscReal> Z((size_t)Q * ms * nc, 0.0), Kh, gh;
   for (PetscInt s = 0; s < ms; ++s) {
-    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
     ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh); // exact reduced terms of this state, for its scaling
     const PetscReal nk = SumSquares(Kh), ng = SumSquares(gh);
     const PetscReal sk = nk > 0 ? 1 / std::sqrt(nk) : 0, sg = ng > 0 ? 1 / std::sqrt(ng) : 0;
@@ -194,7 +194,7 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
   std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh;
@@ -206,7 +206,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
     }
   // each state's scalings: its terms to unit norm over the training solutions
   for (PetscInt s = 0; s < ms; ++s) {
-    const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+    const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
     ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh);
     PetscReal n1 = 0, n2 = 0, gg = SumSquares(gh);
     for (PetscInt j = 0; j < nt; ++j) {
@@ -230,7 +230,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
   ResetGram(Q, H, cand);
   AddHadamardGramBlocks(Q, LP.data(), nt, ms, N, StatesPerBlock(Q, N, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Z) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
-      const PetscReal *kap = &Sk[(size_t)s * Q * N];
+      const PetscReal *kap = Sk(s);
       for (PetscInt n = 0; n < N; ++n) {
         PetscReal *z = &Z[(size_t)((s - s0) * N + n) * Q];
         for (PetscInt p = 0; p < Q; ++p) z[p] = s1[s] * kap[(size_t)p * N + n];
@@ -239,7 +239,7 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
   }, H, cand);
   AddHadamardGramBlocks(Q, P.data(), R, ms, nt, StatesPerBlock(Q, nt, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
-      const PetscReal *kap = &Sk[(size_t)s * Q * N], *gam = &Sg[(size_t)s * Q];
+      const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
       for (PetscInt j = 0; j < nt; ++j) {
         PetscReal *y = &Y[(size_t)((s - s0) * nt + j) * Q];
         for (PetscInt p = 0; p < Q; ++p) {
@@ -270,6 +270,27 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
     }
     AddHadamardGram(Q, LP.data(), nt, Zf.data(), ms * dim, H, cand);
   }
+}
+
+// The ms blocks of a contiguous array.
+static KappaBlocks Blocks(const std::vector<PetscReal> &Sk, PetscInt Q, PetscInt N)
+{
+  return [&Sk, Q, N](PetscInt s) { return &Sk[(size_t)s * Q * N]; };
+}
+
+void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
+{
+  CubatureStateErrors(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, res, errK, errG);
+}
+
+void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand)
+{
+  CubatureGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, H, cand);
+}
+
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
+{
+  CubatureActionGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, Lam, Vs, nt, H, Sw, dim, block, cand);
 }
 
 namespace {

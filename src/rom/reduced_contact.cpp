@@ -396,23 +396,26 @@ PetscInt ContactPatch::Evaluate(const PetscInt *idx, PetscInt np, PetscReal *kap
 {
   PetscInt outside = 0;
   for (PetscInt i = 0; i < np; ++i) {
-    PetscReal        coefs[36], g; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
-    PetscInt         ridx[36], nt;
-    const PetscReal *rows[36];
+    PetscReal coefs[MaxTerms], g; // 2 sides x (<= 6 nodes x 3 dims: SurfaceFacet::dof)
+    PetscInt  ridx[MaxTerms], nt;
     outside += PointTerms(idx[i], &nt, ridx, coefs, &g, hit ? &hit[i] : nullptr, wn ? wn + (size_t)i * dim : nullptr);
-    if (kappa) {
-      for (PetscInt t = 0; t < nt; ++t) rows[t] = &theta[ridx[t] * N];
-      CombineRows(nt, coefs, rows, N, kappa + i * N); // one combination kernel
-    }
+    if (kappa) KappaRow(nt, ridx, coefs, kappa + i * N);
     if (gamma) gamma[i] = g;
   }
   return outside;
 }
 
-PetscInt ContactPatch::EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn) const
+void ContactPatch::KappaRow(PetscInt nt, const PetscInt *rowIdx, const PetscReal *coef, PetscReal *kappa) const
+{
+  const PetscReal *rows[MaxTerms];
+  for (PetscInt t = 0; t < nt; ++t) rows[t] = &theta[rowIdx[t] * N];
+  CombineRows(nt, coef, rows, N, kappa); // one combination kernel
+}
+
+PetscInt ContactPatch::EvaluateCoefficients(const PetscInt *idx, PetscInt np, PetscInt *nt, PetscInt *rowIdx, PetscReal *coef, PetscReal *gamma, PetscReal *wn, PetscInt *hit) const
 {
   PetscInt outside = 0;
-  for (PetscInt i = 0; i < np; ++i) outside += PointTerms(idx[i], &nt[i], rowIdx + (size_t)i * MaxTerms, coef + (size_t)i * MaxTerms, &gamma[i], nullptr, wn ? wn + (size_t)i * dim : nullptr);
+  for (PetscInt i = 0; i < np; ++i) outside += PointTerms(idx[i], &nt[i], rowIdx + (size_t)i * MaxTerms, coef + (size_t)i * MaxTerms, &gamma[i], hit ? &hit[i] : nullptr, wn ? wn + (size_t)i * dim : nullptr);
   return outside;
 }
 
