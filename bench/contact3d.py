@@ -10,10 +10,14 @@ Tables:
      pressures of the -fom_output file, their spread (max - min) / mean and max |p - 1|, and the force, against
      the exact uniform p = E d / H = 1 on the unit area (target 1e-6).
   3. 1 and 2 ranks: contact force relative difference (target 1e-8).
-  4. The 3D reduced model (runs/sphere_block3d.opts, --rom-meshes: the scene's mesh and hertz3d's): offline on the
-     ranks of --rom-np, validate on 20 random parameters: N, R, Mc, max relative errors u, lambda, force (targets
-     1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median, speedup (target 1e4 at the finest level).
-     --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of ~10 s).
+  4. The 3D reduced model (runs/sphere_block3d.opts, --rom-meshes: the scene's mesh and hertz3d's; finest: 5.4e5 dofs,
+     a 6 x 6 grid with sensitivity snapshots): offline on the ranks of --rom-np, validate on 20 random parameters: N, R,
+     Mc, max relative errors u, lambda, force (targets 1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median,
+     speedup (target 1e4 at the finest level). --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of
+     ~10 s). With --rom-workdir DIR every step is kept in DIR/<mesh> and resumed by the next run (the finest level needs
+     it: 36 + 20 FOM solves of 6-8 min): training snapshots, the test set's FOM solutions (offline -offline_stop
+     snapshots, read by validate -test_snapshots: the FOM median is theirs), the ROM, validate; each command and its
+     output go to DIR/<mesh>/bench.log.
   5. --large (printed before table 4): one FOM at about 5e5 dofs on 2 ranks (hertz3d h_fine 0.028 refined once) with the
      iterative saddle-point preset, against refine 1 with the same settings: time, peak resident memory, and the
      memory growth against the dof growth between the two levels (target: no faster than linear).
@@ -21,7 +25,7 @@ Tables:
 Extra options for every fom run: --extra "...". Runs that fail are reported as such and the script goes on.
 It exits 0 unless the executable is missing. Timings depend on the machine's load.
 Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_saddle_solver gamg"]
-       [--large] [--no-rom] [--rom-meshes scene hertz3d] [--rom-np 2]
+       [--large] [--no-rom] [--rom-meshes scene hertz3d finest] [--rom-np 2] [--rom-workdir DIR] [--rom-only]
 """
 import argparse
 import json
@@ -71,13 +75,21 @@ def main():
                     help="table 5: one FOM at ~5e5 dofs on 2 ranks (hertz3d h_fine 0.028 refined once, -fom_saddle_solver gamg, "
                          "-mesh_partitioner metis) against refine 1 with the same settings: time, peak RSS, memory growth / dof growth")
     ap.add_argument("--no-rom", action="store_true")
-    ap.add_argument("--rom-meshes", nargs="+", default=["scene", "hertz3d"], choices=["scene", "hertz3d"])
+    ap.add_argument("--rom-only", action="store_true", help="table 4 only")
+    ap.add_argument("--rom-meshes", nargs="+", default=["scene", "hertz3d"], choices=["scene", "hertz3d", "finest"])
     ap.add_argument("--rom-np", type=int, default=2)
+    ap.add_argument("--rom-workdir", default="",
+                    help="keep table 4's files in this directory (one subdirectory per mesh) and resume every step from them: the "
+                         "training snapshots (-snapshots_restart), the test set's FOM solutions (a snapshot file read by validate "
+                         "-test_snapshots), the ROM; needed for --rom-meshes finest (hours of FOM solves)")
     args = ap.parse_args()
     if not os.path.exists(args.exe):
         sys.exit("contact3d.py: %s not found (build first)" % args.exe)
     extra = shlex.split(args.extra)
     forces = {}
+    if args.rom_only:
+        rom3d(args, extra)
+        return
 
     print("## 1. hertz3d against Hertz's point contact\n")
     print("| refine | ranks | ndofs | R | contact QP | Kacanov | P | a (err) | p0 (err) | target a / p0 | total [s] | peak RSS [MB] max / sum |")
@@ -160,23 +172,53 @@ def rom3d(args, extra):
     print("\n## 4. The 3D reduced model: sphere_block3d (radius 0.8..1.2, displacement 0.03..0.05), 20 random test parameters\n")
     print("| mesh | ndofs | FOM solves | N | R | Mc | u | lambda | force | online force | online median | FOM median | speedup | offline [s] | targets |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    meshes = {"scene": [], "hertz3d": ["-mesh_geo_set", "h_fine=0.035,h_far=0.8"]}
+    # the finest level (5.4e5 dofs, the FOM 6-8 min on 2 ranks): a 6 x 6 grid with sensitivity snapshots (docs/rom3d.md: on
+    # the 41k-dof mesh it meets the targets where the plain 9 x 9 misses lambda), the saddle point by GAMG, METIS
+    meshes = {"scene": [], "hertz3d": ["-mesh_geo_set", "h_fine=0.035,h_far=0.8"],
+              "finest": ["-mesh_geo_set", "h_fine=0.028,h_far=0.8", "-mesh_refine", "1", "-fom_saddle_solver", "gamg", "-mesh_partitioner", "metis",
+                         "-train_size", "6", "-snapshots_sensitivities"]}
     for tag in args.rom_meshes:
-        out = tempfile.mkdtemp(prefix="rbc_rom3d_")
+        if tag == "finest" and not args.rom_workdir:
+            print("| finest | needs --rom-workdir (hours of FOM solves, resumed from there) |||||||||||||")
+            continue
+        if args.rom_workdir:
+            out = os.path.join(os.path.abspath(args.rom_workdir), tag)
+            os.makedirs(out, exist_ok=True)
+        else:
+            out = tempfile.mkdtemp(prefix="rbc_rom3d_")
         base = ["-options_file", "runs/sphere_block3d.opts"] + meshes[tag] + extra
         mpi = ["mpirun", "-n", str(args.rom_np)] if args.rom_np > 1 else []
         ok = True
-        for stage, more in (("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-report", out + "/off.json"]),
-                            ("validate", ["-rom", out + "/rom.h5", "-report", out + "/val.json"])):
-            p = subprocess.run(mpi + [args.exe, stage] + base + more, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        steps = [("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-report", out + "/off.json"]),
+                 ("validate", ["-rom", out + "/rom.h5", "-report", out + "/val.json"])]
+        if args.rom_workdir:  # every step resumable: the snapshots of training and test set checkpointed, a finished step kept
+            test = out + "/test.h5"
+            steps = [("offline", ["-offline_stop", "snapshots", "-snapshots", out + "/snap.h5", "-snapshots_restart", "-snapshots_monitor",
+                                  "-report", out + "/snap.json"]),
+                     ("offline", ["-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
+                                  "-snapshots_subcomm", "1", "-snapshots", test, "-snapshots_restart", "-snapshots_monitor", "-report", out + "/test.json"]),
+                     ("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-snapshots_restart", "-report", out + "/off.json"]),
+                     ("validate", ["-rom", out + "/rom.h5", "-test_snapshots", test, "-report", out + "/val.json"])]
+            if os.path.exists(out + "/off.json") and os.path.exists(out + "/rom.h5"):
+                steps = steps[:2] + steps[3:]  # the ROM of an earlier run (delete off.json to rebuild it)
+        for stage, more in steps:
+            with open(out + "/bench.log", "a") as log:
+                log.write("\n$ %s\n" % " ".join(mpi + [args.exe, stage] + base + more))
+                log.flush()
+                p = subprocess.run(mpi + [args.exe, stage] + base + more, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT, text=True)
             if p.returncode != 0:
-                print("| %s | failed in %s: %s |||||||||||||" % (tag, stage, p.stdout.strip().splitlines()[-1] if p.stdout.strip() else "?"))
+                with open(out + "/bench.log") as log:
+                    last = log.read().strip().splitlines()
+                print("| %s | failed in %s (log %s): %s |||||||||||||" % (tag, stage, out + "/bench.log", last[-1] if last else "?"))
                 ok = False
                 break
         if not ok:
             continue
         with open(out + "/off.json") as f:
             off = json.load(f)
+        if args.rom_workdir:  # the snapshot step's counts (a resumed offline stage solves none)
+            with open(out + "/snap.json") as f:
+                off["ntrain"] = json.load(f).get("ntrain", 0)
         with open(out + "/val.json") as f:
             v = json.load(f)
         t, ro = v["test"], v["rom"]

@@ -211,7 +211,8 @@ def pipeline(args):
     ts = d + "/test.snapshots.h5"
     run(args, 2, "offline", ["-options_file", "runs/ring_on_block.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
                              "-snapshots_subcomm", "1", "-snapshots", ts])
-    run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "10", "-test_snapshots", ts, "-report", d + "/val_ts.json"])
+    pts = run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-validate_repeat", "10", "-test_snapshots", ts, "-report", d + "/val_ts.json"])
+    check("rbcontact: warning" not in pts.stdout, "validate -test_snapshots: the options file's -test_* set aside without an unused-option warning")
     vts = report(d + "/val_ts.json")
     with h5py.File(ts, "r") as f:
         secs = np.array(f["snapshots/seconds"])

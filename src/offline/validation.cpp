@@ -646,7 +646,11 @@ PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &report
   PetscCall(ValidationSettingsFromOptions(comm, reportPath, &s));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   if (s.testSnapshots.empty()) PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
-  else { // the test set is the file's
+  else { // the test set is the file's; the -test_* options of a scene's options file are set aside without a warning
+    for (const char *o : {"-test_type", "-test_size", "-test_seed", "-test_file"}) {
+      PetscBool has;
+      PetscCall(PetscOptionsHasName(NULL, NULL, o, &has));
+    }
     SnapshotHeader h;
     PetscCall(SnapshotFile::ReadHeader(s.testSnapshots, &h));
     test.points = h.trainingPoints;
