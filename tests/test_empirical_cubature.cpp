@@ -219,6 +219,20 @@ int main(int argc, char **argv)
       Check(HC.size() == nc * nc && d <= 1e-13 * sc, blk ? "candidates, blocks of 2: H_CC = (G'G)_CC (max |diff| / max)" : "candidates: H_CC = (G'G)_CC of the explicit rows (max |diff| / max)", d / sc, 1e-13);
       Check(db <= 1e-13 * sb, blk ? "candidates, blocks of 2: b_C = (G'G 1)_C over every point" : "candidates: b_C = (G'G 1)_C over every point (max |diff| / max)", db / sb, 1e-13);
       Check(std::abs(c - cand.c) <= 1e-13 * c, "candidates: c = |G 1|^2 over every point (rel diff)", std::abs(c - cand.c) / c, 1e-13);
+      // the target only (the hierarchical fit's first pass): no Gram matrix, c as above, cOwn = |G_C 1_C|^2 of the
+      // candidates' own terms
+      CubatureCandidates own = cand;
+      own.targetOnly         = true;
+      std::vector<PetscReal> HO;
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HO, Sw, dim, blk, &own);
+      std::vector<PetscReal> GC(rows, 0.0);
+      PetscReal              co = 0;
+      for (size_t i = 0; i < rows; ++i)
+        for (PetscInt p : cand.points) GC[i] += GG[i * Q + p];
+      for (PetscReal t : GC) co += t * t;
+      Check(HO.empty() && own.b.empty() && std::abs(c - own.c) <= 1e-13 * c && std::abs(co - own.cOwn) <= 1e-13 * co,
+            blk ? "target only, blocks of 2: c, cOwn = |G_C 1_C|^2 of the explicit rows, no Gram matrix (rel diff)" : "target only: c = |G 1|^2, cOwn = |G_C 1_C|^2 of the explicit rows, no Gram matrix (rel diff)",
+            std::max(std::abs(c - own.c) / c, std::abs(co - own.cOwn) / co), 1e-13);
     }
   }
 

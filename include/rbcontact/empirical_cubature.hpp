@@ -56,6 +56,10 @@ struct CubatureCandidates {
   std::vector<PetscInt>  points; // candidate point indices (into 0..Q-1); empty: every point, the Q x Q Gram matrix
   std::vector<PetscReal> b;      // (H 1)_C, filled by CubatureGram / CubatureActionGram
   PetscReal              c = 0;  // 1'H1
+  // targetOnly: no Gram matrix and no b, only c and cOwn = 1_C' H_CC 1_C (the candidates' own terms |G_C 1|^2), each
+  // ||B'A||_F^2 of the Hadamard factors over all points / over C: the hierarchical fit's first pass (its tolerances)
+  bool                   targetOnly = false;
+  PetscReal              cOwn = 0;
 };
 
 // A state's kappa block (Q x N, row-major, as ContactPatch::Evaluate returns it) by the state's index among the ms

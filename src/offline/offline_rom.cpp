@@ -513,6 +513,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
         if (c) {
           PetscCallAbort(world, SumOnEveryRank(world, c->b.data(), c->b.size()));
           PetscCallAbort(world, SumOnEveryRank(world, &c->c, 1));
+          PetscCallAbort(world, SumOnEveryRank(world, &c->cOwn, 1));
         }
       };
     PetscCall(HierarchicalCubature(Q, co, gram, &cr, &hier));

@@ -99,13 +99,18 @@ static void AddHadamardGramCandidates(PetscInt Q, const PetscReal *A, PetscInt k
 {
   const std::vector<PetscInt> &C  = cand->points;
   const PetscInt               nc = (PetscInt)C.size();
-  std::vector<PetscReal>       AC((size_t)nc * ka), GA((size_t)nc * nc), GB((size_t)nc * nc, 0.0), B, BC, T, U;
+  const bool                   gramToo = !cand->targetOnly;
+  std::vector<PetscReal>       AC((size_t)nc * ka), GA, GB, B, BC, T, U;
   for (PetscInt a = 0; a < ka; ++a)
     for (PetscInt i = 0; i < nc; ++i) AC[i + (size_t)nc * a] = A[C[i] + (size_t)Q * a];
   const PetscBLASInt q = (PetscBLASInt)Q, n = (PetscBLASInt)nc, a = (PetscBLASInt)ka;
   const PetscReal    one = 1, zero = 0;
-  BLASgemm_("N", "T", &n, &n, &a, &one, AC.data(), &n, AC.data(), &n, &zero, GA.data(), &n);
-  cand->b.resize(nc, 0.0);
+  if (gramToo) {
+    GA.resize((size_t)nc * nc);
+    GB.assign((size_t)nc * nc, 0.0);
+    BLASgemm_("N", "T", &n, &n, &a, &one, AC.data(), &n, AC.data(), &n, &zero, GA.data(), &n);
+    cand->b.resize(nc, 0.0);
+  }
   for (PetscInt s0 = 0; s0 < ms; s0 += block) {
     const PetscInt cnt = std::min(block, ms - s0), kb = cnt * per;
     B.assign((size_t)Q * kb, 0.0);
@@ -114,16 +119,22 @@ static void AddHadamardGramCandidates(PetscInt Q, const PetscReal *A, PetscInt k
     for (PetscInt c = 0; c < kb; ++c)
       for (PetscInt i = 0; i < nc; ++i) BC[i + (size_t)nc * c] = B[C[i] + (size_t)Q * c];
     const PetscBLASInt b = (PetscBLASInt)kb;
-    BLASgemm_("N", "T", &n, &n, &b, &one, BC.data(), &n, BC.data(), &n, &one, GB.data(), &n);
     T.resize((size_t)kb * ka); // B'A
     BLASgemm_("T", "N", &b, &a, &q, &one, B.data(), &q, A, &q, &zero, T.data(), &b);
     for (PetscReal t : T) cand->c += t * t;
+    if (!gramToo) { // the candidates' own target: ||B_C'A_C||^2 = 1_C'((A_C A_C') o (B_C B_C'))1_C
+      BLASgemm_("T", "N", &b, &a, &n, &one, BC.data(), &n, AC.data(), &n, &zero, T.data(), &b);
+      for (PetscReal t : T) cand->cOwn += t * t;
+      continue;
+    }
+    BLASgemm_("N", "T", &n, &n, &b, &one, BC.data(), &n, BC.data(), &n, &one, GB.data(), &n);
     U.resize((size_t)nc * ka); // B_C T
     BLASgemm_("N", "N", &n, &a, &b, &one, BC.data(), &n, T.data(), &b, &zero, U.data(), &n);
     for (PetscInt k = 0; k < ka; ++k)
       for (PetscInt i = 0; i < nc; ++i) cand->b[i] += AC[i + (size_t)nc * k] * U[i + (size_t)nc * k];
   }
-  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
+  if (gramToo)
+    for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
 
 void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand)
@@ -144,14 +155,18 @@ void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt
   for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
 
-// H zeroed at its size (Q x Q, or the candidates' |C| x |C| with their target pieces b, c zeroed too).
+// H zeroed at its size (Q x Q, or the candidates' |C| x |C| with their target pieces b, c zeroed too; empty with
+// cand->targetOnly).
 void ResetGram(PetscInt Q, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
-  const size_t n = cand && !cand->points.empty() ? cand->points.size() : (size_t)Q;
-  H->assign(n * n, 0.0);
+  const bool   onC = cand && !cand->points.empty();
+  const size_t n   = onC ? cand->points.size() : (size_t)Q;
+  if (onC && cand->targetOnly) H->clear();
+  else H->assign(n * n, 0.0);
   if (cand) {
-    cand->b.assign(cand->points.size(), 0.0);
-    cand->c = 0;
+    cand->b.assign(onC && cand->targetOnly ? 0 : cand->points.size(), 0.0);
+    cand->c    = 0;
+    cand->cOwn = 0;
   }
 }
 } // namespace
@@ -503,17 +518,17 @@ PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, cons
     c->points.clear();
     for (PetscInt p = (PetscInt)(((long long)g * Q) / K); p < (PetscInt)(((long long)(g + 1) * Q) / K); ++p) c->points.push_back(p);
   };
-  // pass 1: each group's own target |G_g 1|^2 (the sum of its Gram matrix) and the whole one |G 1|^2
+  // pass 1: each group's own target |G_g 1|^2 and the whole one |G 1|^2, without the Gram matrices (targetOnly)
   CubatureCandidates c;
   PetscReal          sumRoot = 0, cAll = 0;
+  c.targetOnly = true;
   for (PetscInt g = 0; g < K; ++g) {
     group(g, &c);
     gram(&c, &H);
-    PetscReal cg = 0;
-    for (PetscReal h : H) cg += h;
-    sumRoot += std::sqrt(std::max<PetscReal>(cg, 0));
+    sumRoot += std::sqrt(std::max<PetscReal>(c.cOwn, 0));
     cAll = c.c;
   }
+  c.targetOnly = false;
   // the groups' tolerance: their weights together then fit the whole terms within opt.tol (triangle inequality)
   CubatureOptions og = opt;
   og.tol             = sumRoot > 0 ? opt.tol * std::sqrt(cAll) / sumRoot : opt.tol;
