@@ -302,19 +302,22 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ContactStates cs(*full, (PetscInt)(k1 - k0));
   // the first state (a training solution) on every rank: the reference of the constant-term test and of kappa's
   // dependence on u
+  PetscCheck(!states.empty(), world, PETSC_ERR_PLIB, "offline: no contact state to fit the hyper-reduction on");
   std::vector<PetscReal> kap0((size_t)Q * N), gam0(Q);
   {
     const State &st = states[0];
-    std::vector<PetscReal> g0(Q), Z;
     full->SetGeometry(&fom.map, st.mu);
-    full->NodalFromCanonical(std::vector<PetscReal>(snaps[st.j].u.size(), 0.0), &Z);
-    full->SetNodal(Z);
-    (void)full->Evaluate(all.data(), Q, kap.data(), g0.data(), nullptr); // u = 0
-    full->NodalFromCanonical(snaps[st.j].u, &U);
-    full->SetNodal(U);
+    if (st.j >= 0) { // does kappa depend on the displacement? (compare with u = 0)
+      std::vector<PetscReal> g0(Q), Z;
+      full->NodalFromCanonical(std::vector<PetscReal>(snaps[st.j].u.size(), 0.0), &Z);
+      full->SetNodal(Z);
+      (void)full->Evaluate(all.data(), Q, kap.data(), g0.data(), nullptr);
+      full->NodalFromCanonical(snaps[st.j].u, &U);
+      full->SetNodal(U);
+    } else full->SetReduced(st.v.data());
     (void)full->Evaluate(all.data(), Q, kap0.data(), gam0.data(), nullptr);
     PetscReal sc = 0;
-    for (size_t i = 0; i < kap0.size(); ++i) {
+    for (size_t i = 0; st.j >= 0 && i < kap0.size(); ++i) {
       uDep = std::max(uDep, std::abs(kap[i] - kap0[i]));
       sc   = std::max(sc, std::abs(kap0[i]));
     }
