@@ -219,6 +219,14 @@ int main(int argc, char **argv)
       Check(HC.size() == nc * nc && d <= 1e-13 * sc, blk ? "candidates, blocks of 2: H_CC = (G'G)_CC (max |diff| / max)" : "candidates: H_CC = (G'G)_CC of the explicit rows (max |diff| / max)", d / sc, 1e-13);
       Check(db <= 1e-13 * sb, blk ? "candidates, blocks of 2: b_C = (G'G 1)_C over every point" : "candidates: b_C = (G'G 1)_C over every point (max |diff| / max)", db / sb, 1e-13);
       Check(std::abs(c - cand.c) <= 1e-13 * c, "candidates: c = |G 1|^2 over every point (rel diff)", std::abs(c - cand.c) / c, 1e-13);
+      // the per-state scalings formed by a first call and reused by a second: the same Gram system bit for bit
+      CubatureScalings   sc2;
+      CubatureCandidates c1 = cand, c2 = cand;
+      std::vector<PetscReal> H1, H2;
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &H1, Sw, dim, blk, &c1, &sc2);
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &H2, Sw, dim, blk, &c2, &sc2);
+      const bool sameCached = sc2.s1.size() == (size_t)ms && H1 == HC && H2 == HC && c1.b == cand.b && c2.b == cand.b && c2.c == cand.c;
+      Check(sameCached, blk ? "scalings cached, blocks of 2: H_CC, b_C, c bit for bit those computed afresh" : "scalings cached: H_CC, b_C, c bit for bit those computed afresh", sameCached ? 0.0 : 1.0, 0.0);
       // the target only (the hierarchical fit's first pass): no Gram matrix, c as above, cOwn = |G_C 1_C|^2 of the
       // candidates' own terms
       CubatureCandidates own = cand;

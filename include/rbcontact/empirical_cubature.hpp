@@ -78,6 +78,14 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand = nullptr);
 void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, std::vector<PetscReal> *H, CubatureCandidates *cand = nullptr);
 
+// The action fit's per-state scalings (each state's terms to unit norm over the training solutions), the same in every
+// call of CubatureActionGram on the same states and training solutions: given one, a call fills it (when empty) or uses
+// it, instead of forming every state's exact reduced terms again (R x Q x N a state: at 5e5 3D dofs as much as the
+// Gram products of the hierarchical fit's calls).
+struct CubatureScalings {
+  std::vector<PetscReal> s1, s2; // ms each
+};
+
 // The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
 // and Vs (nt x N, row-major),
 //   sum_j ||dK_s' lam_j||^2 / sum_j ||K^_s' lam_j||^2 + sum_j ||dK_s v_j - dg_s||^2 / sum_j (||K^_s v_j||^2 + ||g^_s||^2),
@@ -90,8 +98,8 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
 //   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
 // Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
 // they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding. With cand, as CubatureGram.
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr);
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr);
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr);
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);

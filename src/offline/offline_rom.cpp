@@ -485,6 +485,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
     const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
     CubatureGramFunction gram;
+    CubatureScalings     scalings; // the action fit's per-state scalings, formed by the first call (hierarchical: many calls)
     std::vector<PetscReal> PA, LA, VA, blockA;
     KappaBlocks            SkA;
     if ((nDefault > 0 || rDefault > 0) && !fitAll) {
@@ -505,9 +506,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
         for (PetscInt i = 0; i < rA; ++i) LA[(size_t)j * rA + i] = rm.warmL[(size_t)j * R + i];
         for (PetscInt c = 0; c < Na; ++c) VA[(size_t)j * Na + c] = rm.warmV[(size_t)j * N + cols[c]];
       }
-      if (co.fit == CubatureFit::Action) gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c); };
+      if (co.fit == CubatureFit::Action) gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c, &scalings); };
       else gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, Hc, c); };
-    } else if (co.fit == CubatureFit::Action) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c); };
+    } else if (co.fit == CubatureFit::Action) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c, &scalings); };
     else gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); };
     if (distribute) // this rank's states' share of the Gram system, summed over the ranks
       gram = [&world, local = gram](CubatureCandidates *c, std::vector<PetscReal> *Hc) {

@@ -209,7 +209,7 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
   std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh;
@@ -219,8 +219,13 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
       if (l == 0.0) continue;
       for (PetscInt p = 0; p < Q; ++p) LP[(size_t)j * Q + p] += l * P[(size_t)r * Q + p];
     }
-  // each state's scalings: its terms to unit norm over the training solutions
-  for (PetscInt s = 0; s < ms; ++s) {
+  // each state's scalings: its terms to unit norm over the training solutions (or those of an earlier call)
+  const bool known = scalings && scalings->s1.size() == (size_t)ms && scalings->s2.size() == (size_t)ms;
+  if (known) {
+    s1 = scalings->s1;
+    s2 = scalings->s2;
+  }
+  for (PetscInt s = 0; s < ms && !known; ++s) {
     const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
     ReducedTerms(P, R, Q, N, kap, gam, {}, {}, &Kh, &gh);
     PetscReal n1 = 0, n2 = 0, gg = SumSquares(gh);
@@ -239,6 +244,10 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
     }
     s1[s] = n1 > 0 ? 1 / std::sqrt(n1) : 0;
     s2[s] = n2 > 0 ? 1 / std::sqrt(n2) : 0;
+  }
+  if (scalings && !known) {
+    scalings->s1 = s1;
+    scalings->s2 = s2;
   }
   // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y', Zk (the scaled kappa columns) and Y(p, (s, j)) = s2 (kappa_s(p, :) v_j -
   // gamma_s(p)) formed a block of states at a time
@@ -303,9 +312,9 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   CubatureGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings)
 {
-  CubatureActionGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, Lam, Vs, nt, H, Sw, dim, block, cand);
+  CubatureActionGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, Lam, Vs, nt, H, Sw, dim, block, cand, scalings);
 }
 
 namespace {
