@@ -649,7 +649,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     c["states_distributed"] = distribute; // the states' evaluations split over the ranks (-ecsw_distribute_states)
     c["states_per_rank_max"] = (long long)(distribute ? (msAll + wsize - 1) / wsize : msAll);
     c["states_bytes"]        = (double)cs.Bytes();               // rank 0's store of its states (ContactStates)
-    c["states_dense_bytes"]  = (double)ms * Q * N * sizeof(PetscReal); // the same kappa rows as a Q x N x states array
+    c["states_dense_bytes"]  = (double)ms * Q * (N + 1 + full->dim) * sizeof(PetscReal); // the same as Q x (N + 1 + dim) x states arrays
     c["train_err_K"]  = errK;
     c["train_err_g"]  = errG;
     c["train_max_err_K"] = errK.empty() ? 0.0 : (double)*std::max_element(errK.begin(), errK.end());
