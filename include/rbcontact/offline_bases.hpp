@@ -38,6 +38,7 @@ struct OfflineBasisSet {
   PetscInt             nDefault = -1, rDefault = -1;
   PetscInt             sensitivityVectors = 0; // -snapshots_sensitivities: the scaled du/dmu_i among the POD's vectors
   PetscInt             dualPredicted      = 0; // and the predicted multipliers [lambda +- step dlambda_i]_+ among the dual greedy's
+  PetscInt             snapshotsUsed      = 0; // the snapshots of distinct parameters (a repeated parameter's taken once)
 };
 // POD (-pod_*; with sensitivities of the snapshots and their derivatives), dual basis (-dual_*; with sensitivities
 // also the predicted multipliers), supremizers (-pod_supremizers*) of snaps; R: multipliers (0: no contact).

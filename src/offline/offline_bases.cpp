@@ -144,12 +144,23 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   const PetscInt np = (PetscInt)snaps[0].mu.size(), ndofs = (PetscInt)snaps[0].u.size();
   if (sens) PetscCall(CheckSnapshotSensitivities(world, snaps, source));
   b->dualPredicted = 0;
+  // a training parameter listed again adds nothing (the same solution): each parameter's snapshot taken once, so that
+  // a repetition cannot tip a mode over the POD's or the dual greedy's tolerance by rounding (tests/hard_cases.py
+  // repeated_training; the contact states of the cubature skip repetitions too: offline_rom.cpp)
+  std::vector<PetscInt> once;
+  for (PetscInt j = 0; j < m; ++j) {
+    bool seen = false;
+    for (PetscInt k : once) seen = seen || snaps[k].mu == snaps[j].mu;
+    if (!seen) once.push_back(j);
+  }
+  const PetscInt m1 = (PetscInt)once.size();
+  b->snapshotsUsed  = m1;
   std::vector<const PetscReal *> cols;
-  for (PetscInt j = 0; j < m; ++j) cols.push_back(snaps[j].u.data());
+  for (PetscInt j : once) cols.push_back(snaps[j].u.data());
   if (sens)
-    for (PetscInt j = 0; j < m; ++j)
+    for (PetscInt j : once)
       for (PetscInt i = 0; i < np; ++i) cols.push_back(snaps[j].extra.at("sensitivity_u").data() + (size_t)i * ndofs);
-  b->sensitivityVectors = sens ? m * np : 0;
+  b->sensitivityVectors = sens ? m1 * np : 0;
   std::vector<Vec> X(cols.size());
   {
     PetscInt lo, hi;
@@ -184,23 +195,22 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
     // (nonnegative, so that the cone can hold the tangent of the multipliers; docs/greedy_training.md)
     PetscReal step;
     PetscCall(DualSensitivityStepFromOptions(world, &step));
-    std::vector<PetscInt> srcOf; // the snapshot of each column of L
-    for (PetscInt j = 0; j < m; ++j) srcOf.push_back(j);
+    std::vector<PetscInt> srcOf(once); // the snapshot of each column of L
     if (sens && step > 0)
-      for (PetscInt j = 0; j < m; ++j)
+      for (PetscInt j : once)
         for (PetscInt i = 0; i < np; ++i)
           for (int sg = 0; sg < 2; ++sg) srcOf.push_back(j);
     DenseMatrix L;
     L.Resize(R, (PetscInt)srcOf.size());
-    for (PetscInt j = 0; j < m; ++j)
-      for (PetscInt i = 0; i < R; ++i) L(i, j) = snaps[j].lambda[i];
-    for (PetscInt c = m; c < (PetscInt)srcOf.size(); ++c) {
-      const PetscInt   j = srcOf[c], i = (c - m) / 2 % np;
-      const PetscReal  sgn = (c - m) % 2 ? -step : step;
+    for (PetscInt c = 0; c < m1; ++c)
+      for (PetscInt i = 0; i < R; ++i) L(i, c) = snaps[once[c]].lambda[i];
+    for (PetscInt c = m1; c < (PetscInt)srcOf.size(); ++c) {
+      const PetscInt   j = srcOf[c], i = (c - m1) / 2 % np;
+      const PetscReal  sgn = (c - m1) % 2 ? -step : step;
       const PetscReal *dl  = snaps[j].extra.at("sensitivity_lambda").data() + (size_t)i * R;
       for (PetscInt r = 0; r < R; ++r) L(r, c) = std::max<PetscReal>(0, snaps[j].lambda[r] + sgn * dl[r]);
     }
-    b->dualPredicted = (PetscInt)srcOf.size() - m;
+    b->dualPredicted = (PetscInt)srcOf.size() - m1;
     // -dual_mass_weighted (default off; needs the contact map): the greedy's errors in the slave-mass
     // weighted norm of the reported lambda error, ||x||_M^2 = sum_i int psi_i x_i^2 (reference
     // configuration): rows scaled by sqrt(int psi_i), the basis unscaled after (nonnegativity kept).
@@ -366,7 +376,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     // a dual basis that keeps (nearly) every training multiplier compresses nothing: the training set is
     // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
     // (-snapshots_sensitivities: the candidates are the snapshots' multipliers and their predicted neighbours)
-    const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols, cand = m + bs.dualPredicted;
+    const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols, cand = bs.snapshotsUsed + bs.dualPredicted;
     const bool     tooCoarse = rAnswer >= cand - 1 && cand > 2;
     rep->root["dual_kept_all_snapshots"] = tooCoarse;
     if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", rAnswer, cand));
