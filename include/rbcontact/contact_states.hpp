@@ -2,9 +2,10 @@
 // reduced Kacanov iterates at which the cubature is fitted), kept by the points' terms instead of their kappa rows.
 // A point's row is kappa(p, :) = sum_t coef_t theta(row_t, :) over at most 2 x nodes x dim terms (18 in 3D P1,
 // 8 in 2D P1: ContactPatch::EvaluateCoefficients), 12 bytes a term, against the N doubles of the row: the store does
-// not grow with N (3D default mesh, N 44: 0.58 of the dense arrays; N ~ 150-200 on the fine 3D meshes: about 1/5; 2D
-// with N 13: the same size; docs/hyper_reduction.md, "Memory"). A state's Q x N block is formed on demand by ContactPatch::KappaRow, the kernel Evaluate uses, so the
-// blocks are bit for bit those of Evaluate. Also kept: gamma and w n2 per point (Q and Q x dim doubles a state).
+// not grow with N (measured: 0.58 of the dense arrays on the 3D default mesh, N 44; about the same size in 2D with
+// N 13; by the count about 1/5 for N ~ 150-200 on the fine 3D meshes; docs/hyper_reduction.md, "Memory"). A state's
+// Q x N block is formed on demand by ContactPatch::KappaRow, the kernel Evaluate uses, so the blocks are bit for bit
+// those of Evaluate. Also kept: gamma and w n2 per point (Q and Q x dim doubles a state).
 // Implementation: src/offline/contact_states.cpp.
 #pragma once
 #include <petscsys.h>
