@@ -150,7 +150,9 @@ def pipeline(args):
     _, offw = offline(args, d + "/groups_whole", extra=["-ecsw_group_points", "100", "-ecsw_distribute_states", "0", "-snapshots", d + "/groups/rom.snapshots.h5", "-snapshots_restart"])
     cw = offw["ecsw"]
     wd, ww = np.array(cg["weights"]), np.array(cw["weights"])
-    same_pts = not cw["states_distributed"] and cw["states_per_rank_max"] == cw["states"] == cg["states"] and wd.shape == ww.shape
+    with h5py.File(romg, "r") as f, h5py.File(d + "/groups_whole/rom.h5", "r") as g:
+        pts_equal = np.array_equal(np.array(f["online/ecsw/points"]), np.array(g["online/ecsw/points"]))
+    same_pts = not cw["states_distributed"] and cw["states_per_rank_max"] == cw["states"] == cg["states"] and wd.shape == ww.shape and pts_equal
     dw = np.abs(wd - ww).max() / ww.max() if same_pts else np.inf
     dek = np.abs(np.array(cg["train_err_K"]) - np.array(cw["train_err_K"])).max() if same_pts else np.inf
     check(same_pts and dw <= 1e-5 and abs(cg["residual"] - cw["residual"]) <= 1e-6 * cw["residual"] and dek <= 1e-6 * max(cw["train_err_K"]),
