@@ -368,7 +368,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   } else if (eimKappa) {
     std::vector<PetscReal> Skd; // the EIM's greedy on every snapshot, whole (not distributed)
     Skd.reserve((size_t)ms * Q * N);
-    for (PetscInt j = 0; j < ms; ++j) Skd.insert(Skd.end(), Sk(j), Sk(j) + (size_t)Q * N);
+    for (PetscInt j = 0; j < ms; ++j) {
+      const PetscReal *k = Sk(j); // formed once (every call forms the block again)
+      Skd.insert(Skd.end(), k, k + (size_t)Q * N);
+    }
     PetscCall(EIMGreedy(Skd, Q * N, ms, ok, &ek));
     rm.MkFull = ek.M;
     rm.kB     = ek.B;
