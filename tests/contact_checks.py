@@ -531,6 +531,18 @@ def saddle(args):
     check(dl <= 1e-9 and rg["saddle"]["factorizations"] == rg["saddle"]["steps"] and its <= 100,
           "hertz, gamg preset, a new preconditioner per step: multipliers to %.1e <= 1e-9, %d set-ups for %d steps, %.0f FGMRES its per step <= 100"
           % (dl, rg["saddle"]["factorizations"], rg["saddle"]["steps"], its))
+    # each step's Krylov solve from the last step's solution (the default) against from zero: the same answer (the
+    # stopping test is rtol |b| either way), fewer iterations (measured 2026-11-26: hertz3d 364 -> 234 on 1 rank)
+    h3 = ["-mesh_geo_set", "h_fine=0.08,h_far=1.2", "-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg"] + args.extra
+    rz, h5z = run(args, args.np, "runs/hertz3d.opts", h3 + ["-fom_saddle_previous_guess", "0"], "hertz3d_saddle_zero_guess")
+    rp, h5p = run(args, args.np, "runs/hertz3d.opts", h3, "hertz3d_saddle_previous_guess")
+    lz, lp = contact_fields(h5z)[0], contact_fields(h5p)[0]
+    dl = np.max(np.abs(lz - lp)) / np.max(np.abs(lz))
+    df = abs(rz["contact_force"] - rp["contact_force"]) / abs(rz["contact_force"])
+    kz, kp = rz["saddle"]["krylov"], rp["saddle"]["krylov"]
+    check(dl <= 1e-9 and df <= 1e-10 and rz["kacanov_iterations"] == rp["kacanov_iterations"] and kp <= 0.8 * kz,
+          "hertz3d, gamg: Krylov solves from the last step's solution vs from zero: multipliers to %.1e <= 1e-9, force %.1e <= 1e-10, "
+          "Kacanov its %d / %d, FGMRES its %d <= 0.8 x %d" % (dl, df, rp["kacanov_iterations"], rz["kacanov_iterations"], kp, kz))
     # no contact: lambda = 0 exactly
     extra = ["-mesh_geo_set", "g0=0.3", "-body_force", "0,-0.5"] + args.extra
     r, h5 = run(args, args.np, "runs/ring_on_block.opts", extra + ["-fom_dual_matrix", "saddle"], "saddle_gap")

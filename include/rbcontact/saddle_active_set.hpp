@@ -15,7 +15,8 @@
 // converge together; the loop stops only on an unchanged set, SetChanged()).
 // Options (prefix fom_saddle_): -pdas_max_it (100), -pdas_tol (1e-10), -pdas_inner, -pdas_monitor,
 // -pdas_rtol_loose (1e-4: the solves of a cold start while the set changes; its last set is solved again exactly),
-// -reuse_max_changes (10), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
+// -reuse_max_changes (10), -previous_guess (on: each step's Krylov solve starts from the last step's solution of
+// this parameter, the inactive rows zeroed; the stopping test stays rtol |b|), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
 // fieldsplit with GAMG on the u block and LU on the selfp Schur complement), -ksp_* / -pc_* of the solver
 // (the u and lambda blocks are the fields "u" and "lambda" of a PCFIELDSPLIT).
 #pragma once
@@ -64,7 +65,8 @@ public:
   PetscErrorCode SetNearNullSpace(MatNullSpace nsp);
   bool WantsNearNullSpace() const { return wantsNearNull_; }
   // A has new values (a new parameter): the next step factors afresh (the set is kept as a start).
-  void NewOperator() { factored_ = false; }
+  // The first step of a parameter starts its Krylov solve from zero (no guess from another parameter).
+  void NewOperator() { factored_ = false; guess_ = false; }
 
   PetscInt  maxIt   = 100;
   PetscReal setTol  = 1e-10;
@@ -72,6 +74,7 @@ public:
   PetscBool inner   = PETSC_FALSE; // -pdas_inner: to convergence on every Kacanov iterate
   PetscBool monitor = PETSC_FALSE;
   PetscInt  reuseMaxChanges = 10; // -reuse_max_changes
+  PetscBool previousGuess = PETSC_TRUE; // -previous_guess
   std::string solver = "direct";  // -solver direct|gamg (a preset of the KSP/PC options)
 
 private:
@@ -94,6 +97,7 @@ private:
   PetscReal              diagScale_ = 1, kScale_ = 1; // s, c (Build)
   PetscInt               nu_ = 0, nl_ = 0; // local sizes of u and lambda
   bool                   factored_ = false, canReuse_ = false, newPattern_ = false; // newPattern_: M_ rebuilt since the last set-up
+  bool                   guess_ = false; // x_ holds the last step's solution of this parameter (the next step's initial guess)
   PetscBool              fieldsplit_ = PETSC_FALSE;
   PetscInt               changedSinceFactor_ = 0; // rows whose status changed since the last factorization
   PetscReal              freshSeconds_ = 0;       // wall time of the last solve with a new factorization

@@ -46,11 +46,12 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     solver = types[t];
   }
   PetscCall(PetscOptionsReal("-pdas_rtol_loose", "Relative tolerance of the solves while the set still changes on a cold start (the last set is solved to -fom_saddle_ksp_rtol)", "docs/contact.md", looseRtol, &looseRtol, NULL));
+  PetscCall(PetscOptionsBool("-previous_guess", "Start each step's Krylov solve from the last step's solution of the parameter (the stopping test stays rtol |b|)", "docs/contact.md", previousGuess, &previousGuess, NULL));
   PetscCall(PetscOptionsInt("-reuse_max_changes", "Solve with the last factorization (GMRES) while at most this many rows changed status since it (-1: factor every step)", "docs/contact.md", reuseMaxChanges, &reuseMaxChanges, NULL));
   PetscOptionsEnd();
   if (solver == "gamg") { // defaults of the preset; options given on the command line win
     const char *preset[][2] = {{"ksp_type", "fgmres"}, {"ksp_max_it", "2000"}, {"ksp_gmres_restart", "200"}, {"pc_type", "fieldsplit"},
-                               {"pc_fieldsplit_type", "schur"}, {"pc_fieldsplit_schur_fact_type", "full"}, {"pc_fieldsplit_schur_precondition", "selfp"},
+                               {"pc_fieldsplit_type", "schur"}, {"pc_fieldsplit_schur_fact_type", "lower"}, {"pc_fieldsplit_schur_precondition", "selfp"},
                                {"fieldsplit_u_ksp_type", "preonly"}, {"fieldsplit_u_pc_type", "gamg"}, {"fieldsplit_lambda_ksp_type", "preonly"},
                                {"fieldsplit_lambda_pc_type", "lu"}, {"fieldsplit_lambda_pc_factor_mat_solver_type", "mumps"}};
     for (const auto &kv : preset) {
@@ -218,9 +219,20 @@ PetscErrorCode SaddleActiveSetSolver::Build(Mat A, Mat K)
   PetscCall(MatSetOption(M_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   PetscCall(MatSetOption(M_, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatSetOption(M_, MAT_SPD, PETSC_FALSE));
-  PetscCall(VecDestroy(&x_));
-  PetscCall(VecDestroy(&b_));
-  PetscCall(MatCreateVecs(M_, &x_, &b_));
+  { // a new pattern keeps the layout (A's and K's rows): the last step's solution stays the next one's guess
+    Vec      x;
+    PetscInt nx = -1;
+    PetscCall(MatCreateVecs(M_, &x, NULL));
+    if (x_) PetscCall(VecGetLocalSize(x_, &nx));
+    PetscBool keep = guess_ && nx == n ? PETSC_TRUE : PETSC_FALSE;
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &keep, 1, MPIU_BOOL, MPI_LAND, comm));
+    if (keep) PetscCall(VecCopy(x_, x));
+    guess_ = keep;
+    PetscCall(VecDestroy(&x_));
+    PetscCall(VecDestroy(&b_));
+    x_ = x;
+    PetscCall(VecDuplicate(x_, &b_));
+  }
   // Balance: the multiplier rows scaled by c = max diag(A) / |K|_inf (entries of c K of A's size; lambda =
   // c lambda~), the inactive rows' pivot -s = -max diag(A) (c^2 times the size of a diagonal entry of
   // K A^{-1} K^T). Unscaled, a row that changed status left GMRES on an earlier factor stagnating near 1e-11.
@@ -340,6 +352,8 @@ PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lam
   PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
   PetscCall(KSPSetTolerances(ksp_, exactRtol_, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_TRUE));
+  PetscCall(KSPSetInitialGuessNonzero(ksp_, PETSC_FALSE));
+  guess_ = false; // x_ will hold this right-hand side's solution, not a step's
   PetscCall(KSPSolve(ksp_, b_, x_));
   PetscCall(KSPGetConvergedReason(ksp_, &reason));
   PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
@@ -361,6 +375,22 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
   PetscCall(PetscLogEventBegin(SAS_Solve, 0, 0, 0, 0));
   bool     fresh = !(factored_ && canReuse_ && changedSinceFactor_ <= reuseMaxChanges);
   PetscCall(KSPSetTolerances(ksp_, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  // the initial guess: the last step's solution of this parameter with the rows now inactive zeroed (their
+  // equation is -s lambda~ = 0), or zero
+  const PetscBool guess = previousGuess && guess_ ? PETSC_TRUE : PETSC_FALSE;
+  if (guess) {
+    PetscScalar *xa;
+    PetscCall(VecGetArray(x_, &xa));
+    for (PetscInt i = 0; i < nl_; ++i)
+      if (!active_[i]) xa[nu_ + i] = 0.0;
+    PetscCall(VecRestoreArray(x_, &xa));
+  }
+  Vec x0 = nullptr; // the guess, kept for a retry with a new factorization
+  if (guess && !fresh) {
+    PetscCall(VecDuplicate(x_, &x0));
+    PetscCall(VecCopy(x_, x0));
+  }
+  PetscCall(KSPSetInitialGuessNonzero(ksp_, guess));
   const PetscReal addTol = std::max(setTol, rtol > exactRtol_ ? rtol : 0.0); // a loose solve: a loose threshold for adding rows
   PetscInt its   = 0;
   bool stale = false; // the earlier factor cost more than a new one: factor at the next step
@@ -382,8 +412,13 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
     PetscCall(PetscTime(&r0));
     // a PCFIELDSPLIT set up on an earlier pattern does not rebuild its blocks correctly (measured: 480 FGMRES
     // iterations instead of 60): a new KSP; a factorization handles the new pattern itself
-    if (fieldsplit_ && newPattern_) PetscCall(CreateKSP());
+    if (fieldsplit_ && newPattern_) {
+      PetscCall(CreateKSP());
+      PetscCall(KSPSetTolerances(ksp_, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+      PetscCall(KSPSetInitialGuessNonzero(ksp_, guess));
+    }
     newPattern_ = false;
+    if (x0) PetscCall(VecCopy(x0, x_)); // a failed solve with the earlier factor: from the guess again
     PetscCall(KSPSetReusePreconditioner(ksp_, PETSC_FALSE));
     PetscCall(KSPSolve(ksp_, b_, x_));
     PetscCall(KSPGetIterationNumber(ksp_, &its));
@@ -394,12 +429,14 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
     changedSinceFactor_ = 0;
     freshSeconds_       = r1 - r0;
   } else if (stale) factored_ = false;
+  PetscCall(VecDestroy(&x0));
   PetscCall(PetscLogEventEnd(SAS_Solve, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   PetscCall(KSPGetConvergedReason(ksp_, &reason));
   PetscCheck(reason > 0, comm, PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve failed (%s) at active-set step %" PetscInt_FMT ": a failed factorization (-%spc_type, -%spc_factor_mat_solver_type; MUMPS workspace: -%smat_mumps_icntl_14) or the iterative solver's -%sksp_* settings",
              KSPConvergedReasons[reason], info->steps + 1, prefix_.c_str(), prefix_.c_str(), prefix_.c_str(), prefix_.c_str());
   PetscCall(GetSolution(u, lambda));
+  guess_ = true;
   PetscReal nx;
   PetscCall(VecNorm(x_, NORM_INFINITY, &nx));
   PetscCheck(std::isfinite(nx), comm, PETSC_ERR_FP, "Contact saddle-point solve gave non-finite values at active-set step %" PetscInt_FMT " (-%spc_type)", info->steps + 1, prefix_.c_str());
