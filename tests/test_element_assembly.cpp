@@ -141,6 +141,37 @@ static PetscErrorCode Run(MPI_Comm comm)
     PetscCall(CompareMats(comm, "H1 inner product (mass + grad:grad)", Mfe, Mel));
     PetscCall(MatDestroy(&Mfe));
     PetscCall(MatDestroy(&Mel));
+    {
+      // the rigid-body modes at the nodes (GAMG's near null space) span what DMPlexCreateRigidBody projects
+      MatNullSpace nn, np;
+      PetscInt     nn_n, np_n;
+      const Vec   *vn, *vp;
+      PetscBool    hasc;
+      PetscReal    worst = 0;
+      PetscCall(NodalRigidBodyModes(el.dm, &nn));
+      PetscCheck(nn, comm, PETSC_ERR_PLIB, "NodalRigidBodyModes: not supported on a P%" PetscInt_FMT " field", el.degree);
+      PetscCall(DMPlexCreateRigidBody(fe.dm, 0, &np));
+      PetscCall(MatNullSpaceGetVecs(nn, &hasc, &nn_n, &vn));
+      PetscCall(MatNullSpaceGetVecs(np, &hasc, &np_n, &vp));
+      PetscCheck(nn_n == np_n && nn_n == (el.dim == 2 ? 3 : 6), comm, PETSC_ERR_PLIB, "rigid-body modes: %" PetscInt_FMT " at the nodes, %" PetscInt_FMT " projected", nn_n, np_n);
+      for (PetscInt j = 0; j < np_n; ++j) { // the part of each projected mode outside the nodal span
+        Vec       r;
+        PetscReal nr;
+        PetscCall(VecDuplicate(vp[j], &r));
+        PetscCall(VecCopy(vp[j], r));
+        for (PetscInt i = 0; i < nn_n; ++i) {
+          PetscScalar d;
+          PetscCall(VecDot(vp[j], vn[i], &d));
+          PetscCall(VecAXPY(r, -d, vn[i]));
+        }
+        PetscCall(VecNorm(r, NORM_2, &nr));
+        worst = std::max(worst, nr);
+        PetscCall(VecDestroy(&r));
+      }
+      PetscCall(Check(comm, "rigid-body modes at the nodes span DMPlexCreateRigidBody's", worst, 1.0, 1e-12));
+      PetscCall(MatNullSpaceDestroy(&nn));
+      PetscCall(MatNullSpaceDestroy(&np));
+    }
     PetscCheck(nmu > 0, comm, PETSC_ERR_PLIB, "no parameter point tested");
   }
   PetscCall(DMDestroy(&dm2));

@@ -19,6 +19,11 @@ namespace rbc {
 // Pointwise signatures of PetscDS (volume and boundary residual terms).
 using PointwiseF = void (*)(PetscInt, PetscInt, PetscInt, const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], const PetscInt[], const PetscInt[], const PetscScalar[], const PetscScalar[], const PetscScalar[], PetscReal, const PetscReal[], PetscInt, const PetscScalar[], PetscScalar[]);
 
+// The rigid-body modes of a vector P1/P2 Lagrange field on dm (field 0, dim components), orthonormal on the free
+// dofs: the modes evaluated at the nodes (vertices, centroids of the other points' vertices), what
+// DMPlexCreateRigidBody projects through every cell. *nsp = nullptr where a point holds more than one node.
+PetscErrorCode NodalRigidBodyModes(DM dm, MatNullSpace *nsp);
+
 class Elasticity {
 public:
   Elasticity() = default;
@@ -60,7 +65,8 @@ public:
   PetscErrorCode Energy(Vec u, PetscReal *energy) const;
   // Cell von Mises stress (mean over each cell; plane strain sigma_zz = L tr(eps) in 2D).
   PetscErrorCode VonMises(Vec u, Vec *vm) const;
-  // Rigid-body near-null space for GAMG.
+  // Rigid-body near-null space for GAMG (of the reference coordinates: the same for every parameter), computed
+  // once per mesh and shared: *nsp is a new reference (MatNullSpaceDestroy it).
   PetscErrorCode NearNullSpace(MatNullSpace *nsp) const;
   // Body index of each local cell (cStart..cEnd-1), -1 where no body label matched.
   const std::vector<PetscInt> &CellBody() const { return cellBody_; }
@@ -94,6 +100,7 @@ private:
   mutable ElementAssembler  elem_;
   mutable Vec               bcLocal_ = nullptr; // the Dirichlet values of the current state, zero elsewhere
   mutable bool              bcValid_ = false;   // cleared by every change of the load scales
+  mutable MatNullSpace      nearNull_ = nullptr; // NearNullSpace's rigid-body modes, once per mesh
   std::vector<PetscInt>     bcValue_;           // label value of each essential boundary (bcs_ order)
   // Constant Dirichlet values straight into the local vector (Lagrange nodes of the closures of the
   // labeled points, in DMAddBoundary's order): what DMPlexInsertBoundaryValues projects, without its cost
