@@ -177,6 +177,7 @@ private:
   // Collective; the relative order of the facets is that of Gather.
   PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin);
   MasterSearchStats searchStats_;
+  size_t            kReserve_[2] = {0, 0}; // the last assembly's buffered K pieces and entries (the next one reserves as many)
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
   PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);
   void           SegmentFacet(const SurfaceFacet &F, const ClosestPoint &cp, std::vector<std::pair<PetscReal, PetscReal>> *segs) const;
