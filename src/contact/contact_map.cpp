@@ -839,23 +839,23 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       for (size_t i = 0; i < kRow.size(); ++i) piece[next[kRow[i]]++] = (PetscInt)i;
     }
     std::vector<PetscInt>                              slot((size_t)N, -1);
-    std::vector<std::pair<PetscInt, PetscScalar>>      acc;
+    std::vector<std::pair<PetscInt, PetscScalar>>      entries; // this row's (column, sum)
     for (PetscInt r = 0; r < R_; ++r) {
       if (start[r] == start[(size_t)r + 1]) continue;
-      acc.clear();
+      entries.clear();
       for (PetscInt k = start[r]; k < start[(size_t)r + 1]; ++k)
         for (PetscInt e = kPtr[piece[k]]; e < kPtr[piece[k] + 1]; ++e) {
           PetscInt &sl = slot[kCol[e]];
           if (sl < 0) {
-            sl = (PetscInt)acc.size();
-            acc.emplace_back(kCol[e], 0.0);
+            sl = (PetscInt)entries.size();
+            entries.emplace_back(kCol[e], 0.0);
           }
-          acc[sl].second += kVal[e];
+          entries[sl].second += kVal[e];
         }
-      for (const auto &cv : acc) slot[cv.first] = -1;
-      std::sort(acc.begin(), acc.end(), [](const std::pair<PetscInt, PetscScalar> &a, const std::pair<PetscInt, PetscScalar> &b) { return a.first < b.first; });
+      for (const auto &cv : entries) slot[cv.first] = -1;
+      std::sort(entries.begin(), entries.end(), [](const std::pair<PetscInt, PetscScalar> &a, const std::pair<PetscInt, PetscScalar> &b) { return a.first < b.first; });
       mRow.push_back(r);
-      for (const auto &cv : acc) {
+      for (const auto &cv : entries) {
         mCol.push_back(cv.first);
         mVal.push_back(cv.second);
       }
