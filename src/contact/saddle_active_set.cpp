@@ -376,8 +376,8 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
   bool     fresh = !(factored_ && canReuse_ && changedSinceFactor_ <= reuseMaxChanges);
   PetscCall(KSPSetTolerances(ksp_, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   // the initial guess: the last step's solution of this parameter with the rows now inactive zeroed (their
-  // equation is -s lambda~ = 0), or zero
-  const PetscBool guess = previousGuess && guess_ ? PETSC_TRUE : PETSC_FALSE;
+  // equation is -s lambda~ = 0), or zero (always with KSPPREONLY, which refuses a nonzero guess)
+  const PetscBool guess = previousGuess && guess_ && canReuse_ ? PETSC_TRUE : PETSC_FALSE;
   if (guess) {
     PetscScalar *xa;
     PetscCall(VecGetArray(x_, &xa));
