@@ -227,10 +227,14 @@ def rom3d(args, extra):
         t, ro = v["test"], v["rom"]
         met = t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3
         fast = v["online_time_s"]["median"] <= 200e-6
-        print("| %s | %d | %d | %d | %d | %d | %.2e | %.2e | %.2e | %.2e | %.0f us | %.2f s | %.0f | %.1f | accuracy %s, online %s |"
+        # the speedup target (1e4) is the finest level's
+        verdict = "online %s" % ("met" if fast else "MISSED")
+        if tag == "finest":
+            verdict += ", speedup %s" % ("met" if v["speedup_median"] >= 1e4 else "MISSED")
+        print("| %s | %d | %d | %d | %d | %d | %.2e | %.2e | %.2e | %.2e | %.0f us | %.2f s | %.0f | %.1f | accuracy %s, %s |"
               % (tag, off.get("ndofs", 0), off.get("ntrain", 0), ro["N"], ro["R"], ro["Mc"], t["max_rel_err_u"], t["max_rel_err_lambda"],
                  t["max_rel_err_force"], t["max_rel_err_force_online"], 1e6 * v["online_time_s"]["median"], v["fom_time_s"]["median"],
-                 v["speedup_median"], off["time_s"]["total"], "met" if met else "MISSED", "met" if fast else "MISSED"))
+                 v["speedup_median"], off["time_s"]["total"], "met" if met else "MISSED", verdict))
 
 
 if __name__ == "__main__":
