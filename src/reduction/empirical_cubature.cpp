@@ -339,23 +339,30 @@ bool SolveOnSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vect
   return info == 0;
 }
 // The Cholesky factor of H(S, S) kept along Lawson-Hanson's steps: a point appended to S adds a row (O(k^2):
-// L l = H(S, j), d^2 = H(j, j) - l'l), points leaving S refactor it. The same pivot test as SolveOnSupport on the new
-// pivot (d^2 > 1e-13 max diag H(S, S)). O(k^2) a step instead of O(k^3): the groups of the hierarchical fit select
-// thousands of points (CubatureOptions::incremental).
+// L l = H(S, j), d^2 = H(j, j) - l'l), a point leaving S deletes its row and column (the rows below it lose that column
+// and their trailing block takes the rank-one update by it: O((k - i)^2) Givens steps, i the point's place). The same
+// pivot test as SolveOnSupport on an appended pivot (d^2 > 1e-13 max diag H(S, S)). O(k^2) a step instead of O(k^3):
+// the groups of the hierarchical fit select thousands of points (CubatureOptions::incremental).
 class SupportCholesky {
 public:
-  // Factor of H(S, S) for the current S (appending when S is the factored set plus one point); false: not
-  // (numerically) positive definite, the factor left as it was.
+  // Factor of H(S, S) for the current S: the factored set's points missing from S deleted, S's points after them
+  // appended; false: an appended pivot not (numerically) positive, the factor left at the points before it.
   bool Update(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S)
   {
-    const size_t k = S_.size();
     if (S == S_) return true;
-    if (S.size() == k + 1 && std::equal(S_.begin(), S_.end(), S.begin())) return Append(H, Q, S.back());
-    S_.clear(); // refactor: rebuild by appending (the same arithmetic as a sequence of Appends)
-    L_.clear();
-    dmax_ = 0;
-    for (PetscInt p : S)
-      if (!Append(H, Q, p)) return false;
+    std::vector<size_t> gone; // places in S_ of the points S no longer holds (S_ minus these = S[0, m))
+    size_t              m = 0;
+    for (size_t i = 0; i < S_.size(); ++i) {
+      if (m < S.size() && S_[i] == S[m]) ++m;
+      else gone.push_back(i);
+    }
+    for (size_t g = gone.size(); g-- > 0;) Delete(gone[g]);
+    if (!gone.empty()) {
+      dmax_ = 0;
+      for (PetscInt p : S_) dmax_ = std::max(dmax_, H[(size_t)p * Q + p]);
+    }
+    for (size_t i = m; i < S.size(); ++i)
+      if (!Append(H, Q, S[i])) return false;
     return true;
   }
   // z = H(S, S)^{-1} b(S) (forward and back substitution)
@@ -395,6 +402,31 @@ private:
     S_.push_back(j);
     dmax_ = dmax;
     return true;
+  }
+  // delete the point at place i: rows below i without column i, L33 L33' + v v' refactored by Givens rotations
+  // (v the deleted column below the diagonal); a rank-one update, no cancellation
+  void Delete(size_t i)
+  {
+    const size_t           k = S_.size(), t = k - i - 1;
+    std::vector<PetscReal> v(t), NL(Row(k - 1));
+    std::copy(L_.begin(), L_.begin() + Row(i), NL.begin());
+    for (size_t r = i + 1; r < k; ++r) { // old row r -> new row r - 1, column i left out
+      v[r - i - 1] = L_[Row(r) + i];
+      std::copy(L_.begin() + Row(r), L_.begin() + Row(r) + i, NL.begin() + Row(r - 1));
+      std::copy(L_.begin() + Row(r) + i + 1, L_.begin() + Row(r) + r + 1, NL.begin() + Row(r - 1) + i);
+    }
+    for (size_t j = 0; j < t; ++j) {
+      const size_t    c = i + j;
+      const PetscReal d = NL[Row(c) + c], r = std::hypot(d, v[j]), cs = r / d, sn = v[j] / d;
+      NL[Row(c) + c] = r;
+      for (size_t q = j + 1; q < t; ++q) {
+        PetscReal &e = NL[Row(i + q) + c];
+        e            = (e + sn * v[q]) / cs;
+        v[q]         = cs * v[q] - sn * e;
+      }
+    }
+    L_ = std::move(NL);
+    S_.erase(S_.begin() + i);
   }
   std::vector<PetscInt>  S_;
   std::vector<PetscReal> L_;
@@ -487,11 +519,12 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
       S = keep;
       if (S.empty()) break;
     }
-    // gradient b - H x, and H x on the support for the residual
-    for (PetscInt p = 0; p < Q; ++p) {
-      PetscReal s = 0;
-      for (PetscInt q : S) s += H[(size_t)p * Q + q] * x[q];
-      Hx[p] = s;
+    // gradient b - H x, and H x on the support for the residual; H symmetric: summed by its rows q in S (contiguous),
+    // each Hx[p] over q in the order of S as a dot product of row p would
+    std::fill(Hx.begin(), Hx.end(), 0.0);
+    for (PetscInt q : S) {
+      const PetscReal *Hq = H.data() + (size_t)q * Q, xq = x[q];
+      for (PetscInt p = 0; p < Q; ++p) Hx[p] += Hq[p] * xq;
     }
     grad.assign(Q, 0.0);
     for (PetscInt p = 0; p < Q; ++p) grad[p] = b[p] - Hx[p];
