@@ -408,24 +408,24 @@ private:
   void Delete(size_t i)
   {
     const size_t           k = S_.size(), t = k - i - 1;
-    std::vector<PetscReal> v(t), NL(Row(k - 1));
-    std::copy(L_.begin(), L_.begin() + Row(i), NL.begin());
-    for (size_t r = i + 1; r < k; ++r) { // old row r -> new row r - 1, column i left out
+    std::vector<PetscReal> v(t);
+    auto                   L = L_.begin();
+    for (size_t r = i + 1; r < k; ++r) { // old row r -> new row r - 1, column i left out, in place (every piece moves to lower places)
       v[r - i - 1] = L_[Row(r) + i];
-      std::copy(L_.begin() + Row(r), L_.begin() + Row(r) + i, NL.begin() + Row(r - 1));
-      std::copy(L_.begin() + Row(r) + i + 1, L_.begin() + Row(r) + r + 1, NL.begin() + Row(r - 1) + i);
+      std::copy(L + Row(r), L + Row(r) + i, L + Row(r - 1));
+      std::copy(L + Row(r) + i + 1, L + Row(r) + r + 1, L + Row(r - 1) + i);
     }
+    L_.resize(Row(k - 1));
     for (size_t j = 0; j < t; ++j) {
       const size_t    c = i + j;
-      const PetscReal d = NL[Row(c) + c], r = std::hypot(d, v[j]), cs = r / d, sn = v[j] / d;
-      NL[Row(c) + c] = r;
+      const PetscReal d = L_[Row(c) + c], r = std::hypot(d, v[j]), cs = r / d, sn = v[j] / d;
+      L_[Row(c) + c] = r;
       for (size_t q = j + 1; q < t; ++q) {
-        PetscReal &e = NL[Row(i + q) + c];
+        PetscReal &e = L_[Row(i + q) + c];
         e            = (e + sn * v[q]) / cs;
         v[q]         = cs * v[q] - sn * e;
       }
     }
-    L_ = std::move(NL);
     S_.erase(S_.begin() + i);
   }
   std::vector<PetscInt>  S_;
