@@ -498,6 +498,24 @@ def sphere_block3d(args):
         dd = max(abs(a - b) for a, b in zip(vals[1][k], vd["test"][k]))
         print("  single against double precision: max |change| of %s %.1e (bound %.0e)" % (k, dd, bound))
         check(dd <= bound, "single precision moves %s by %.1e <= %.0e" % (k, dd, bound))
+    # the points' sum has a single-precision path too (since 2026-11-26; it ran in double before), and the outer products
+    # are summed by the BLAS's gemm or by the built-in kernels (-rom_gemm): the same reduced solution to the float sum's
+    # noise (about 1e-6 on u: bound 1e-5; a misplaced row or column moves it by O(1))
+    hs = {}
+    for tag, extra in (("pd", ["-rom_ecsw_sum", "points", "-rom_ecsw_precision", "double"]), ("ps", ["-rom_ecsw_sum", "points"]),
+                       ("psb", ["-rom_ecsw_sum", "points", "-rom_gemm", "builtin"]), ("ds", ["-rom_ecsw_sum", "dofs"]),
+                       ("dsb", ["-rom_ecsw_sum", "dofs", "-rom_gemm", "builtin"])):
+        run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", "%s/sp_%s.json" % (d, tag)] + extra)
+        hs[tag] = report("%s/sp_%s.json" % (d, tag))
+    check([hs[t]["rom"]["ecsw_sum"] + "/" + hs[t]["rom"]["ecsw_precision"] + "/" + hs[t]["rom"]["gemm"] for t in ("pd", "ps", "psb", "ds", "dsb")]
+          == ["points/double/blas", "points/single/blas", "points/single/builtin", "dofs/single/blas", "dofs/single/builtin"],
+          "the reports name the sum, its precision and its gemm")
+    for t in ("ps", "psb", "ds", "dsb"):
+        dv = np.linalg.norm(np.array(hs[t]["u_hat"]) - hs["pd"]["u_hat"]) / np.linalg.norm(hs["pd"]["u_hat"])
+        df = abs(hs[t]["outputs"]["contact_force"] - hs["pd"]["outputs"]["contact_force"]) / hs["pd"]["outputs"]["contact_force"]
+        print("  %s against the points' sum in double: |du|/|u| %.1e, force %.1e" % (t, dv, df))
+        check(dv <= 1e-5 and df <= 1e-5, "%s: the same reduced solution as the points' sum in double to %.1e (u), %.1e (force) <= 1e-5" % (t, dv, df))
+    expect_error(args, ["-rom", rom, "-mu", "0.93,0.043", "-rom_gemm", "mkl"], ["mkl", "-rom_gemm"], "unknown -rom_gemm")
     # the online Kacanov tolerances of the options file travel in the ROM file (/online/kacanov_rtol): an online
     # solve without options uses them (2 iterates from this 3 x 3 grid's warm start against 5 to 1e-9), and what the
     # looser tolerance leaves is far below the 3D u target (docs/online.md: one iterate and 1-2e-6 on the 9 x 9 grid)
@@ -580,7 +598,10 @@ def estimate(args):
     check(same_sizes and dc <= 0.05, "1 and 2 ranks: the same answer sizes and calibration to %.1e (<= 5 %%: FOM solver tolerance, scale grid)" % dc)
     # online: the estimate, and its raw changes against a separate solve with every stored basis function at the reference radius
     # (A(1.0) = X: the basis is X-orthonormal, so energy norms are Euclidean norms of the coordinates); tight Kacanov tolerances
-    tight = ["-rom_kacanov_rtol_primal", "1e-13", "-rom_kacanov_rtol_dual", "1e-13"]
+    # (1e-12: the loop's changes of the multipliers stall near 1e-13 with every stored basis function, whose nearly
+    # collinear dual vectors amplify rounding: 1e-13 converged or not with the CPU's BLAS kernels; the differences
+    # compared below are 1e-6 and larger)
+    tight = ["-rom_kacanov_rtol_primal", "1e-12", "-rom_kacanov_rtol_dual", "1e-12"]
     run(args, 1, "online", ["-rom", rom, "-mu", "1.0", "-report", d + "/on.json"] + tight)
     on = report(d + "/on.json")
     ee = on["error_estimate"]

@@ -6,6 +6,8 @@
 // residual X L' - D) and LowerGram of the reduced QP's set-up, n 1..60; RowDots (U = uD + theta v). The dispatched version (AVX2+FMA
 // where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|). The single-precision
 // dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) within the float accumulation bound.
+// The sums of outer products each by the BLAS's gemm and by the built-in kernels (SetGemmBlas), and from point-major
+// rows (SumOfOuterProductsRows*, the points' sum of the cubature).
 #include "../src/rom/dense_kernels.hpp"
 #include <cmath>
 #include <random>
@@ -21,15 +23,23 @@ int main(int argc, char **argv)
   std::uniform_real_distribution<double> u(-1, 1);
 
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  // the sums of outer products by the BLAS's gemm and by the built-in kernels (-rom_gemm), X row-major by columns
+  // (SumOfOuterProducts) and point-major with a leading dimension beyond nc (SumOfOuterProductsRows)
+  for (bool blas : {true, false})
+    for (bool rows : {false, true})
   for (PetscInt M : {0, 1, 7, 202})
     for (PetscInt r : {1, 3, 4, 5, 9, 12, 18})
       for (PetscInt nc : {1, 3, 4, 5, 21}) {
-        const PetscInt      rp = PaddedRows(r);
-        std::vector<double> W((size_t)M * rp, 0.0), X((size_t)nc * M), K((size_t)rp * nc, -7.0);
+        const PetscInt      rp = PaddedRows(r), ldx = nc + 2;
+        std::vector<double> W((size_t)M * rp, 0.0), X((size_t)nc * M), K((size_t)rp * nc, -7.0), Xr((size_t)M * ldx, 99.0);
         for (PetscInt p = 0; p < M; ++p)
           for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rp + i] = u(gen);
         for (auto &x : X) x = u(gen);
-        SumOfOuterProducts(M, rp, nc, W.data(), X.data(), K.data());
+        for (PetscInt p = 0; p < M; ++p)
+          for (PetscInt c = 0; c < nc; ++c) Xr[(size_t)p * ldx + c] = X[(size_t)c * M + p];
+        SetGemmBlas(blas);
+        if (rows) SumOfOuterProductsRows(M, rp, nc, W.data(), Xr.data(), ldx, K.data());
+        else SumOfOuterProducts(M, rp, nc, W.data(), X.data(), K.data());
         for (PetscInt c = 0; c < nc; ++c)
           for (PetscInt i = 0; i < rp; ++i) {
             double s = 0, a = 0;
@@ -42,7 +52,7 @@ int main(int argc, char **argv)
             ++checks;
             if (!(e <= 1e-13) && !(a == 0 && K[(size_t)c * rp + i] == 0)) {
               ++failures;
-              PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL SumOfOuterProducts M %d r %d nc %d entry (%d, %d): %g vs %g\n", (int)M, (int)r, (int)nc, (int)i, (int)c, K[(size_t)c * rp + i], s));
+              PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL SumOfOuterProducts%s (%s) M %d r %d nc %d entry (%d, %d): %g vs %g\n", rows ? "Rows" : "", blas ? "blas" : "builtin", (int)M, (int)r, (int)nc, (int)i, (int)c, K[(size_t)c * rp + i], s));
             }
           }
       }
@@ -118,16 +128,22 @@ int main(int argc, char **argv)
   // double sum of the same float inputs, within the accumulation bound (terms + 2) 2^-24 sum |terms| per entry
   // (a misplaced row or column is off by O(1) of the sum)
   const double uf = std::ldexp(1.0, -24);
+  for (bool blas : {true, false})
+    for (bool rows : {false, true})
   for (PetscInt M : {0, 1, 7, 202, 631})
     for (PetscInt r : {1, 5, 8, 9, 24, 30, 33, 44})
       for (PetscInt nc : {1, 3, 4, 5, 44}) {
-        const PetscInt      rps = PaddedRows(r, 8);
-        std::vector<float>  W((size_t)M * rps, 0.0f), X((size_t)nc * M);
+        const PetscInt      rps = PaddedRows(r, 8), ldx = nc + 1;
+        std::vector<float>  W((size_t)M * rps, 0.0f), X((size_t)nc * M), Xr((size_t)M * ldx, 99.0f);
         std::vector<double> K((size_t)rps * nc, -7.0);
         for (PetscInt p = 0; p < M; ++p)
           for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rps + i] = (float)u(gen);
         for (auto &x : X) x = (float)u(gen);
-        SumOfOuterProductsSingle(M, rps, nc, W.data(), X.data(), K.data());
+        for (PetscInt p = 0; p < M; ++p)
+          for (PetscInt c = 0; c < nc; ++c) Xr[(size_t)p * ldx + c] = X[(size_t)c * M + p];
+        SetGemmBlas(blas);
+        if (rows) SumOfOuterProductsRowsSingle(M, rps, nc, W.data(), Xr.data(), ldx, K.data());
+        else SumOfOuterProductsSingle(M, rps, nc, W.data(), X.data(), K.data());
         for (PetscInt c = 0; c < nc; ++c)
           for (PetscInt i = 0; i < rps; ++i) {
             double s = 0, a = 0;
@@ -140,7 +156,7 @@ int main(int argc, char **argv)
             ++checks;
             if (!(e <= bound)) {
               ++failures;
-              PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL SumOfOuterProductsSingle M %d r %d nc %d entry (%d, %d): %g vs %g\n", (int)M, (int)r, (int)nc, (int)i, (int)c, K[(size_t)c * rps + i], s));
+              PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL SumOfOuterProducts%sSingle (%s) M %d r %d nc %d entry (%d, %d): %g vs %g\n", rows ? "Rows" : "", blas ? "blas" : "builtin", (int)M, (int)r, (int)nc, (int)i, (int)c, K[(size_t)c * rps + i], s));
             }
           }
       }

@@ -186,8 +186,13 @@ public:
   // (docs/online.md "Single precision"). It leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov
   // changes: with tolerances near it the loop needs more iterates (half_disks at 1e-5: 2.4 -> 4.85 on average,
   // slower than double). Stored in the ROM file (/online/ecsw_precision); options override it.
+  // Since 2026-11-26 the points' sum has a single-precision path too (kappa's rows converted, then one sgemm).
   bool ecswSingle = false;
   bool EcswSingle() const { return cSingle_; }
+  // -rom_gemm blas|builtin: the cubature's sums of outer products (K^ = Pw' kappa, Q' theta) by the BLAS's gemm
+  // (default; OpenBLAS 2.5-3x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for a
+  // reference BLAS). Process-wide (SetGemmBlas); docs/online.md "The BLAS for the cubature's sums".
+  bool gemmBlas = true;
   bool      recordIterates = false;
   ReducedQP qp;
 
@@ -218,8 +223,9 @@ private:
   std::vector<PetscReal> cX_, cK_;                    // cubature scratch: [kappa gamma] point-contiguous, [K g] padded
   bool                   cDofs_ = false;              // the cubature's K^ summed by patch dofs (-rom_ecsw_sum)
   PetscInt               cNd_   = 0;                  // ... over the dofs [0, cNd_) that terms fall on (ContactPatch::TermDofs)
-  bool                   cSingle_ = false;            // the dof sum in float (ecswSingle and cDofs_)
-  std::vector<float>     cPwTs_, cThetaTs_, cQs_;     // ... its weights (M x rp rounded up to 8), theta' and Q
+  bool                   cSingle_ = false;            // the cubature's K^ in float (ecswSingle), by dofs or by points
+  std::vector<float>     cPwTs_, cThetaTs_, cQs_;     // ... its weights (M x rp rounded up to 8), theta' and Q (dofs)
+  std::vector<float>     cXs_;                        // ... kappa's used columns (M x Na, point-major; points)
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;

@@ -8,14 +8,30 @@
 // registers (up to 12 blocks of 4, WithRegisterBlocks). Results differ from the portable ones by rounding (FMA);
 // RBC_KERNELS_PORTABLE=1 in the environment selects the portable ones.
 #include "dense_kernels.hpp"
+#include <petscblaslapack.h>
 #include <algorithm>
 #include <cstdlib>
 #include <type_traits>
 #include <utility>
+#include <vector>
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #define RBC_KERNEL_DISPATCH 1
 #endif
+
+// sgemm and sgemv with PETSc's BLAS name mangling (petscblaslapack.h declares those of PetscScalar only)
+#if defined(PETSC_BLASLAPACK_CAPS)
+#define RBC_SGEMM PETSC_PASTE2(SGEMM, PETSC_BLASLAPACK_SUFFIX_)
+#else
+#define RBC_SGEMM PETSC_PASTE2(sgemm, PETSC_BLASLAPACK_SUFFIX_)
+#endif
+#if defined(PETSC_BLASLAPACK_CAPS)
+#define RBC_SGEMV PETSC_PASTE2(SGEMV, PETSC_BLASLAPACK_SUFFIX_)
+#else
+#define RBC_SGEMV PETSC_PASTE2(sgemv, PETSC_BLASLAPACK_SUFFIX_)
+#endif
+extern "C" void RBC_SGEMV(const char *, const PetscBLASInt *, const PetscBLASInt *, const float *, const float *, const PetscBLASInt *, const float *, const PetscBLASInt *, const float *, float *, const PetscBLASInt *);
+extern "C" void RBC_SGEMM(const char *, const char *, const PetscBLASInt *, const PetscBLASInt *, const PetscBLASInt *, const float *, const float *, const PetscBLASInt *, const float *, const PetscBLASInt *, const float *, float *, const PetscBLASInt *);
 
 namespace rbc {
 
@@ -377,8 +393,66 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
   CombinePortable(nt, coef, rows, n, out);
 }
 
+namespace {
+bool gemmBlas = true;
+
+// K (rp x nc, column-major, double) = W' X by the BLAS: W is M x rp point-major (a column-major rp x M), X either
+// nc x M row-major (transX false: a column-major M x nc, leading dimension ldx) or M x nc row-major (transX true:
+// a column-major nc x M). Single precision through a float result, converted.
+template <class T>
+void Gemm(bool transX, PetscInt M, PetscInt rp, PetscInt nc, const T *W, const T *X, PetscInt ldx, PetscReal *K)
+{
+  if (rp <= 0 || nc <= 0) return;
+  if (M <= 0) {
+    std::fill(K, K + (size_t)rp * nc, 0.0);
+    return;
+  }
+  const PetscBLASInt m = (PetscBLASInt)rp, n = (PetscBLASInt)nc, k = (PetscBLASInt)M, ld = (PetscBLASInt)ldx;
+  const PetscBLASInt inc = transX ? ld : 1, one1 = 1; // one column (g^): gemv, which does not pack W as gemm does
+  const T            one = 1, zero = 0;
+  if constexpr (std::is_same<T, double>::value) {
+    if (nc == 1) BLASgemv_("N", &m, &k, &one, W, &m, X, &inc, &zero, K, &one1);
+    else BLASgemm_("N", transX ? "T" : "N", &m, &n, &k, &one, W, &m, X, &ld, &zero, K, &m);
+  } else {
+    thread_local std::vector<float> Kf;
+    Kf.resize((size_t)rp * nc);
+    if (nc == 1) RBC_SGEMV("N", &m, &k, &one, W, &m, X, &inc, &zero, Kf.data(), &one1);
+    else RBC_SGEMM("N", transX ? "T" : "N", &m, &n, &k, &one, W, &m, X, &ld, &zero, Kf.data(), &m);
+    std::copy(Kf.begin(), Kf.end(), K);
+  }
+}
+
+// The built-in kernels' sum of a point-major X: transposed into a scratch array first
+template <class T>
+void OuterRowsBuiltin(PetscInt M, PetscInt rp, PetscInt nc, const T *W, const T *X, PetscInt ldx, PetscReal *K)
+{
+  thread_local std::vector<T> Xt;
+  Xt.resize((size_t)nc * M);
+  for (PetscInt c = 0; c < nc; ++c)
+    for (PetscInt p = 0; p < M; ++p) Xt[(size_t)c * M + p] = X[(size_t)p * ldx + c];
+  if constexpr (std::is_same<T, double>::value) SumOfOuterProducts(M, rp, nc, W, Xt.data(), K);
+  else SumOfOuterProductsSingle(M, rp, nc, W, Xt.data(), K);
+}
+} // namespace
+
+void SetGemmBlas(bool blas) { gemmBlas = blas; }
+bool GemmBlas() { return gemmBlas; }
+
+void SumOfOuterProductsRows(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscInt ldx, PetscReal *K)
+{
+  if (gemmBlas) Gemm<double>(true, M, rp, nc, W, X, ldx, K);
+  else OuterRowsBuiltin<double>(M, rp, nc, W, X, ldx, K);
+}
+
+void SumOfOuterProductsRowsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscInt ldx, PetscReal *K)
+{
+  if (gemmBlas) Gemm<float>(true, M, rp, nc, W, X, ldx, K);
+  else OuterRowsBuiltin<float>(M, rp, nc, W, X, ldx, K);
+}
+
 void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K)
 {
+  if (gemmBlas) return Gemm<double>(false, M, rp, nc, W, X, std::max<PetscInt>(M, 1), K);
 #ifdef RBC_KERNEL_DISPATCH
   if (HaveAvx2()) return OuterAvx2<double>(M, rp, nc, W, X, K);
 #endif
@@ -411,6 +485,7 @@ void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
 
 void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K)
 {
+  if (gemmBlas) return Gemm<float>(false, M, rp, nc, W, X, std::max<PetscInt>(M, 1), K);
 #ifdef RBC_KERNEL_DISPATCH
   if (HaveAvx2()) return OuterAvx2<float>(M, rp, nc, W, X, K);
 #endif

@@ -14,6 +14,17 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
 // point-major, rp a multiple of 4, padding zero) and X (nc x M, row-major); K is rp x nc, column-major.
 void SumOfOuterProducts(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscReal *K);
 
+// The same sum with X point-major (M x nc, row-major, leading dimension ldx >= nc): the points' sum straight from
+// the rows of kappa, without a transposed copy on the BLAS path. K is rp x nc, column-major.
+void SumOfOuterProductsRows(PetscInt M, PetscInt rp, PetscInt nc, const PetscReal *W, const PetscReal *X, PetscInt ldx, PetscReal *K);
+void SumOfOuterProductsRowsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscInt ldx, PetscReal *K);
+
+// Who computes the sums of outer products (SumOfOuterProducts*): the BLAS's gemm (true, the default) or the built-in
+// kernels below (-rom_gemm builtin: for a reference BLAS; docs/online.md "The BLAS for the cubature's sums").
+// Process-wide (ReducedModel::SetFromOptions sets it).
+void SetGemmBlas(bool blas);
+bool GemmBlas();
+
 // The patch-dof accumulation of the cubature's dof sum: for every point p < M and term t < nt[p],
 // Q(rowIdx[p][t], :) += coef[p][t] W(p, :), and g += gamma[p] W(p, :) (W M x rp point-major, Q nd x rp
 // row-major, g of length rp; rowIdx and coef hold maxTerms entries per point). Accumulates into Q, g.

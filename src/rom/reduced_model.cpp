@@ -196,6 +196,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["hyper"]    = m.HyperName();
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
+  (*r)["gemm"]           = m.gemmBlas ? "blas" : "builtin";
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
   (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
@@ -415,6 +416,12 @@ PetscErrorCode ReducedModel::SetFromOptions()
   // a model read from a file; the offline stage's in-memory model sets its mode itself (SetContactMode)
   if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
   PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
+  {
+    const char *gemms[] = {"blas", "builtin"};
+    PetscInt    gm      = gemmBlas ? 0 : 1;
+    PetscCall(PetscOptionsEList("-gemm", "who sums the cubature's outer products (K^ = Pw' kappa, Q' theta): the BLAS's gemm or the built-in AVX2 kernels (for a reference BLAS)", "", gemms, 2, gemms[gm], &gm, NULL));
+    gemmBlas = gm == 0;
+  }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's dof sum (K^; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
@@ -439,6 +446,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
       SetContactMode(ContactMode::EIM);
     } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
   }
+  SetGemmBlas(gemmBlas);
   if (sumSet) ecswSum = (EcswSum)k;
   ecswSingle = prec == 1;
   PetscCall(Truncate(n, r, mk, mg));
@@ -497,9 +505,10 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum); the points'
     // row combination gathers its rows from theta and counts twice (measured: docs/online.md)
     const PetscInt nd = patch.TermDofs(), Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim); nd: the dofs terms fall on
-    // (single precision: the dof sum's kernels do twice the work per vector operation, count half; measured on the
-    // hertz3d mesh, docs/rom3d.md: points 1.46 ms, dofs 1.60 ms in double, 0.87 ms in single)
-    const double byPoints = (double)Mc * (2.0 * nt * Nfull + rp * (Na + 1)), byDofs = (ecswSingle ? 0.5 : 1.0) * ((double)Mc * rp * (nt + 1) + (double)nd * rp * Na);
+    // (single precision: the sums do twice the work per vector operation, count half; the gemm of the BLAS a third
+    // of the built-in kernels' time per flop, measured: docs/online.md "The BLAS for the cubature's sums")
+    const double sp = ecswSingle ? 0.5 : 1.0, gm = GemmBlas() ? 1.0 / 3.0 : 1.0;
+    const double byPoints = (double)Mc * (2.0 * nt * Nfull) + sp * gm * (double)Mc * rp * (Na + 1), byDofs = sp * ((double)Mc * rp * (nt + 1) + gm * (double)nd * rp * Na);
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cNd_   = nd;
     cThetaT_.clear();
@@ -512,15 +521,17 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
       cRow_.assign((size_t)Mc * ContactPatch::MaxTerms, 0);
       cCoef_.assign((size_t)Mc * ContactPatch::MaxTerms, 0.0);
     }
-    cSingle_ = cDofs_ && ecswSingle;
+    cSingle_ = Mc > 0 && ecswSingle;
     cPwTs_.clear();
     cThetaTs_.clear();
+    cXs_.clear();
     if (cSingle_) {
       const PetscInt rps = PaddedRows(r, 8);
       cPwTs_.assign((size_t)Mc * rps, 0.0f);
       for (PetscInt p = 0; p < Mc; ++p)
         for (PetscInt i = 0; i < r; ++i) cPwTs_[(size_t)p * rps + i] = (float)cPwT_[(size_t)p * rp + i];
-      cThetaTs_.assign(cThetaT_.begin(), cThetaT_.end());
+      if (cDofs_) cThetaTs_.assign(cThetaT_.begin(), cThetaT_.end());
+      else cXs_.assign((size_t)Mc * Na, 0.0f);
     }
   }
   if (!P_.empty()) {
@@ -605,14 +616,20 @@ void ReducedModel::CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, c
     SumOfOuterProducts(nd, rp, nc, Q->data(), ThetaT.data(), Kp->data());
     return;
   }
-  X->resize((size_t)(nc + 1) * M);
-  for (PetscInt c = 0; c < nc; ++c) {
-    PetscReal     *x   = &(*X)[(size_t)c * M];
-    const PetscInt col = cols ? cols[c] : c;
-    for (PetscInt p = 0; p < M; ++p) x[p] = kap_[(size_t)p * Nfull + col];
+  // the points' sum from the rows of kappa (its leading nc columns in place; other columns gathered row by row)
+  bool prefix = true;
+  for (PetscInt c = 0; cols && c < nc && prefix; ++c) prefix = cols[c] == c;
+  const PetscReal *kx  = kap_.data();
+  PetscInt         ldx = Nfull;
+  if (!prefix) {
+    X->resize((size_t)M * std::max<PetscInt>(nc, 1));
+    for (PetscInt p = 0; p < M; ++p)
+      for (PetscInt c = 0; c < nc; ++c) (*X)[(size_t)p * nc + c] = kap_[(size_t)p * Nfull + cols[c]];
+    kx  = X->data();
+    ldx = std::max<PetscInt>(nc, 1);
   }
-  std::copy(gam_.begin(), gam_.begin() + M, X->begin() + (size_t)nc * M);
-  SumOfOuterProducts(M, rp, nc + 1, PwT.data(), X->data(), Kp->data());
+  SumOfOuterProductsRows(M, rp, nc, PwT.data(), kx, ldx, Kp->data());
+  SumOfOuterProductsRows(M, rp, 1, PwT.data(), gam_.data(), 1, Kp->data() + (size_t)nc * rp); // g^
 }
 
 PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
@@ -663,10 +680,16 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
                  : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
     if (cSingle_) {
       const PetscInt rps = PaddedRows(r, 8), nd = cNd_;
-      cQs_.assign((size_t)nd * rps, 0.0f);
       cK_.resize((size_t)rps * Na);
-      ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
-      SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
+      if (cDofs_) {
+        cQs_.assign((size_t)nd * rps, 0.0f);
+        ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
+        SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
+      } else { // the points' sum: kappa's used columns in float, then one sum
+        for (PetscInt p = 0; p < M; ++p)
+          for (PetscInt c = 0; c < Na; ++c) cXs_[(size_t)p * Na + c] = (float)kap_[(size_t)p * Nfull + cols_[c]];
+        SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), Na, cK_.data());
+      }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
       cX_.resize(rp);
       SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
@@ -863,7 +886,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   sol->nactive = loop.history.nactive;
   if (!sol->converged) {
     sol->message = "reduced model: " + loop.NotConverged(false);
-    // the float dof sum leaves a noise floor on the changes (about 1e-6 on u, 1e-5 on lambda: docs/online.md)
+    // the float sum leaves a noise floor on the changes (about 1e-6 on u, 1e-5 on lambda: docs/online.md)
     if (cSingle_) sol->message += "; -rom_ecsw_precision single (the ROM file's or the option's) bounds the attainable changes to about 1e-6 (u) and 1e-5 (lambda): use -rom_ecsw_precision double for tighter tolerances";
     PetscFunctionReturn(0);
   }
