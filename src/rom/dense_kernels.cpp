@@ -394,7 +394,7 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
 }
 
 namespace {
-bool gemmBlas = true;
+thread_local bool gemmBlas = true; // per thread: each ReducedModel sets its own before its sums
 
 // K (rp x nc, column-major, double) = W' X by the BLAS: W is M x rp point-major (a column-major rp x M), X either
 // nc x M row-major (transX false: a column-major M x nc, leading dimension ldx) or M x nc row-major (transX true:

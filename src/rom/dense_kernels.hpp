@@ -21,7 +21,7 @@ void SumOfOuterProductsRowsSingle(PetscInt M, PetscInt rp, PetscInt nc, const fl
 
 // Who computes the sums of outer products (SumOfOuterProducts*): the BLAS's gemm (true, the default) or the built-in
 // kernels below (-rom_gemm builtin: for a reference BLAS; docs/online.md "The BLAS for the cubature's sums").
-// Process-wide (ReducedModel::SetFromOptions sets it).
+// Per thread: a ReducedModel sets its own choice before it sums (ContactTerms, EstimateError).
 void SetGemmBlas(bool blas);
 bool GemmBlas();
 

@@ -422,7 +422,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
     PetscCall(PetscOptionsEList("-gemm", "who sums the cubature's outer products (K^ = Pw' kappa, Q' theta): the BLAS's gemm or the built-in AVX2 kernels (for a reference BLAS)", "", gemms, 2, gemms[gm], &gm, NULL));
     gemmBlas = gm == 0;
   }
-  PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's dof sum (K^; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
+  PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
   PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
@@ -446,7 +446,6 @@ PetscErrorCode ReducedModel::SetFromOptions()
       SetContactMode(ContactMode::EIM);
     } else SETERRQ(PETSC_COMM_SELF, PETSC_ERR_ARG_UNKNOWN_TYPE, "-rom_hyper: unknown value '%s' (eim or ecsw)", hyper);
   }
-  SetGemmBlas(gemmBlas);
   if (sumSet) ecswSum = (EcswSum)k;
   ecswSingle = prec == 1;
   PetscCall(Truncate(n, r, mk, mg));
@@ -507,7 +506,7 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     const PetscInt nd = patch.TermDofs(), Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim); nd: the dofs terms fall on
     // (single precision: the sums do twice the work per vector operation, count half; the gemm of the BLAS a third
     // of the built-in kernels' time per flop, measured: docs/online.md "The BLAS for the cubature's sums")
-    const double sp = ecswSingle ? 0.5 : 1.0, gm = GemmBlas() ? 1.0 / 3.0 : 1.0;
+    const double sp = ecswSingle ? 0.5 : 1.0, gm = gemmBlas ? 1.0 / 3.0 : 1.0;
     const double byPoints = (double)Mc * (2.0 * nt * Nfull) + sp * gm * (double)Mc * rp * (Na + 1), byDofs = sp * ((double)Mc * rp * (nt + 1) + gm * (double)nd * rp * Na);
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cNd_   = nd;
@@ -674,6 +673,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     }
     patch.SetReduced(vfull.data());
     const PetscInt rp = PaddedRows(r);
+    SetGemmBlas(gemmBlas); // this model's choice for the sums below (-rom_gemm)
     wn_.resize((size_t)M * patch.dim);
     wnMode_ = ContactMode::Cubature;
     out = cDofs_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
@@ -936,7 +936,10 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
         for (PetscInt n = 0; n < Nf; ++n) eKp_[i + (size_t)rpf * n] += wp * kap_[(size_t)p * Nf + n];
         eKp_[i + (size_t)rpf * Nf] += wp * gam_[p];
       }
-  } else CubatureSum(rpf, ePwT_, eThetaT_, nullptr, Nf, &eQ_, &eX_, &eKp_); // the answer's sum, every stored row and column
+  } else {
+    SetGemmBlas(gemmBlas);
+    CubatureSum(rpf, ePwT_, eThetaT_, nullptr, Nf, &eQ_, &eX_, &eKp_); // the answer's sum, every stored row and column
+  }
   eK_.resize((size_t)Rf * Nf);
   for (PetscInt n = 0; n < Nf; ++n) std::copy_n(&eKp_[(size_t)n * rpf], Rf, &eK_[(size_t)Rf * n]);
   eg_.assign(eKp_.begin() + (size_t)Nf * rpf, eKp_.begin() + (size_t)Nf * rpf + Rf);
