@@ -190,7 +190,7 @@ public:
   bool ecswSingle = false;
   bool EcswSingle() const { return cSingle_; }
   // -rom_gemm blas|builtin: the cubature's sums of outer products (K^ = Pw' kappa, Q' theta) by the BLAS's gemm
-  // (default; OpenBLAS 2.5-3x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for a
+  // (default; OpenBLAS 1.5-2.4x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for a
   // reference BLAS); docs/online.md "The BLAS for the cubature's sums".
   bool gemmBlas = true;
   bool      recordIterates = false;

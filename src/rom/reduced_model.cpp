@@ -504,9 +504,9 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   { // the cubature's sum: by points or by patch dofs, whichever costs fewer flops (-rom_ecsw_sum); the points'
     // row combination gathers its rows from theta and counts twice (measured: docs/online.md)
     const PetscInt nd = patch.TermDofs(), Mc = (PetscInt)cPoint.size(), nt = 2 * patch.dim * patch.dim; // nt: terms per point (P1: 2 sides x dim nodes x dim); nd: the dofs terms fall on
-    // (single precision: the sums do twice the work per vector operation, count half; the gemm of the BLAS a third
-    // of the built-in kernels' time per flop, measured: docs/online.md "The BLAS for the cubature's sums")
-    const double sp = ecswSingle ? 0.5 : 1.0, gm = gemmBlas ? 1.0 / 3.0 : 1.0;
+    // (single precision: the sums do twice the work per vector operation, count half; the gemm of the BLAS half
+    // the built-in kernels' time per flop, measured: docs/online.md "The BLAS for the cubature's sums")
+    const double sp = ecswSingle ? 0.5 : 1.0, gm = gemmBlas ? 0.5 : 1.0;
     const double byPoints = (double)Mc * (2.0 * nt * Nfull) + sp * gm * (double)Mc * rp * (Na + 1), byDofs = sp * ((double)Mc * rp * (nt + 1) + gm * (double)nd * rp * Na);
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cNd_   = nd;
