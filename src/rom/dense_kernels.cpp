@@ -22,12 +22,9 @@
 // sgemm and sgemv with PETSc's BLAS name mangling (petscblaslapack.h declares those of PetscScalar only)
 #if defined(PETSC_BLASLAPACK_CAPS)
 #define RBC_SGEMM PETSC_PASTE2(SGEMM, PETSC_BLASLAPACK_SUFFIX_)
-#else
-#define RBC_SGEMM PETSC_PASTE2(sgemm, PETSC_BLASLAPACK_SUFFIX_)
-#endif
-#if defined(PETSC_BLASLAPACK_CAPS)
 #define RBC_SGEMV PETSC_PASTE2(SGEMV, PETSC_BLASLAPACK_SUFFIX_)
 #else
+#define RBC_SGEMM PETSC_PASTE2(sgemm, PETSC_BLASLAPACK_SUFFIX_)
 #define RBC_SGEMV PETSC_PASTE2(sgemv, PETSC_BLASLAPACK_SUFFIX_)
 #endif
 extern "C" void RBC_SGEMV(const char *, const PetscBLASInt *, const PetscBLASInt *, const float *, const float *, const PetscBLASInt *, const float *, const PetscBLASInt *, const float *, float *, const PetscBLASInt *);
