@@ -1,7 +1,7 @@
 // tests/test_element_assembly.cpp: the element-by-element assembly (src/fem/element_assembly.cpp, the
 // default) against PetscFE's residual and Jacobian (-fem_assembly petscfe) on the same mesh: the
-// stiffness A, the right-hand side f (loads and Dirichlet lifting), the H1 inner-product matrix and the
-// energy 1/2 a(U, U) of a random field, each to 1e-12 relative, at every -test_mu point (the
+// stiffness A, the right-hand side f (loads and Dirichlet lifting), the H1 inner-product matrix, the
+// energy 1/2 a(U, U) and the cell von Mises stresses of a random field, each to 1e-12 relative, at every -test_mu point (the
 // geometric maps give anisotropic effective tensors). The scene comes from the options
 // (-options_file runs/<scene>.opts plus overrides); exits 1 on a mismatch.
 #include "rbcontact/elasticity.hpp"
@@ -111,6 +111,20 @@ static PetscErrorCode Run(MPI_Comm comm)
       PetscCall(fe.Energy(u, &efe));
       PetscCall(el.Energy(u, &eel));
       PetscCall(Check(comm, "energy 1/2 a(U, U) of a random field", std::abs(efe - eel), std::abs(efe), 1e-12));
+      {
+        // cell von Mises stress of the same field: the element tables' quadrature mean against PetscFE's
+        // cellwise integral divided by the cell volume (the output's cell field)
+        Vec       vfe, vel;
+        PetscReal nref, ndiff;
+        PetscCall(fe.VonMises(u, &vfe));
+        PetscCall(el.VonMises(u, &vel));
+        PetscCall(VecNorm(vfe, NORM_INFINITY, &nref));
+        PetscCall(VecAXPY(vel, -1.0, vfe));
+        PetscCall(VecNorm(vel, NORM_INFINITY, &ndiff));
+        PetscCall(Check(comm, "cell von Mises stress of a random field (max)", ndiff, nref, 1e-12));
+        PetscCall(VecDestroy(&vfe));
+        PetscCall(VecDestroy(&vel));
+      }
       {
         // the local vector with the Dirichlet values: constant values inserted directly (element path)
         // against DMPlexInsertBoundaryValues's projection (PetscFE path); same numbering (cloned DM)

@@ -3,9 +3,10 @@
 // indices of every local cell (global, constrained dofs negative; local), the cell Jacobians, the exact
 // reference-element integrals of the basis gradients and values (the integrands are polynomials with a
 // cell-constant tensor: no quadrature per assembly), and a preallocated matrix pattern reused by every
-// assembly on the mesh. Computes A, the Dirichlet lifting -A_{free,constrained} u_D and the energy
-// 1/2 a(U, U) with the same basis ordering as PetscFE (its own tabulation); the PetscFE residual and
-// Jacobian of elasticity.cpp stay the reference (-fem_assembly petscfe, docs/fom_speed.md).
+// assembly on the mesh. Computes A, the Dirichlet lifting -A_{free,constrained} u_D, the energy
+// 1/2 a(U, U) and the cell means of the von Mises stress (the output's cell field) with the same basis
+// ordering and quadrature as PetscFE (its own tabulation); the PetscFE residual, Jacobian and cellwise
+// integral of elasticity.cpp stay the reference (-fem_assembly petscfe, docs/fom_speed.md).
 #pragma once
 #include <petscdmplex.h>
 #include <vector>
@@ -31,6 +32,7 @@ public:
     const std::vector<PetscInt>                *cellBody = nullptr;
     std::vector<const PetscReal *>              tensor;  // per body, dim^4 entries
     std::vector<PetscReal>                      mass;    // per body
+    std::vector<const PetscReal *>              lame;    // per body: L, G, G^-1 (dim x dim); VonMises only
   };
   // A (created from the cached pattern when *A is null; otherwise zeroed and refilled).
   PetscErrorCode AssembleMatrix(const Coefficients &k, Mat *A) const;
@@ -39,6 +41,11 @@ public:
   PetscErrorCode AddLifting(const Coefficients &k, Vec uloc, Vec f) const;
   // 1/2 a(U, U) of the full local field U (constrained dofs included), summed over the ranks.
   PetscErrorCode Energy(const Coefficients &k, Vec uloc, PetscReal *energy) const;
+  // Cell means of the von Mises stress of the local field U: vm[c - cStart] = the quadrature mean over the
+  // cell of sqrt(J2(sigma)), sigma = L tr(eps) I + 2 G eps of the physical gradient grad_xr u G^-1 (plane
+  // strain in 2D: sigma_zz = L tr eps), PetscFE's quadrature points and weights (what
+  // DMPlexComputeCellwiseIntegralFEM divided by the cell volume gives, without its per-cell cost).
+  PetscErrorCode VonMises(const Coefficients &k, Vec uloc, std::vector<PetscReal> *vm) const;
 
 private:
   PetscErrorCode CreatePattern();
@@ -53,6 +60,7 @@ private:
   std::vector<PetscInt>  comp_;              // component of each vector basis function
   std::vector<PetscReal> gradInt_;           // [i][j][alpha][beta] int dphi_i/dxi_alpha dphi_j/dxi_beta
   std::vector<PetscReal> massInt_;           // [i][j] int phi_i phi_j (same component only)
+  std::vector<PetscReal> qDer_, qWeight_;     // per quadrature point q: [q][i][alpha] dphi_i/dxi_alpha; weights
 };
 
 } // namespace rbc

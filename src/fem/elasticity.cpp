@@ -291,7 +291,7 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
     const char *types[] = {"element", "petscfe"};
     PetscInt    t       = elementAssembly_ ? 0 : 1;
     PetscOptionsBegin(comm, "fem_", "Finite-element assembly", "Elasticity");
-    PetscCall(PetscOptionsEList("-assembly", "Assembly of A, the lifting and the energy: element (cell tables and exact reference integrals, a cached pattern) or petscfe (PetscFE residual and Jacobian, the reference)", NULL, types, 2, types[t], &t, NULL));
+    PetscCall(PetscOptionsEList("-assembly", "Assembly of A, the lifting, the energy and the von Mises output: element (cell tables and exact reference integrals, a cached pattern) or petscfe (PetscFE residual and Jacobian, the reference)", NULL, types, 2, types[t], &t, NULL));
     PetscOptionsEnd();
     elementAssembly_ = t == 0;
   }
@@ -421,6 +421,7 @@ ElementAssembler::Coefficients Elasticity::ElementCoefficients() const
   for (const auto &a : bodyAux_) {
     k.tensor.push_back(a.data() + AuxTensorOffset());
     k.mass.push_back(a[AuxMassIndex()]);
+    k.lame.push_back(a.data()); // L, G, G^-1: the aux layout's head
   }
   return k;
 }
@@ -610,10 +611,35 @@ PetscErrorCode Elasticity::VonMises(Vec u, Vec *vm) const
   PetscInt cStart, cEnd;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDS(dm, &ds));
-  PetscCall(PetscDSSetObjective(ds, 0, obj_von_mises));
   PetscCall(DMCreateGlobalVector(dmCell, vm));
   PetscCall(PetscObjectSetName((PetscObject)*vm, "von_mises"));
+  if (elementAssembly_) {
+    // the same quadrature mean from the element tables: PETSc's cellwise integral cost 160 us a cell on
+    // P1 tetrahedra (12 of the 27 s of a hertz3d FOM, 2026-11-26; docs/fom_speed.md)
+    Vec                    uloc;
+    PetscSection           s;
+    PetscInt               rstart;
+    PetscScalar           *arr;
+    std::vector<PetscReal> cellVm;
+    PetscCall(EnsureElements());
+    PetscCall(DMGetLocalVector(dm, &uloc));
+    PetscCall(GlobalToLocalWithBC(u, uloc));
+    PetscCall(elem_.VonMises(ElementCoefficients(), uloc, &cellVm));
+    PetscCall(DMRestoreLocalVector(dm, &uloc));
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+    PetscCall(DMGetGlobalSection(dmCell, &s));
+    PetscCall(VecGetOwnershipRange(*vm, &rstart, NULL));
+    PetscCall(VecGetArray(*vm, &arr));
+    for (PetscInt c = cStart; c < cEnd; ++c) {
+      PetscInt off;
+      PetscCall(PetscSectionGetOffset(s, c, &off));
+      if (off >= 0) arr[off - rstart] = cellVm[c - cStart];
+    }
+    PetscCall(VecRestoreArray(*vm, &arr));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetObjective(ds, 0, obj_von_mises));
   PetscCall(DMPlexComputeCellwiseIntegralFEM(dm, u, *vm, NULL));
   // integral over the cell -> cell mean
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));

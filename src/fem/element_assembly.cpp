@@ -1,5 +1,6 @@
 // src/fem/element_assembly.cpp: element-by-element assembly of linear elasticity on affine simplices
-// (the tables, the preallocated pattern, A, the Dirichlet lifting, the energy). See element_assembly.hpp.
+// (the tables, the preallocated pattern, A, the Dirichlet lifting, the energy, the cell von Mises stress).
+// See element_assembly.hpp.
 #include "rbcontact/element_assembly.hpp"
 #include <petscds.h>
 #include <algorithm>
@@ -7,7 +8,7 @@
 
 namespace rbc {
 
-static PetscLogEvent EA_Setup = 0, EA_Matrix = 0, EA_Lifting = 0, EA_Energy = 0;
+static PetscLogEvent EA_Setup = 0, EA_Matrix = 0, EA_Lifting = 0, EA_Energy = 0, EA_VonMises = 0;
 
 void PullBackTensor(PetscInt dim, const PetscReal *T, const PetscReal *M, PetscReal scale, PetscReal *out)
 {
@@ -45,6 +46,7 @@ PetscErrorCode ElementAssembler::Setup(DM dm)
     PetscCall(PetscLogEventRegister("RBCElemMatrix", DM_CLASSID, &EA_Matrix));
     PetscCall(PetscLogEventRegister("RBCElemLifting", DM_CLASSID, &EA_Lifting));
     PetscCall(PetscLogEventRegister("RBCElemEnergy", DM_CLASSID, &EA_Energy));
+    PetscCall(PetscLogEventRegister("RBCElemVonMises", DM_CLASSID, &EA_VonMises));
   }
   PetscCall(PetscLogEventBegin(EA_Setup, 0, 0, 0, 0));
   PetscCall(MatDestroy(&pattern_));
@@ -94,6 +96,11 @@ PetscErrorCode ElementAssembler::Setup(DM dm)
           for (PetscInt b = 0; b < d; ++b) g[a * d + b] += qweights[p] * gi[a] * gj[b];
         if (comp_[i] == comp_[j]) massInt_[(size_t)i * nb + j] += qweights[p] * B[(p * nb + i) * Nc + comp_[i]] * B[(p * nb + j) * Nc + comp_[j]];
       }
+  qWeight_.assign(qweights, qweights + nq);
+  qDer_.assign((size_t)nq * nb * d, 0.0);
+  for (PetscInt p = 0; p < nq; ++p)
+    for (PetscInt i = 0; i < nb; ++i)
+      for (PetscInt a = 0; a < d; ++a) qDer_[((size_t)p * nb + i) * d + a] = D[((p * nb + i) * Nc + comp_[i]) * d + a];
 
   // Per-cell tables: closure indices (global as DMPlexMatSetClosure uses them: constrained dofs
   // negative; local: offsets in the local vector, closure order) and the affine geometry.
@@ -329,6 +336,53 @@ PetscErrorCode ElementAssembler::Energy(const Coefficients &k, Vec uloc, PetscRe
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &e, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm_)));
   *energy = e;
   PetscCall(PetscLogEventEnd(EA_Energy, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ElementAssembler::VonMises(const Coefficients &k, Vec uloc, std::vector<PetscReal> *vm) const
+{
+  const PetscScalar *u;
+  const PetscInt     d = dim_, nb = nb_, nq = (PetscInt)qWeight_.size();
+
+  PetscFunctionBeginUser;
+  PetscCheck(Ready(), PETSC_COMM_SELF, PETSC_ERR_ORDER, "ElementAssembler: Setup() first");
+  PetscCheck(k.lame.size() == k.tensor.size(), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "ElementAssembler::VonMises: %zu bodies with Lame data, %zu with tensors", k.lame.size(), k.tensor.size());
+  PetscCall(PetscLogEventBegin(EA_VonMises, 0, 0, 0, 0));
+  PetscReal wsum = 0;
+  for (PetscInt p = 0; p < nq; ++p) wsum += qWeight_[p];
+  vm->assign(cEnd_ - cStart_, 0.0);
+  PetscCall(VecGetArrayRead(uloc, &u));
+  for (PetscInt c = cStart_; c < cEnd_; ++c) {
+    const PetscInt  *lx = &lidx_[(size_t)(c - cStart_) * nb];
+    const PetscReal *iJ = &invJ_[(size_t)(c - cStart_) * d * d], *lame = k.lame[(*k.cellBody)[c - cStart_]];
+    const PetscReal  L = lame[0], G = lame[1], *Ginv = lame + 2;
+    PetscReal        mean = 0;
+    for (PetscInt p = 0; p < nq; ++p) {
+      PetscReal gr[9] = {0}, gx[9], s[3][3] = {{0}}, tr = 0; // grad_xr u [c][b], then the physical gradient
+      for (PetscInt i = 0; i < nb; ++i) {
+        const PetscReal *D = &qDer_[((size_t)p * nb + i) * d], ui = PetscRealPart(u[lx[i]]);
+        for (PetscInt b = 0; b < d; ++b) {
+          PetscReal db = 0;
+          for (PetscInt a = 0; a < d; ++a) db += D[a] * iJ[a * d + b];
+          gr[comp_[i] * d + b] += ui * db;
+        }
+      }
+      for (PetscInt cc = 0; cc < d; ++cc)
+        for (PetscInt dd = 0; dd < d; ++dd) {
+          gx[cc * d + dd] = 0;
+          for (PetscInt m = 0; m < d; ++m) gx[cc * d + dd] += gr[cc * d + m] * Ginv[m * d + dd];
+        }
+      for (PetscInt dd = 0; dd < d; ++dd) tr += gx[dd * d + dd];
+      for (PetscInt cc = 0; cc < d; ++cc)
+        for (PetscInt dd = 0; dd < d; ++dd) s[cc][dd] = G * (gx[cc * d + dd] + gx[dd * d + cc]) + (cc == dd ? L * tr : 0);
+      if (d == 2) s[2][2] = L * tr; // plane strain
+      const PetscReal j2 = 0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) + (s[1][1] - s[2][2]) * (s[1][1] - s[2][2]) + (s[2][2] - s[0][0]) * (s[2][2] - s[0][0])) + 3 * (s[0][1] * s[0][1] + s[1][2] * s[1][2] + s[0][2] * s[0][2]);
+      mean += qWeight_[p] * std::sqrt(j2);
+    }
+    (*vm)[c - cStart_] = mean / wsum; // |det J| is constant on the cell: it cancels
+  }
+  PetscCall(VecRestoreArrayRead(uloc, &u));
+  PetscCall(PetscLogEventEnd(EA_VonMises, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
