@@ -661,14 +661,22 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   pastMasterEnd_.clear();
   points_.clear();
 
-  std::vector<PetscInt>    cols, near3, kRow, kCol, kPtr(1, 0);
-  std::vector<PetscScalar> vals, kVal;
+  std::vector<PetscInt>    near3, kRow, kCol, kPtr(1, 0);
+  std::vector<PetscScalar> kVal;
   // the row vectors accumulated here by global row and set once at the end (one VecSetValue per contribution was 13 %
   // of the contact assembly on hertz3d, 2026-11-26): weight, normal, g (added), coordinates (inserted)
   RowAccumulator           acc(R_, dim);
   kRow.reserve(kReserve_[0]);
   kCol.reserve(kReserve_[1]);
   kVal.reserve(kReserve_[1]);
+  // a slave facet's contributions to its rows summed first, over its integration points (one piece per facet and row
+  // instead of one per integration point and row: 3D clipping gives tens of points a facet, and the buffered pieces
+  // were tens of MB per assembly on hertz3d, 2026-11-26); slot marks a column's place in the facet's list fCol, fVal
+  // and fHit hold [column][row of the facet]
+  std::vector<PetscInt>    slot((size_t)N, -1), fCol;
+  std::vector<PetscScalar> fVal;
+  std::vector<char>        fHit;
+  bool                     rowHit[3];
   PetscReal                reach3 = 0;
   const PetscInt           nq = (PetscInt)quadWeights_.size();
   for (size_t s = 0; s < slave_.facets.size(); ++s) {
@@ -708,6 +716,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
     } else {
       for (PetscInt qp = 0; qp < nq; ++qp) ipts.push_back({quadPoints_[qp * nv], quadPoints_[qp * nv + 1], quadPoints_[qp * nv + 2], quadWeights_[qp] * meas});
     }
+    for (PetscInt k = 0; k < nv; ++k) rowHit[k] = false;
     for (const auto &ip : ipts) {
       const PetscReal  b[3] = {ip[0], ip[1], ip[2]}, w = ip[3];
       ContactPointEval e;
@@ -772,29 +781,50 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
           for (PetscInt d = 0; d < dim; ++d) acc.normal[d][r] += w * b[k] * n2[d];
         }
         if (psi == 0.0) continue;
-        PetscScalar    gk = w * psi * gap;
-        cols.clear();
-        vals.clear();
+        PetscScalar gk  = w * psi * gap;
+        auto        add = [&](PetscInt col, PetscScalar v) {
+          PetscInt &sl = slot[col];
+          if (sl < 0) {
+            sl = (PetscInt)fCol.size();
+            fCol.push_back(col);
+            fVal.insert(fVal.end(), nv, 0.0);
+            fHit.insert(fHit.end(), nv, 0);
+          }
+          fVal[(size_t)sl * nv + k] += v;
+          fHit[(size_t)sl * nv + k] = 1;
+        };
         for (PetscInt a = 0; a < F.nnodes; ++a)
           for (PetscInt d = 0; d < dim; ++d) {
             const PetscReal coef = -w * psi * Ns[a] * n2[d];
-            if (F.dof[a * dim + d] >= 0) { cols.push_back(F.dof[a * dim + d]); vals.push_back(coef); }
+            if (F.dof[a * dim + d] >= 0) add(F.dof[a * dim + d], coef);
             else gk -= coef * F.Ubc[a * dim + d];
           }
         for (PetscInt a = 0; a < M.nnodes; ++a)
           for (PetscInt d = 0; d < dim; ++d) {
             const PetscReal coef = w * psi * Nm[a] * n2[d];
-            if (M.dof[a * dim + d] >= 0) { cols.push_back(M.dof[a * dim + d]); vals.push_back(coef); }
+            if (M.dof[a * dim + d] >= 0) add(M.dof[a * dim + d], coef);
             else gk -= coef * M.Ubc[a * dim + d];
           }
-        kRow.push_back(r); // K's rows are buffered: its exact pattern preallocates it below
-        kCol.insert(kCol.end(), cols.begin(), cols.end());
-        kVal.insert(kVal.end(), vals.begin(), vals.end());
-        kPtr.push_back((PetscInt)kCol.size());
+        rowHit[k] = true;
         acc.Touch(r);
         acc.g[r] += gk;
       }
     }
+    // the facet's rows buffered (K's exact pattern preallocates it below), its columns unmarked
+    for (PetscInt k = 0; k < nv; ++k) {
+      if (!rowHit[k]) continue;
+      kRow.push_back(rows[k]);
+      for (size_t j = 0; j < fCol.size(); ++j)
+        if (fHit[j * nv + k]) {
+          kCol.push_back(fCol[j]);
+          kVal.push_back(fVal[j * nv + k]);
+        }
+      kPtr.push_back((PetscInt)kCol.size());
+    }
+    for (PetscInt c : fCol) slot[c] = -1;
+    fCol.clear();
+    fVal.clear();
+    fHit.clear();
     for (PetscInt k = 0; k < nv; ++k) {
       acc.TouchCoord(rows[k]);
       for (PetscInt d = 0; d < dim; ++d) {
@@ -824,9 +854,9 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   }
   searchStats_.farPoints = farPoints;
   // The buffered rows merged: one row per multiplier with its columns sorted and unique, the contributions of an entry
-  // summed in the order they came (what ADD_VALUES into K would sum, so a row owned here gets the same bits); a
-  // slave node's row came in one piece per integration cell and quadrature point (measured 2026-11-26: the
-  // MatSetValues of the unmerged pieces were half of the contact assembly on hertz3d)
+  // summed in the order they came (facet by facet, each facet's already summed over its integration points); a
+  // slave node's row came in one piece per adjacent slave facet (measured 2026-11-26: the MatSetValues of the
+  // unmerged pieces, one per integration point then, were half of the contact assembly on hertz3d)
   std::vector<PetscInt>    mRow, mPtr(1, 0), mCol;
   std::vector<PetscScalar> mVal;
   {
@@ -838,8 +868,7 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       std::vector<PetscInt> next(start.begin(), start.end() - 1);
       for (size_t i = 0; i < kRow.size(); ++i) piece[next[kRow[i]]++] = (PetscInt)i;
     }
-    std::vector<PetscInt>                              slot((size_t)N, -1);
-    std::vector<std::pair<PetscInt, PetscScalar>>      entries; // this row's (column, sum)
+    std::vector<std::pair<PetscInt, PetscScalar>>      entries; // this row's (column, sum); slot: unmarked above
     for (PetscInt r = 0; r < R_; ++r) {
       if (start[r] == start[(size_t)r + 1]) continue;
       entries.clear();
