@@ -17,6 +17,11 @@ namespace rbc {
 // fourth-order tensor's derivative indices pulled back by M (the physical tensor by G^-1, the cell's by J^-1).
 void PullBackTensor(PetscInt dim, const PetscReal *T, const PetscReal *M, PetscReal scale, PetscReal *out);
 
+// Von Mises stress of the displacement gradient gr[c][b] = du_c/dxr_b on the reference mesh: the physical gradient
+// gr G^-1 (Ginv dim x dim row-major), sigma = L tr(eps) I + 2 G eps (plane strain in 2D: sigma_zz = L tr eps),
+// sqrt(J2(sigma)). The one formula of the PetscFE pointwise function and of ElementAssembler::VonMises.
+PetscReal VonMisesStress(PetscInt dim, const PetscReal *gr, PetscReal L, PetscReal G, const PetscReal *Ginv);
+
 class ElementAssembler {
 public:
   ElementAssembler() = default;

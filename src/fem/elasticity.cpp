@@ -54,17 +54,6 @@ static void g3_stiffness(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscI
         for (PetscInt b = 0; b < dim; ++b) g3[((c * dim + e) * dim + aa) * dim + b] += a[RBC_AUX_T + ((c * dim + aa) * dim + e) * dim + b];
 }
 
-// Physical displacement gradient: du_c/dx_d = sum_a du_c/dxr_a (G^-1)_{a d}
-static void PhysicalGradient(PetscInt dim, const PetscScalar u_x[], const PetscScalar a[], PetscScalar gx[])
-{
-  const PetscScalar *Ginv = a + RBC_AUX_GINV;
-  for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt d = 0; d < dim; ++d) {
-      gx[c * dim + d] = 0;
-      for (PetscInt k = 0; k < dim; ++k) gx[c * dim + d] += u_x[c * dim + k] * Ginv[k * dim + d];
-    }
-}
-
 // Energy density in the reference configuration: 1/2 grad u : T : grad u (includes |det G|).
 static void EnergyDensity(PetscInt dim, const PetscScalar u_x[], const PetscScalar a[], PetscScalar *w)
 {
@@ -78,15 +67,7 @@ static void obj_energy(RBC_POINTWISE_ARGS, PetscScalar obj[]) { EnergyDensity(di
 
 static void obj_von_mises(RBC_POINTWISE_ARGS, PetscScalar obj[])
 {
-  const PetscScalar L = a[RBC_AUX_L], G = a[RBC_AUX_G];
-  PetscScalar       s[3][3] = {{0}}, tr = 0, gx[9];
-  PhysicalGradient(dim, u_x, a, gx);
-  for (PetscInt d = 0; d < dim; ++d) tr += gx[d * dim + d];
-  for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt d = 0; d < dim; ++d) s[c][d] = G * (gx[c * dim + d] + gx[d * dim + c]) + (c == d ? L * tr : 0);
-  if (dim == 2) s[2][2] = L * tr; // plane strain
-  const PetscScalar j2 = 0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) + (s[1][1] - s[2][2]) * (s[1][1] - s[2][2]) + (s[2][2] - s[0][0]) * (s[2][2] - s[0][0])) + 3 * (s[0][1] * s[0][1] + s[1][2] * s[1][2] + s[0][2] * s[0][2]);
-  obj[0] = PetscSqrtReal(PetscRealPart(j2));
+  obj[0] = rbc::VonMisesStress(dim, u_x, PetscRealPart(a[RBC_AUX_L]), PetscRealPart(a[RBC_AUX_G]), a + RBC_AUX_GINV);
 }
 
 template <int K>

@@ -24,6 +24,22 @@ void PullBackTensor(PetscInt dim, const PetscReal *T, const PetscReal *M, PetscR
         }
 }
 
+PetscReal VonMisesStress(PetscInt dim, const PetscReal *gr, PetscReal L, PetscReal G, const PetscReal *Ginv)
+{
+  PetscReal s[3][3] = {{0}}, tr = 0, gx[9];
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt d = 0; d < dim; ++d) {
+      gx[c * dim + d] = 0;
+      for (PetscInt k = 0; k < dim; ++k) gx[c * dim + d] += gr[c * dim + k] * Ginv[k * dim + d];
+    }
+  for (PetscInt d = 0; d < dim; ++d) tr += gx[d * dim + d];
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt d = 0; d < dim; ++d) s[c][d] = G * (gx[c * dim + d] + gx[d * dim + c]) + (c == d ? L * tr : 0);
+  if (dim == 2) s[2][2] = L * tr; // plane strain
+  const PetscReal j2 = 0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) + (s[1][1] - s[2][2]) * (s[1][1] - s[2][2]) + (s[2][2] - s[0][0]) * (s[2][2] - s[0][0])) + 3 * (s[0][1] * s[0][1] + s[1][2] * s[1][2] + s[0][2] * s[0][2]);
+  return std::sqrt(j2);
+}
+
 ElementAssembler::~ElementAssembler()
 {
   (void)MatDestroy(&pattern_);
@@ -358,7 +374,7 @@ PetscErrorCode ElementAssembler::VonMises(const Coefficients &k, Vec uloc, std::
     const PetscReal  L = lame[0], G = lame[1], *Ginv = lame + 2;
     PetscReal        mean = 0;
     for (PetscInt p = 0; p < nq; ++p) {
-      PetscReal gr[9] = {0}, gx[9], s[3][3] = {{0}}, tr = 0; // grad_xr u [c][b], then the physical gradient
+      PetscReal gr[9] = {0}; // grad_xr u [c][b]
       for (PetscInt i = 0; i < nb; ++i) {
         const PetscReal *D = &qDer_[((size_t)p * nb + i) * d], ui = PetscRealPart(u[lx[i]]);
         for (PetscInt b = 0; b < d; ++b) {
@@ -367,17 +383,7 @@ PetscErrorCode ElementAssembler::VonMises(const Coefficients &k, Vec uloc, std::
           gr[comp_[i] * d + b] += ui * db;
         }
       }
-      for (PetscInt cc = 0; cc < d; ++cc)
-        for (PetscInt dd = 0; dd < d; ++dd) {
-          gx[cc * d + dd] = 0;
-          for (PetscInt m = 0; m < d; ++m) gx[cc * d + dd] += gr[cc * d + m] * Ginv[m * d + dd];
-        }
-      for (PetscInt dd = 0; dd < d; ++dd) tr += gx[dd * d + dd];
-      for (PetscInt cc = 0; cc < d; ++cc)
-        for (PetscInt dd = 0; dd < d; ++dd) s[cc][dd] = G * (gx[cc * d + dd] + gx[dd * d + cc]) + (cc == dd ? L * tr : 0);
-      if (d == 2) s[2][2] = L * tr; // plane strain
-      const PetscReal j2 = 0.5 * ((s[0][0] - s[1][1]) * (s[0][0] - s[1][1]) + (s[1][1] - s[2][2]) * (s[1][1] - s[2][2]) + (s[2][2] - s[0][0]) * (s[2][2] - s[0][0])) + 3 * (s[0][1] * s[0][1] + s[1][2] * s[1][2] + s[0][2] * s[0][2]);
-      mean += qWeight_[p] * std::sqrt(j2);
+      mean += qWeight_[p] * VonMisesStress(d, gr, L, G, Ginv);
     }
     (*vm)[c - cStart_] = mean / wsum; // |det J| is constant on the cell: it cancels
   }
