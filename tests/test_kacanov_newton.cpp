@@ -12,6 +12,8 @@
 //      y = the solution plus a random field): with the scene's rule to -test_fd_rtol (1e-3: the segment-based
 //      rule's moving cuts are left out, 5e-7 to 6e-4 measured), with fixed composite points (the pointwise
 //      derivative alone) to -test_fd_rtol_fixed (1e-8; 8e-11 to 9e-10 measured).
+//   4. GatherRowsOnDofs (the contact matrix's rows on the contact dofs, gathered by rows on every rank: the dense
+//      dual path's K_D) against PETSc's MatMult and MatMultTranspose with K itself, in a random direction, to 1e-14.
 // Serial and parallel (the tangent is gathered on every rank; the direction is the same on every rank).
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov.hpp"
@@ -140,6 +142,66 @@ static PetscErrorCode TangentCheck(MPI_Comm comm, ElasticFOM &fom, ContactMap &m
   PetscFunctionReturn(0);
 }
 
+// GatherRowsOnDofs: K_D x and K_D' y from the gathered rows against MatMult / MatMultTranspose with K (x on the
+// contact dofs, zero elsewhere; the same random x and y on every rank).
+static PetscErrorCode GatherCheck(MPI_Comm comm, const ContactMap &map, Mat K)
+{
+  std::vector<PetscInt>  D;
+  SparseRows             KD;
+  PetscInt               R, n, lo, hi;
+  std::vector<PetscReal> kx, kty, x, y;
+  Vec                    xv, yv, kxv, ktyv;
+
+  PetscFunctionBeginUser;
+  PetscCall(map.SurfaceDofs(comm, &D));
+  PetscCall(GatherRowsOnDofs(K, D, &KD));
+  PetscCall(MatGetSize(K, &R, &n));
+  PetscCall(MatCreateVecs(K, &xv, &yv));
+  PetscCall(VecDuplicate(yv, &kxv));
+  PetscCall(VecDuplicate(xv, &ktyv));
+  std::mt19937                           gen(11);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (size_t j = 0; j < D.size(); ++j) x.push_back(U(gen));
+  for (PetscInt i = 0; i < R; ++i) y.push_back(U(gen));
+  PetscCall(VecGetOwnershipRange(xv, &lo, &hi));
+  for (size_t j = 0; j < D.size(); ++j)
+    if (D[j] >= lo && D[j] < hi) PetscCall(VecSetValue(xv, D[j], x[j], INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(xv));
+  PetscCall(VecAssemblyEnd(xv));
+  PetscCall(VecGetOwnershipRange(yv, &lo, &hi));
+  for (PetscInt i = lo; i < hi; ++i) PetscCall(VecSetValue(yv, i, y[i], INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(yv));
+  PetscCall(VecAssemblyEnd(yv));
+  PetscCall(MatMult(K, xv, kxv));
+  PetscCall(MatMultTranspose(K, yv, ktyv));
+  PetscCall(GatherVec(kxv, &kx));
+  PetscCall(ValuesAt(ktyv, D, &kty));
+  PetscReal ex = 0, nx = 0, ey = 0, ny = 0;
+  std::vector<PetscReal> t(D.size(), 0.0);
+  for (PetscInt i = 0; i < R; ++i) {
+    PetscReal v = 0;
+    for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) {
+      v += KD.val[e] * x[KD.col[e]];
+      t[KD.col[e]] += KD.val[e] * y[i];
+    }
+    ex = std::max(ex, std::abs(v - kx[i]));
+    nx = std::max(nx, std::abs(kx[i]));
+  }
+  for (size_t j = 0; j < D.size(); ++j) {
+    ey = std::max(ey, std::abs(t[j] - kty[j]));
+    ny = std::max(ny, std::abs(kty[j]));
+  }
+  const bool shape = KD.rows == R && KD.cols == (PetscInt)D.size() && (PetscInt)KD.ptr.size() == R + 1 && KD.ptr[R] == (PetscInt)KD.col.size() && KD.col.size() == KD.val.size() && KD.ptr[R] > 0;
+  PetscCall(Check(comm, shape, "GatherRowsOnDofs: R + 1 row pointers, as many columns as values, some nonzeros", (double)KD.ptr[R], 1.0));
+  PetscCall(Check(comm, nx > 0 && ex <= 1e-14 * nx, "GatherRowsOnDofs: K_D x against MatMult (max abs error / max |K x|)", nx > 0 ? ex / nx : 1.0, 1e-14));
+  PetscCall(Check(comm, ny > 0 && ey <= 1e-14 * ny, "GatherRowsOnDofs: K_D' y against MatMultTranspose", ny > 0 ? ey / ny : 1.0, 1e-14));
+  PetscCall(VecDestroy(&xv));
+  PetscCall(VecDestroy(&yv));
+  PetscCall(VecDestroy(&kxv));
+  PetscCall(VecDestroy(&ktyv));
+  PetscFunctionReturn(0);
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
@@ -208,6 +270,7 @@ int main(int argc, char **argv)
     fixedPoints.SetGeometry(&fom.map, fom.mu);
     fixedPoints.quadrature = ContactQuadrature::Composite;
     PetscCall(TangentCheck(comm, fom, fixedPoints, nw.lambda, fdTolFixed, "composite"));
+    PetscCall(GatherCheck(comm, map, nw.sys.K));
   }
   PetscCall(PetscPrintf(comm, "%s (%d failure(s))\n", failures ? "FAILED" : "passed", failures));
   PetscCall(PetscFinalize());

@@ -7,8 +7,9 @@
 // closing (fork on rank 0, two snapshots, _exit(9)) leaves a file that restarts with exactly those
 // two done and readable; a writer killed by SIGKILL at an arbitrary moment of a loop of rewrites
 // leaves a file that reopens, every done row complete. ImportSnapshotMatrix: HDF5 (rows = dofs,
-// and -import_transpose), PETSc binary dense and AIJ, and its errors. The contact matrix (dense in the file) is
-// kept by its nonzeros after ReadAll (CompactContactMatrix), bit for bit; a wrong length is refused. Scratch files live in /tmp/rbc_test_snapshot_file.<pid>.
+// and -import_transpose), PETSc binary dense and AIJ, and its errors. A version-1 file (dense contact matrices in
+// the extras contact_K, contact_dofs) is read without them and upgraded by a restart; an unknown version is refused.
+// Scratch files live in /tmp/rbc_test_snapshot_file.<pid>.
 #include "rbcontact/snapshot_file.hpp"
 #include <hdf5.h>
 #include <petscmat.h>
@@ -364,40 +365,62 @@ int main(int argc, char **argv)
     PetscCall(f.Close());
   }
   PetscCall(ReadAllChecked(path, h, {0, 1, 2, 3, 4}, "after the restart"));
-  { // the contact matrix: dense in the file (/snapshots/extra/contact_K), its nonzeros by rows after ReadAll
-    const std::string     kpath = dir + "/contact_k.h5";
-    const PetscInt        nD    = 5, R = h.nmult;
-    Snapshot              s     = MakeSnapshot(h, 1);
-    std::vector<PetscReal> K((size_t)R * nD, 0.0);
-    for (PetscInt i = 0; i < R; ++i)
-      for (PetscInt c = 0; c < nD; ++c)
-        if ((i + 2 * c) % 3 == 0) K[(size_t)i * nD + c] = 1.0 + i - 0.25 * c; // includes a row without entries when R > 2
-    s.extra["contact_K"]    = K;
+  { // a version-1 file (until 2026-11-27: each snapshot's contact matrix dense in the extras contact_K and
+    // contact_dofs): read with those two skipped and the other extras kept; a restart upgrades it to version 2
+    // before writing; a version this build does not know is refused, naming it
+    const std::string kpath = dir + "/version1.h5";
+    Snapshot          s     = MakeSnapshot(h, 1);
+    s.extra["contact_K"]    = std::vector<PetscReal>((size_t)h.nmult * 5, 1.5);
     s.extra["contact_dofs"] = {4, 9, 11, 20, 21};
+    s.extra["contact_gap"]  = std::vector<PetscReal>(h.nmult, 0.25);
     {
       SnapshotFile f;
       PetscCall(f.Open(PETSC_COMM_WORLD, kpath, h, false));
       PetscCall(f.Write(s));
       PetscCall(f.Close());
     }
+    auto setVersion = [&](int v) { // rank 0 rewrites the attribute, as a file of that version would hold it
+      bool ok = true;
+      if (rank == 0) {
+        hid_t f = H5Fopen(kpath.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), a = f >= 0 ? H5Aopen(f, "format_version", H5P_DEFAULT) : -1;
+        ok      = a >= 0 && H5Awrite(a, H5T_NATIVE_INT, &v) >= 0;
+        if (a >= 0) H5Aclose(a);
+        if (f >= 0) H5Fclose(f);
+      }
+      MPI_Barrier(PETSC_COMM_WORLD);
+      return ok;
+    };
+    auto getVersion = [&]() {
+      int v = -1;
+      if (rank == 0) {
+        hid_t f = H5Fopen(kpath.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), a = f >= 0 ? H5Aopen(f, "format_version", H5P_DEFAULT) : -1;
+        if (a < 0 || H5Aread(a, H5T_NATIVE_INT, &v) < 0) v = -1;
+        if (a >= 0) H5Aclose(a);
+        if (f >= 0) H5Fclose(f);
+      }
+      MPI_Bcast(&v, 1, MPI_INT, 0, PETSC_COMM_WORLD);
+      return v;
+    };
+    Check(getVersion() == 2, "a new file says format_version 2");
+    Check(setVersion(1), "the file marked version 1");
     std::vector<Snapshot> snaps;
     PetscCall(SnapshotFile::ReadAll(kpath, &snaps));
-    bool ok = snaps.size() == 1 && !snaps[0].extra.count("contact_K") && snaps[0].extra.count("contact_dofs") && snaps[0].contactK.rows == R && snaps[0].contactK.cols == nD && (PetscInt)snaps[0].contactK.ptr.size() == R + 1;
-    std::vector<PetscReal> back((size_t)R * nD, 0.0);
-    if (ok)
-      for (PetscInt i = 0; i < R; ++i)
-        for (PetscInt e = snaps[0].contactK.ptr[i]; e < snaps[0].contactK.ptr[i + 1]; ++e) {
-          ok = ok && snaps[0].contactK.val[e] != 0;
-          back[(size_t)i * nD + snaps[0].contactK.col[e]] = snaps[0].contactK.val[e];
-        }
-    Check(ok && SameBits(back, K), "contact_K: ReadAll keeps its nonzeros by rows (the dense copy dropped), equal bit for bit");
-    Snapshot bad = MakeSnapshot(h, 1);
-    bad.extra["contact_K"]    = std::vector<PetscReal>((size_t)R * nD + 1, 1.0);
-    bad.extra["contact_dofs"] = {4, 9, 11, 20, 21};
+    Check(snaps.size() == 1 && !snaps[0].extra.count("contact_K") && !snaps[0].extra.count("contact_dofs") && snaps[0].extra.count("contact_gap") && SameBits(snaps[0].extra["contact_gap"], s.extra["contact_gap"]) && SameBits(snaps[0].u, s.u),
+          "version 1: ReadAll skips contact_K and contact_dofs, keeps the other extras and u bit for bit");
+    {
+      SnapshotFile          f;
+      std::vector<PetscInt> done;
+      PetscCall(f.Open(PETSC_COMM_WORLD, kpath, h, true));
+      PetscCall(f.DoneIndices(&done));
+      PetscCall(f.Close());
+      Check(done == std::vector<PetscInt>{1}, "version 1: the restart sees its done snapshot");
+    }
+    Check(getVersion() == 2, "version 1: a restart upgrades the file to format_version 2");
+    Check(setVersion(3), "the file marked version 3");
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    PetscErrorCode code = CompactContactMatrix(&bad);
+    PetscErrorCode code = SnapshotFile::ReadAll(kpath, &snaps);
     PetscCall(PetscPopErrorHandler());
-    CheckError(code, "a contact matrix of the wrong length", {"contact matrix of", "contact dofs"});
+    CheckError(code, "a format_version this build does not read", {"version1.h5", "format_version 3", "versions 1 to 2"});
     PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
   }
   {

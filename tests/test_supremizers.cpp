@@ -78,15 +78,21 @@ int main(int argc, char **argv)
   std::uniform_real_distribution<> U(0, 1);
   // synthetic data, the same on every rank
   std::vector<std::vector<double>> K(m, std::vector<double>((size_t)R * n));
-  std::vector<rbc::Snapshot>       snaps(m);
+  rbc::SnapshotContactMatrices     snaps; // the snapshots' contact matrices by rows, columns = all n dofs
+  for (PetscInt d = 0; d < n; ++d) snaps.dofs.push_back(d);
   for (PetscInt j = 0; j < m; ++j) {
     for (auto &x : K[j]) x = U(gen) - 0.5;
-    snaps[j].index                 = j;
-    snaps[j].extra["contact_K"]    = K[j];
-    snaps[j].extra["contact_dofs"] = std::vector<double>(n);
-    for (PetscInt d = 0; d < n; ++d) snaps[j].extra["contact_dofs"][d] = d;
-    snaps[j].lambda.assign(R, 0.0);
-    PetscCall(rbc::CompactContactMatrix(&snaps[j])); // as SnapshotFile::ReadAll keeps it
+    rbc::SparseRows &Kj = snaps.K.emplace_back();
+    Kj.rows             = R;
+    Kj.cols             = n;
+    for (PetscInt i = 0; i < R; ++i) {
+      for (PetscInt d = 0; d < n; ++d) {
+        Kj.col.push_back(d);
+        Kj.val.push_back(K[j][(size_t)i * n + d]);
+      }
+      Kj.ptr.push_back((PetscInt)Kj.col.size());
+    }
+    snaps.index.push_back(j);
   }
   rbc::DenseMatrix W;
   W.Resize(R, r);

@@ -21,6 +21,7 @@
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov_loop.hpp"
 #include "rbcontact/saddle_active_set.hpp"
+#include "rbcontact/sparse_rows.hpp"
 
 namespace rbc {
 
@@ -35,7 +36,7 @@ struct KacanovNewtonData {
   const std::vector<PetscInt> *D   = nullptr; // the sorted contact dofs (nD)
   PetscInt                     R   = 0;
   const PetscReal             *G   = nullptr; // compliance (A^-1)_DD, nD x nD
-  const PetscReal             *KD  = nullptr; // K on D, R x nD (column-major)
+  const SparseRows            *KD  = nullptr; // K on D, R x nD (GatherRowsOnDofs)
   const PetscReal             *T   = nullptr; // G K_D^T, nD x R
   const PetscReal             *S   = nullptr; // K_D G K_D^T, R x R
   const PetscReal             *lam = nullptr; // the QP's multipliers at x (R)
@@ -128,8 +129,9 @@ struct ContactSummary {
   PetscReal pressureSpread = 0; // 2D: max/min - 1 of the nodal pressure over the active nodes but the two ends
   PetscReal pressureRoughness = 0; // 2D: RMS of the second difference of the nodal pressure over the active nodes but the two ends, / their mean (node-to-node oscillation)
 };
-// Rows of K restricted to the sorted global dofs D: dense R x nD, column-major, on every rank.
-PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD);
+// Rows of K restricted to the sorted global dofs D, on every rank: R rows in K's global order, the columns their
+// positions in D (ascending within a row), exact zeros dropped. Collective.
+PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, SparseRows *KD);
 
 // Warnings about a converged contact solution (collective): the contact zone reaching an end of the
 // declared slave surface (contact beyond it is not enforced: the slave may penetrate there).

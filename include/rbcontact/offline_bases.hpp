@@ -31,6 +31,7 @@ struct OfflineBasisSet {
   std::vector<double>  modes;            // the same N columns, N x ndofs canonical, on every rank of fom's communicator
   bool                 massWeighted = false;
   PetscLogDouble       seconds[2]   = {0, 0}; // POD, dual basis
+  PetscLogDouble       contactSeconds = 0;      // the snapshots' contact matrices reassembled for the supremizers
   // -estimate (docs/error_estimate.md): the bases are computed to the tighter -estimate_pod_tol / -estimate_dual_tol;
   // the answer uses the leading nDefault POD modes and rDefault dual vectors (what -pod_tol / -dual_tol choose), the
   // rest is the online error estimate's enrichment (-1: none of that kind)

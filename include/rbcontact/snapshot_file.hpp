@@ -30,13 +30,6 @@ struct SnapshotHeader {
   PetscInt                             nmult = 0;      // length of lambda (R)
 };
 
-// A sparse matrix by rows (CSR).
-struct SparseRows {
-  PetscInt               rows = 0, cols = 0;
-  std::vector<PetscInt>  ptr{0}, col; // row i: entries [ptr[i], ptr[i + 1])
-  std::vector<PetscReal> val;
-};
-
 // Per-snapshot data (all arrays in canonical ordering, identical on any rank count).
 struct Snapshot {
   PetscInt                                 index = -1; // position in the training set
@@ -47,16 +40,10 @@ struct Snapshot {
   std::vector<PetscReal>                   kkt;    // primal, dual, complementarity, stationarity
   PetscReal                                seconds = 0;
   // Named extra arrays (EIM data: contact map and gap at the converged state, ...), fixed length
-  // per name across snapshots (the first snapshot written fixes it).
+  // per name across snapshots (the first snapshot written fixes it). ReadAll skips the version-1 files' dense
+  // contact matrices (contact_K, contact_dofs): the offline stage reassembles them from u (SnapshotContactMatrices).
   std::map<std::string, std::vector<PetscReal>> extra;
-  // The contact matrix on the contact dofs (nmult x contact_dofs, canonical orders) by rows: the file holds it dense
-  // (/snapshots/extra/contact_K, 421 MB a snapshot at 5.4e5 3D dofs, nearly all zeros); ReadAll keeps this instead.
-  SparseRows contactK;
 };
-
-// Moves extra["contact_K"] (dense, nmult x contact_dofs row-major) into s->contactK (its nonzeros) and drops the dense
-// copy; nothing without it. Errors: a length that is not nmult x contact_dofs.
-PetscErrorCode CompactContactMatrix(Snapshot *s);
 
 class SnapshotFile {
 public:
@@ -67,7 +54,8 @@ public:
 
   // Creates path (temp file + rename after the header) or, with restart = true and an existing file,
   // opens it and checks that its header matches (sceneHash, meshChecksum, paramNames, boxes, the
-  // training points to 1e-14, ndofs, nmult). Collective on comm; only rank 0 touches the file.
+  // training points to 1e-14, ndofs, nmult); a version-1 file is upgraded to version 2 (its attribute) before any
+  // write. Collective on comm; only rank 0 touches the file.
   PetscErrorCode Open(MPI_Comm comm, const std::string &path, const SnapshotHeader &header, bool restart);
   // Indices of the training set already stored (done flags), on every rank.
   PetscErrorCode DoneIndices(std::vector<PetscInt> *done) const;

@@ -13,7 +13,7 @@
 #include <slepcbv.h>
 #include <vector>
 #include "rbcontact/dual_basis.hpp"
-#include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/snapshot_contact.hpp"
 
 namespace rbc {
 
@@ -30,9 +30,9 @@ struct SupremizerEnrichment {
 PetscErrorCode SupremizerRatioFromOptions(MPI_Comm comm, PetscReal *ratio);
 
 // pod: the POD modes (Np M-orthonormal columns, active columns 0..Np); sup: the supremizers (same
-// layout); snaps[j].extra "contact_K" (R x nD row-major) and "contact_dofs" (canonical); W: the dual
-// basis (R x r); canonical[g]: the canonical index of global dof g (CanonicalOrder::CanonicalDof).
-// *out: a new BV [V, Z_1..kept], M-orthonormal (the caller destroys it). Collective.
-PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const std::vector<Snapshot> &snaps, const DenseMatrix &W, const std::vector<PetscInt> &canonical, PetscReal ratio, BV *out, SupremizerEnrichment *info);
+// layout); K: the training snapshots' contact matrices on the contact dofs (snapshot_contact.hpp; beta's
+// minimum runs over them); W: the dual basis (R x r); canonical[g]: the canonical index of global dof g
+// (CanonicalOrder::CanonicalDof). *out: a new BV [V, Z_1..kept], M-orthonormal (the caller destroys it). Collective.
+PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const SnapshotContactMatrices &K, const DenseMatrix &W, const std::vector<PetscInt> &canonical, PetscReal ratio, BV *out, SupremizerEnrichment *info);
 
 } // namespace rbc

@@ -164,40 +164,54 @@ PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
   PetscFunctionReturn(0);
 }
 
-// Rows of K restricted to the columns D, dense R x nD column-major, on every rank.
-PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, std::vector<PetscReal> *KD)
+// Rows of K restricted to the columns D, by rows, on every rank (a dense R x nD copy was 54 MB a rank on hertz3d's
+// default mesh, zeroed on every Kacanov iterate only to be scanned for its nonzeros).
+PetscErrorCode GatherRowsOnDofs(Mat K, const std::vector<PetscInt> &D, SparseRows *KD)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)K);
   PetscInt    R, rstart, rend;
   PetscMPIInt size;
-  const PetscInt nD = (PetscInt)D.size();
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(MatGetSize(K, &R, NULL));
   PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
-  std::vector<PetscReal> mine((size_t)(rend - rstart) * nD, 0.0);
+  std::vector<PetscInt>  count((size_t)(rend - rstart), 0), col;
+  std::vector<PetscReal> val;
   for (PetscInt r = rstart; r < rend; ++r) {
     PetscInt           nc;
     const PetscInt    *cols;
     const PetscScalar *vals;
     PetscCall(MatGetRow(K, r, &nc, &cols, &vals));
     for (PetscInt k = 0; k < nc; ++k) {
+      if (PetscRealPart(vals[k]) == 0.0) continue;
       const auto it = std::lower_bound(D.begin(), D.end(), cols[k]);
       PetscCheck(it != D.end() && *it == cols[k], PETSC_COMM_SELF, PETSC_ERR_PLIB, "Constraint column %" PetscInt_FMT " outside the contact dofs", cols[k]);
-      mine[(size_t)(r - rstart) * nD + (it - D.begin())] += PetscRealPart(vals[k]);
+      col.push_back((PetscInt)(it - D.begin())); // AIJ rows: columns unique and ascending, so are their positions in D
+      val.push_back(PetscRealPart(vals[k]));
+      ++count[r - rstart];
     }
     PetscCall(MatRestoreRow(K, r, &nc, &cols, &vals));
   }
-  std::vector<int> counts(size), displs(size, 0);
-  int              c = (int)mine.size();
-  PetscCallMPI(MPI_Allgather(&c, 1, MPI_INT, counts.data(), 1, MPI_INT, comm));
-  for (int q = 1; q < size; ++q) displs[q] = displs[q - 1] + counts[q - 1];
-  std::vector<PetscReal> rows((size_t)R * nD);
-  PetscCallMPI(MPI_Allgatherv(mine.data(), c, MPIU_REAL, rows.data(), counts.data(), displs.data(), MPIU_REAL, comm));
-  KD->assign((size_t)R * nD, 0.0);
-  for (PetscInt i = 0; i < R; ++i)
-    for (PetscInt j = 0; j < nD; ++j) (*KD)[i + (size_t)j * R] = rows[(size_t)i * nD + j];
+  std::vector<int> rowsOf(size), rowDispl(size, 0), nnzOf(size), nnzDispl(size, 0);
+  int              nrow = (int)count.size(), nnz = (int)col.size();
+  PetscCallMPI(MPI_Allgather(&nrow, 1, MPI_INT, rowsOf.data(), 1, MPI_INT, comm));
+  PetscCallMPI(MPI_Allgather(&nnz, 1, MPI_INT, nnzOf.data(), 1, MPI_INT, comm));
+  for (int q = 1; q < size; ++q) {
+    rowDispl[q] = rowDispl[q - 1] + rowsOf[q - 1];
+    nnzDispl[q] = nnzDispl[q - 1] + nnzOf[q - 1];
+  }
+  const size_t total = (size_t)nnzDispl[size - 1] + (size_t)nnzOf[size - 1];
+  std::vector<PetscInt> all((size_t)R);
+  KD->rows = R;
+  KD->cols = (PetscInt)D.size();
+  KD->col.resize(total);
+  KD->val.resize(total);
+  PetscCallMPI(MPI_Allgatherv(count.data(), nrow, MPIU_INT, all.data(), rowsOf.data(), rowDispl.data(), MPIU_INT, comm));
+  PetscCallMPI(MPI_Allgatherv(col.data(), nnz, MPIU_INT, KD->col.data(), nnzOf.data(), nnzDispl.data(), MPIU_INT, comm));
+  PetscCallMPI(MPI_Allgatherv(val.data(), nnz, MPIU_REAL, KD->val.data(), nnzOf.data(), nnzDispl.data(), MPIU_REAL, comm));
+  KD->ptr.assign((size_t)R + 1, 0);
+  for (PetscInt i = 0; i < R; ++i) KD->ptr[i + 1] = KD->ptr[i] + all[i];
   PetscFunctionReturn(0);
 }
 
@@ -357,7 +371,8 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   }
 
   for (PetscInt k = 1; k <= loop.maxIt; ++k) {
-    std::vector<PetscReal> KD, T, Sfull, gfull, bfull, lam;
+    SparseRows             KD;
+    std::vector<PetscReal> T, Sfull, gfull, bfull, lam;
     PetscInt               nact = 0;
     PetscCall(PetscTime(&t0));
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
@@ -407,22 +422,19 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(GatherVec(sys.g, &gfull));
     // K_D is sparse (a row touches the dofs of a few facets): T = G K_D^T and S = K_D T by its
     // nonzeros, O(nD nnz + R nnz) instead of dense products
-    std::vector<std::vector<std::pair<PetscInt, PetscReal>>> rows(R);
-    for (PetscInt c = 0; c < nD; ++c)
-      for (PetscInt i = 0; i < R; ++i)
-        if (KD[i + (size_t)c * R] != 0.0) rows[i].emplace_back(c, KD[i + (size_t)c * R]);
     T.assign((size_t)nD * R, 0.0);
     Sfull.assign((size_t)R * R, 0.0);
     for (PetscInt i = 0; i < R; ++i)
-      for (const auto &cv : rows[i]) {
-        const PetscReal *g = &compliance.G[(size_t)cv.first * nD];
+      for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) {
+        const PetscReal *g = &compliance.G[(size_t)KD.col[e] * nD];
         PetscReal       *t = &T[(size_t)i * nD];
-        for (PetscInt q = 0; q < nD; ++q) t[q] += g[q] * cv.second;
+        const PetscReal  k = KD.val[e];
+        for (PetscInt q = 0; q < nD; ++q) t[q] += g[q] * k;
       }
     for (PetscInt j = 0; j < R; ++j)
       for (PetscInt i = 0; i < R; ++i) {
         PetscReal v = 0;
-        for (const auto &cv : rows[i]) v += cv.second * T[(size_t)j * nD + cv.first];
+        for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) v += KD.val[e] * T[(size_t)j * nD + KD.col[e]];
         Sfull[i + (size_t)j * R] = v;
       }
     for (PetscInt i = 0; i < R; ++i)
@@ -431,7 +443,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     bfull.assign(R, 0.0);
     for (PetscInt i = 0; i < R; ++i) {
       PetscReal v = -gfull[i];
-      for (PetscInt j = 0; j < nD; ++j) v += KD[i + (size_t)j * R] * u0D[j];
+      for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) v += KD.val[e] * u0D[KD.col[e]];
       bfull[i] = v;
     }
     PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
@@ -469,12 +481,9 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     } else {
       const PetscBLASInt R = (PetscBLASInt)sys.R, one = 1;
       const PetscScalar  m1 = -1.0, p1 = 1.0;
-      std::vector<PetscReal> w(nD, 0.0);
-      for (PetscBLASInt j = 0; j < nD; ++j) {
-        PetscReal v = 0;
-        for (PetscBLASInt i = 0; i < R; ++i) v += KD[i + (size_t)j * R] * lam[i];
-        w[j] = v;
-      }
+      std::vector<PetscReal> w(nD, 0.0); // K_D' lambda
+      for (PetscBLASInt i = 0; i < R; ++i)
+        for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) w[KD.col[e]] += KD.val[e] * lam[i];
       std::vector<PetscReal> uD(u0D);
       if (nD) BLASgemv_("N", &nD, &nD, &m1, compliance.G.data(), &nD, w.data(), &one, &p1, uD.data(), &one);
       if (uDprev.empty()) uDprev.assign(nD, 0.0);
@@ -542,7 +551,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
           in.D   = &D;
           in.R   = sys.R;
           in.G   = compliance.G.data();
-          in.KD  = KD.data();
+          in.KD  = &KD;
           in.T   = T.data();
           in.S   = Sfull.data();
           in.lam = lam.data();

@@ -70,9 +70,9 @@ PetscErrorCode KacanovNewtonStep(const KacanovNewtonData &in, PetscReal maxRatio
   std::vector<PetscReal> B((size_t)nA * nC, 0.0);
   for (PetscInt a = 0; a < nA; ++a) {
     const PetscInt i = act[a];
-    for (PetscInt q = 0; q < nD; ++q) {
-      const PetscReal k = in.KD[i + (size_t)q * R];
-      if (k == 0.0) continue;
+    for (PetscInt e = in.KD->ptr[i]; e < in.KD->ptr[i + 1]; ++e) {
+      const PetscInt  q = in.KD->col[e];
+      const PetscReal k = in.KD->val[e];
       for (PetscInt c = 0; c < nC; ++c) B[a + (size_t)c * nA] += k * GH[q + (size_t)c * nD];
     }
   }

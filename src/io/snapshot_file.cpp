@@ -3,9 +3,11 @@
 // matrices from other codes (HDF5 dataset or PETSc binary Mat). Only rank 0 touches files in the
 // collective calls; it broadcasts the status so that every rank fails together, never hangs.
 //
-// File layout (format_version 1; also in docs/snapshot_file.md). ntrain = training points,
+// File layout (format_version 2; also in docs/snapshot_file.md). ntrain = training points,
 // nparams = parameters, ndofs = length of u, nmult = length of lambda. All reals IEEE float64 LE.
-//   / attributes      format = "rbcontact-snapshots" (string), format_version = 1 (int32),
+//   / attributes      format = "rbcontact-snapshots" (string), format_version = 2 (int32; version 1 files,
+//                     which also held every snapshot's contact matrix dense, are read, and a restart upgrades
+//                     them),
 //                     scene, code_version, options (strings), scene_hash, mesh_checksum (uint64),
 //                     ntrain, nparams, ndofs, nmult (int64). options longer than 32 KiB: the
 //                     attribute says "@/options" and the text is the scalar string dataset /options.
@@ -55,7 +57,12 @@ static_assert(std::is_same<PetscReal, double>::value, "the snapshot file stores 
 namespace {
 
 constexpr const char *kFormat        = "rbcontact-snapshots";
-constexpr int         kFormatVersion = 1;
+constexpr int         kFormatVersion = 2;
+// Version 1 (until 2026-11-27) also stored the contact matrix on the contact dofs dense (the extras contact_K and
+// contact_dofs: 434 MB a snapshot at 5.4e5 3D dofs); the offline stage now reassembles it from u (offline_bases.cpp).
+// Such files are read (those two extras skipped) and upgraded to version 2 when a restart writes to them.
+constexpr int         kOldestReadableVersion = 1;
+const char *const     kDroppedExtras[]       = {"contact_K", "contact_dofs"};
 constexpr size_t      kMaxAttrString = 32768;
 const double          kNaN           = std::numeric_limits<double>::quiet_NaN();
 
@@ -122,7 +129,7 @@ bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
 }
 
 // Opens an existing file and checks that it is an rbcontact snapshot file.
-bool OpenExisting(Ctx &c, const std::string &path, bool rdwr, H5Id *file)
+bool OpenExisting(Ctx &c, const std::string &path, bool rdwr, H5Id *file, int *versionOut = nullptr)
 {
   if (!FileExists(path)) return c.Fail("does not exist", false);
   const htri_t is = H5Fis_hdf5(path.c_str());
@@ -143,7 +150,8 @@ bool OpenExisting(Ctx &c, const std::string &path, bool rdwr, H5Id *file)
   if (fmt != kFormat) return c.Fail("is not an rbcontact snapshot file (format '" + fmt + "', expected '" + kFormat + "')", false);
   int version = 0;
   if (!ReadAttr(c, file->get(), "format_version", H5T_NATIVE_INT, &version)) return false;
-  if (version != kFormatVersion) return c.Fail("has format_version " + std::to_string(version) + "; this build reads version " + std::to_string(kFormatVersion), false);
+  if (version < kOldestReadableVersion || version > kFormatVersion) return c.Fail("has format_version " + std::to_string(version) + "; this build reads versions " + std::to_string(kOldestReadableVersion) + " to " + std::to_string(kFormatVersion), false);
+  if (versionOut) *versionOut = version;
   return true;
 }
 
@@ -252,13 +260,22 @@ PetscErrorCode BcastReals(MPI_Comm comm, PetscReal *v, size_t n)
 bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool restart, H5Id *file, std::vector<signed char> *done)
 {
   if (restart && FileExists(path)) {
-    if (!OpenExisting(c, path, true, file)) return false;
+    int version = 0;
+    if (!OpenExisting(c, path, true, file, &version)) return false;
     SnapshotHeader fh;
     if (!ReadHeaderH5(c, file->get(), &fh)) return false;
     const std::string diff = SnapshotHeaderDiff(fh, h);
     if (!diff.empty()) {
       c.err = "Snapshot file '" + path + "' was made for another scene/mesh/parameter box: " + diff + "; delete it, give another file (-rom or -snapshots), or start afresh with -snapshots_restart 0";
       return false;
+    }
+    if (version < kFormatVersion) { // the snapshots written from now on lack the version-1 contact matrices: a
+      // version-1 reader would take their stale rows, so the file says version 2 before the first write
+      H5Id a(H5Aopen(file->get(), "format_version", H5P_DEFAULT), H5Aclose);
+      const int v = kFormatVersion;
+      if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_INT, &v) < 0) return c.Fail("cannot upgrade attribute format_version to " + std::to_string(v));
+      a.Reset();
+      if (!FlushSync(c, file->get())) return false;
     }
     return ReadDone(c, file->get(), h.trainingPoints.size(), done);
   }
@@ -506,31 +523,6 @@ PetscErrorCode SnapshotFile::ReadHeader(const std::string &path, SnapshotHeader 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode CompactContactMatrix(Snapshot *s)
-{
-  PetscFunctionBeginUser;
-  const auto k = s->extra.find("contact_K"), d = s->extra.find("contact_dofs");
-  if (k == s->extra.end()) PetscFunctionReturn(0);
-  PetscCheck(d != s->extra.end(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": a contact matrix (contact_K) without its dofs (contact_dofs)", s->index);
-  const size_t nD = d->second.size(), R = s->lambda.size();
-  PetscCheck(k->second.size() == R * nD, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": contact matrix of %zu entries for %zu multipliers x %zu contact dofs", s->index, k->second.size(), R, nD);
-  SparseRows &K = s->contactK;
-  K      = SparseRows();
-  K.rows = (PetscInt)R;
-  K.cols = (PetscInt)nD;
-  for (size_t i = 0; i < R; ++i) {
-    for (size_t c = 0; c < nD; ++c) {
-      const PetscReal v = k->second[i * nD + c];
-      if (v == 0) continue;
-      K.col.push_back((PetscInt)c);
-      K.val.push_back(v);
-    }
-    K.ptr.push_back((PetscInt)K.col.size());
-  }
-  s->extra.erase(k);
-  PetscFunctionReturn(0);
-}
-
 PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapshot> *snaps)
 {
   std::string err;
@@ -565,7 +557,9 @@ PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapsh
         std::vector<hsize_t> dims;
         ok = (d.ok() || c.Fail("cannot open dataset " + dn)) && DatasetDims(c, d.get(), dn, &dims);
         if (ok && (dims.size() != 2 || dims[0] != h.trainingPoints.size())) ok = c.Fail("dataset " + dn + " has shape " + ShapeString(dims) + ", expected ntrain x len", false);
-        if (ok) extras.emplace_back(name.data(), dims[1]);
+        bool dropped = false; // a version-1 file's dense contact matrices: not read (the offline stage reassembles them)
+        for (const char *x : kDroppedExtras) dropped = dropped || !strcmp(name.data(), x);
+        if (ok && !dropped) extras.emplace_back(name.data(), dims[1]);
       }
     }
     const hsize_t np = h.paramNames.size();
@@ -600,10 +594,7 @@ PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapsh
       };
       ok = ok && finite("/snapshots/mu", s.mu) && finite("/snapshots/u", s.u) && finite("/snapshots/lambda", s.lambda);
       for (const auto &e : s.extra) ok = ok && finite("/snapshots/extra/" + e.first, e.second);
-      if (ok) {
-        PetscCall(CompactContactMatrix(&s)); // one dense row at a time in memory
-        snaps->push_back(std::move(s));
-      }
+      if (ok) snaps->push_back(std::move(s));
     }
     if (ok) ok = CloseFile(c, &f);
     if (!ok) err = c.err;

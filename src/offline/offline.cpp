@@ -204,20 +204,12 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     }
     PetscCall(order.BuildDofs(fom.elas));
     PetscInt               R = 0;
-    std::vector<PetscInt>  D, Dc, Dperm;
     if (scene.contact) {
       PetscCall(kac.SetFromOptions(group));
       PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
       PetscCall(kac.ShareFactor(fom, cmap));
       R = cmap.NumMultipliers();
-      PetscCall(cmap.SurfaceDofs(group, &D));
-      // contact dofs in canonical numbering, sorted; Dperm[j] = position in D of the j-th canonical one
-      std::vector<std::pair<PetscInt, PetscInt>> cd;
-      for (size_t j = 0; j < D.size(); ++j) cd.emplace_back(order.CanonicalDof(D[j]), (PetscInt)j);
-      std::sort(cd.begin(), cd.end());
-      for (const auto &p : cd) { Dc.push_back(p.first); Dperm.push_back(p.second); }
     }
-    const PetscInt nD = (PetscInt)D.size();
 
     SnapshotHeader h;
     h.scene          = scene.name;
@@ -243,11 +235,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
     if (!restart) PetscCheck(done.empty(), world, PETSC_ERR_PLIB, "new snapshot file with done entries");
 
-    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], K_D[R*nD], and with
+    // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], and with
     // -snapshots_sensitivities the scaled derivatives (mu_i range) du/dmu_i [np*ndofs], dlambda/dmu_i [np*R]
     PetscCheck(!s.sensitivities || scene.contact, world, PETSC_ERR_SUP, "-snapshots_sensitivities: the derivatives are those of a contact solution (-contact_slave, -contact_master)");
     const bool             sensOn = s.sensitivities;
-    const size_t           L0 = 7 + np + ndofs + 2 * R + (size_t)R * nD, L = L0 + (sensOn ? (size_t)np * (ndofs + R) : 0);
+    const size_t           L0 = 7 + np + ndofs + 2 * R, L = L0 + (sensOn ? (size_t)np * (ndofs + R) : 0);
     PetscLogDouble         sensSeconds = 0;
     PetscInt               sensIts = 0, sensActive = 0;
     std::string            sensMethod;
@@ -271,7 +263,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           const std::vector<PetscReal> &mu = train.points[idx];
           PetscCall(fom.SetMu(mu));
           PetscCall(fom.AssembleAndFactor());
-          std::vector<PetscReal> u, lam, gap, KDg;
+          std::vector<PetscReal> u, lam, gap;
           if (scene.contact) {
             cmap.SetGeometry(&fom.map, mu);
             PetscCall(kac.Solve(fom, cmap));
@@ -282,7 +274,6 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
             }
             PetscCall(order.MultipliersToCanonical(kac.lambda, &lam));
             PetscCall(order.MultipliersToCanonical(kac.sys.g, &gap));
-            PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KDg));
           } else {
             PetscCall(fom.SolveElastic());
             PetscCall(PetscTime(&s1));
@@ -322,11 +313,6 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
             for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = u[j];
             for (PetscInt j = 0; j < R; ++j) pack[o++] = lam[j];
             for (PetscInt j = 0; j < R; ++j) pack[o++] = gap[j];
-            // K_D: rows in canonical multiplier order, columns in canonical dof order (row-major)
-            for (PetscInt g = 0; g < R; ++g) {
-              const PetscInt c = order.CanonicalMultiplier(g);
-              for (PetscInt j = 0; j < nD; ++j) pack[o + (size_t)c * nD + j] = KDg[g + (size_t)Dperm[j] * R];
-            }
             o = L0;
             for (const auto &d : dus)
               for (PetscInt j = 0; j < ndofs; ++j) pack[o++] = d[j];
@@ -360,8 +346,6 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
             if (scene.contact) {
               s.extra["contact_gap"].assign(p + o, p + o + R);
               o += R;
-              s.extra["contact_K"].assign(p + o, p + o + (size_t)R * nD);
-              s.extra["contact_dofs"].assign(Dc.begin(), Dc.end());
             }
             if (sensOn) {
               s.extra["sensitivity_u"].assign(p + L0, p + L0 + (size_t)np * ndofs);

@@ -119,16 +119,17 @@ PetscErrorCode ParameterSensitivities(ElasticFOM &fom, ContactMap &cmap, Kacanov
   if (dense && info->active > 0) {
     const std::vector<PetscInt> &D  = kac.compliance.D;
     const PetscBLASInt           nD = (PetscBLASInt)D.size();
-    std::vector<PetscReal>       KD, lam, T;
-    PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KD)); // R x nD, column-major
+    SparseRows                   KD;
+    std::vector<PetscReal>       lam, T;
+    PetscCall(GatherRowsOnDofs(kac.sys.K, D, &KD));
     PetscCall(GatherVec(kac.lambda, &lam));
     const PetscInt R = (PetscInt)lam.size();
     for (PetscInt r = 0; r < R; ++r)
       if (lam[r] > 0) act.push_back(r);
     const PetscBLASInt na = (PetscBLASInt)act.size();
-    std::vector<PetscReal> KA((size_t)na * nD); // K_AD, na x nD column-major
-    for (PetscBLASInt j = 0; j < nD; ++j)
-      for (PetscBLASInt a = 0; a < na; ++a) KA[a + (size_t)j * na] = KD[act[a] + (size_t)j * R];
+    std::vector<PetscReal> KA((size_t)na * nD, 0.0); // K_AD, na x nD column-major
+    for (PetscBLASInt a = 0; a < na; ++a)
+      for (PetscInt e = KD.ptr[act[a]]; e < KD.ptr[act[a] + 1]; ++e) KA[a + (size_t)KD.col[e] * na] = KD.val[e];
     T.assign((size_t)nD * na, 0.0); // G K_AD'
     SA.assign((size_t)na * na, 0.0);
     const PetscReal one = 1, zero = 0;

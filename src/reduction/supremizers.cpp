@@ -42,7 +42,7 @@ PetscErrorCode SupremizerRatioFromOptions(MPI_Comm comm, PetscReal *ratio)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const std::vector<Snapshot> &snaps, const DenseMatrix &W, const std::vector<PetscInt> &canonical, PetscReal ratio, BV *out, SupremizerEnrichment *info)
+PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const SnapshotContactMatrices &K, const DenseMatrix &W, const std::vector<PetscInt> &canonical, PetscReal ratio, BV *out, SupremizerEnrichment *info)
 {
   MPI_Comm comm;
   BV       S;
@@ -110,18 +110,14 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
   if (q > 0) PetscCall(BVMultInPlace(S, Q, 0, q)); // Z_k = S y_k / sigma_k, M-orthonormal
   PetscCall(MatDestroy(&Q));
 
-  // the basis [V Z] at the contact dofs of the snapshots (canonical order), on every rank
+  // the basis [V Z] at the contact dofs (canonical order), on every rank
   const PetscInt         ncol = Np + q, ndofs = (PetscInt)canonical.size();
   std::vector<PetscInt>  pos(ndofs, -1);
   PetscInt               nu = 0;
-  for (const auto &s : snaps) {
-    const auto it = s.extra.find("contact_dofs");
-    PetscCheck(it != s.extra.end() && s.contactK.rows > 0, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT " holds no contact matrix (contact_K, contact_dofs)", s.index);
-    for (PetscReal c : it->second) {
-      const PetscInt ci = (PetscInt)c;
-      PetscCheck(ci >= 0 && ci < ndofs, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact dof %" PetscInt_FMT " out of range", s.index, ci);
-      if (pos[ci] < 0) pos[ci] = nu++;
-    }
+  PetscCheck(!K.K.empty() && K.index.size() == K.K.size(), comm, PETSC_ERR_ARG_SIZ, "supremizers: no snapshot contact matrix (%zu matrices, %zu indices)", K.K.size(), K.index.size());
+  for (PetscInt ci : K.dofs) {
+    PetscCheck(ci >= 0 && ci < ndofs, comm, PETSC_ERR_ARG_OUTOFRANGE, "supremizers: contact dof %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", ci, ndofs);
+    pos[ci] = nu++;
   }
   std::vector<PetscReal> vd((size_t)nu * ncol, 0.0);
   for (PetscInt k = 0; k < ncol; ++k) {
@@ -157,11 +153,11 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
   // beta(k) = min_j sigma_min(L^{-1} W^T K_j [V Z_1..k]), k = 0..q
   info->beta.assign(q + 1, PETSC_MAX_REAL);
   std::vector<PetscReal> T, B, E, Ek, w;
-  for (const auto &s : snaps) {
-    const SparseRows &KD = s.contactK;
-    const auto       &Dc = s.extra.at("contact_dofs");
-    const PetscInt    nD = (PetscInt)Dc.size();
-    PetscCheck(KD.rows == R && KD.cols == nD, comm, PETSC_ERR_FILE_UNEXPECTED, "supremizers: snapshot %" PetscInt_FMT ": contact matrix %" PetscInt_FMT " x %" PetscInt_FMT " for %" PetscInt_FMT " x %" PetscInt_FMT, s.index, KD.rows, KD.cols, R, nD);
+  const auto    &Dc = K.dofs;
+  const PetscInt nD = (PetscInt)Dc.size();
+  for (size_t j = 0; j < K.K.size(); ++j) {
+    const SparseRows &KD = K.K[j];
+    PetscCheck(KD.rows == R && KD.cols == nD, comm, PETSC_ERR_ARG_SIZ, "supremizers: snapshot %" PetscInt_FMT ": contact matrix %" PetscInt_FMT " x %" PetscInt_FMT " for %" PetscInt_FMT " x %" PetscInt_FMT, K.index[j], KD.rows, KD.cols, R, nD);
     T.assign((size_t)r * nD, 0.0); // W^T K_D, r x nD column-major
     for (PetscInt i = 0; i < R; ++i)
       for (PetscInt e = KD.ptr[i]; e < KD.ptr[i + 1]; ++e) {
@@ -177,7 +173,7 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
     B.assign((size_t)r * ncol, 0.0); // L^{-1} W^T K_D [V Z]
     for (PetscInt k = 0; k < ncol; ++k)
       for (PetscInt c = 0; c < nD; ++c) {
-        const PetscReal v = vd[pos[(PetscInt)Dc[c]] + (size_t)nu * k];
+        const PetscReal v = vd[pos[Dc[c]] + (size_t)nu * k];
         if (v == 0) continue;
         for (PetscInt a = 0; a < r; ++a) B[a + (size_t)r * k] += T[a + (size_t)r * c] * v;
       }
@@ -197,7 +193,7 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
     }
     if (Np == 0) info->beta[0] = 0;
   }
-  if (snaps.empty()) std::fill(info->beta.begin(), info->beta.end(), 0.0);
+  if (K.K.empty()) std::fill(info->beta.begin(), info->beta.end(), 0.0);
   // the fewest directions that keep ratio x the full enrichment's inf-sup constant
   const PetscReal target = ratio * info->beta[q] * (1 - 1e-12);
   info->kept             = q;
