@@ -17,9 +17,14 @@ struct SnapshotContactMatrices {
   std::vector<PetscInt>   index; // index[j]: snapshot j's position in the training set (for messages)
 };
 
+// fom.u := snap's stored displacement (created if absent) and *sys := the contact system assembled at it, with the
+// Dirichlet values of fom's current mu (the caller sets fom and the map's geometry at snap's mu); the canonical
+// multiplier order built if the caller has not. Collective. (validate -test_snapshots reads its FOM solutions so.)
+PetscErrorCode AssembleAtStoredSolution(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const Snapshot &snap, ContactSystem *sys);
+
 // For every snapshot (mu_j, u_j): the map's geometry at mu_j, K(u_j) assembled at u_j (its Dirichlet values at mu_j),
-// gathered on every rank in canonical orders (the multiplier order built here if the caller has not). fom's mu and
-// the map's geometry are set back to fom's mu on entry. Collective.
+// gathered on every rank in canonical orders (the multiplier order built here if the caller has not). fom's mu, u
+// and the map's geometry are set back to those on entry. Collective.
 PetscErrorCode AssembleSnapshotContactMatrices(MPI_Comm comm, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, SnapshotContactMatrices *out);
 
 } // namespace rbc

@@ -1,20 +1,42 @@
-// src/offline/snapshot_contact.cpp: AssembleSnapshotContactMatrices (snapshot_contact.hpp): the training snapshots'
-// contact matrices on the contact dofs, reassembled from their displacements.
+// src/offline/snapshot_contact.cpp: AssembleAtStoredSolution and AssembleSnapshotContactMatrices (snapshot_contact.hpp):
+// the contact system at a stored solution, and the training snapshots' contact matrices on the contact dofs.
 #include "rbcontact/snapshot_contact.hpp"
 #include "rbcontact/kacanov.hpp"
 #include <algorithm>
 
 namespace rbc {
 
+PetscErrorCode AssembleAtStoredSolution(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const Snapshot &snap, ContactSystem *sys)
+{
+  PetscInt     lo, hi;
+  PetscScalar *a;
+  Vec          uloc;
+
+  PetscFunctionBeginUser;
+  PetscCheck((PetscInt)snap.u.size() == order.NumDofs(), PetscObjectComm((PetscObject)fom.dm), PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": %zu displacement values for %" PetscInt_FMT " dofs", snap.index, snap.u.size(), order.NumDofs());
+  if (!fom.u) PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
+  PetscCall(VecGetOwnershipRange(fom.u, &lo, &hi));
+  PetscCall(VecGetArray(fom.u, &a));
+  for (PetscInt i = lo; i < hi; ++i) a[i - lo] = snap.u[order.CanonicalDof(i)];
+  PetscCall(VecRestoreArray(fom.u, &a));
+  PetscCall(DMGetLocalVector(fom.dm, &uloc));
+  PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
+  PetscCall(cmap.Assemble(fom.elas, uloc, sys));
+  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
+  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys->coordRef, fom.elas.dim));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode AssembleSnapshotContactMatrices(MPI_Comm comm, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, SnapshotContactMatrices *out)
 {
   std::vector<PetscInt> D;
-  Vec                   u, uloc;
-  PetscInt              lo, hi;
 
   PetscFunctionBeginUser;
   *out                             = SnapshotContactMatrices();
-  const std::vector<PetscReal> muIn = fom.mu; // restored at the end, with the map's geometry there
+  const std::vector<PetscReal> muIn = fom.mu; // restored at the end, with the map's geometry there, and fom.u
+  Vec                          uIn  = nullptr;
+  if (fom.u) PetscCall(VecDuplicate(fom.u, &uIn));
+  if (fom.u) PetscCall(VecCopy(fom.u, uIn));
   PetscCall(cmap.SurfaceDofs(comm, &D));
   // the columns: D's canonical indices, ascending; canon[p] = the column of D[p]
   std::vector<std::pair<PetscInt, PetscInt>> cd;
@@ -25,22 +47,12 @@ PetscErrorCode AssembleSnapshotContactMatrices(MPI_Comm comm, ElasticFOM &fom, C
     out->dofs.push_back(cd[j].first);
     canon[cd[j].second] = (PetscInt)j;
   }
-  PetscCall(DMCreateGlobalVector(fom.dm, &u));
-  PetscCall(DMGetLocalVector(fom.dm, &uloc));
-  PetscCall(VecGetOwnershipRange(u, &lo, &hi));
   for (const Snapshot &s : snaps) {
-    PetscCheck((PetscInt)s.u.size() == order.NumDofs(), comm, PETSC_ERR_FILE_UNEXPECTED, "snapshot %" PetscInt_FMT ": %zu displacement values for %" PetscInt_FMT " dofs", s.index, s.u.size(), order.NumDofs());
     PetscCall(fom.SetMu(s.mu)); // the Dirichlet values at mu_j
     cmap.SetGeometry(&fom.map, fom.mu);
-    PetscScalar *a;
-    PetscCall(VecGetArray(u, &a));
-    for (PetscInt i = lo; i < hi; ++i) a[i - lo] = s.u[order.CanonicalDof(i)];
-    PetscCall(VecRestoreArray(u, &a));
-    PetscCall(fom.elas.GlobalToLocalWithBC(u, uloc));
     ContactSystem sys;
     SparseRows    KD;
-    PetscCall(cmap.Assemble(fom.elas, uloc, &sys));
-    if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys.coordRef, fom.elas.dim));
+    PetscCall(AssembleAtStoredSolution(fom, cmap, order, s, &sys));
     PetscCall(GatherRowsOnDofs(sys.K, D, &KD));
     // rows to the canonical multiplier order, columns to the canonical dof order (ascending within a row)
     SparseRows &K = out->K.emplace_back();
@@ -65,8 +77,10 @@ PetscErrorCode AssembleSnapshotContactMatrices(MPI_Comm comm, ElasticFOM &fom, C
     }
     out->index.push_back(s.index);
   }
-  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-  PetscCall(VecDestroy(&u));
+  if (uIn) {
+    PetscCall(VecCopy(uIn, fom.u));
+    PetscCall(VecDestroy(&uIn));
+  }
   if (muIn.size() == fom.scene.params.size()) {
     PetscCall(fom.SetMu(muIn));
     cmap.SetGeometry(&fom.map, fom.mu);

@@ -13,6 +13,7 @@
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/snapshot_contact.hpp"
 #include "rbcontact/mesh.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -87,20 +88,8 @@ PetscErrorCode ReadTestSnapshots(MPI_Comm comm, const std::string &path, const S
 // u (sys), its multipliers in sys's layout (lambda, created here).
 PetscErrorCode StoredSolution(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const Snapshot &snap, ContactSystem *sys, Vec *lambda)
 {
-  PetscInt     lo, hi;
-  PetscScalar *a;
-  Vec          uloc;
   PetscFunctionBeginUser;
-  if (!fom.u) PetscCall(DMCreateGlobalVector(fom.dm, &fom.u));
-  PetscCall(VecGetOwnershipRange(fom.u, &lo, &hi));
-  PetscCall(VecGetArray(fom.u, &a));
-  for (PetscInt i = lo; i < hi; ++i) a[i - lo] = snap.u[order.CanonicalDof(i)];
-  PetscCall(VecRestoreArray(fom.u, &a));
-  PetscCall(DMGetLocalVector(fom.dm, &uloc));
-  PetscCall(fom.elas.GlobalToLocalWithBC(fom.u, uloc));
-  PetscCall(cmap.Assemble(fom.elas, uloc, sys));
-  PetscCall(DMRestoreLocalVector(fom.dm, &uloc));
-  if (order.NumMultipliers() != cmap.NumMultipliers()) PetscCall(order.BuildMultipliers(sys->coordRef, fom.elas.dim));
+  PetscCall(AssembleAtStoredSolution(fom, cmap, order, snap, sys));
   PetscCall(VecDuplicate(sys->weight, lambda));
   PetscCall(CanonicalToMultipliers(order, snap.lambda, *lambda));
   PetscFunctionReturn(0);
