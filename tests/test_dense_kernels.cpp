@@ -5,7 +5,8 @@
 // 1..12 register blocks, and beyond) with repeated target rows, 0..8 terms per point; RightSolveT (through the
 // residual X L' - D) and LowerGram of the reduced QP's set-up, n 1..60; RowDots (U = uD + theta v). The dispatched version (AVX2+FMA
 // where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|). The single-precision
-// dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) within the float accumulation bound.
+// dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) and the float row combination
+// (CombineRowsSingle) within the float accumulation bound.
 // The sums of outer products each by the BLAS's gemm and by the built-in kernels (SetGemmBlas), and from point-major
 // rows (SumOfOuterProductsRows*, the points' sum of the cubature).
 #include "../src/rom/dense_kernels.hpp"
@@ -189,6 +190,41 @@ int main(int argc, char **argv)
         if (!(e <= (count[k] + 2) * uf * Qa[k])) {
           ++failures;
           PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL ScatterRowsSingle M %d r %d entry %d: %g vs %g\n", (int)M, (int)r, (int)k, (double)Q[k], Qr[k]));
+        }
+      }
+    }
+  // CombineRowsSingle (kappa's rows in float for the single points' sum): 0..18 terms (3D P1: 2 sides x 3 nodes x 3),
+  // lengths around the 12 blocks of 8 held in registers, one pass and two (192: the finest 3D model's padded N), and tails
+  for (PetscInt nt = 0; nt <= 18; ++nt)
+    for (PetscInt n : {1, 7, 8, 9, 15, 16, 17, 95, 96, 97, 103, 104, 191, 192, 200}) {
+      std::vector<std::vector<float>> rows(nt, std::vector<float>(n));
+      std::vector<const float *>      ptr(nt);
+      std::vector<double>             coef(nt);
+      std::vector<float>              out(n + 1, -7.0f);
+      for (PetscInt j = 0; j < nt; ++j) {
+        coef[j] = u(gen);
+        for (auto &x : rows[j]) x = (float)u(gen);
+        ptr[j] = rows[j].data();
+      }
+      CombineRowsSingle(nt, coef.data(), ptr.data(), n, out.data());
+      ++checks;
+      if (out[n] != -7.0f) {
+        ++failures;
+        PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL CombineRowsSingle nt %d n %d: wrote past the end\n", (int)nt, (int)n));
+      }
+      for (PetscInt k = 0; k < n; ++k) {
+        double s = 0, a = 0;
+        for (PetscInt j = 0; j < nt; ++j) {
+          const double term = (double)(float)coef[j] * rows[j][k];
+          s += term;
+          a += std::abs(term);
+        }
+        const double e = std::abs(out[k] - s);
+        worst32        = std::max(worst32, a > 0 ? e / a : e);
+        ++checks;
+        if (!(e <= (nt + 2) * uf * a)) {
+          ++failures;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL CombineRowsSingle nt %d n %d entry %d: %g vs %g\n", (int)nt, (int)n, (int)k, (double)out[k], s));
         }
       }
     }

@@ -225,7 +225,9 @@ private:
   PetscInt               cNd_   = 0;                  // ... over the dofs [0, cNd_) that terms fall on (ContactPatch::TermDofs)
   bool                   cSingle_ = false;            // the cubature's K^ in float (ecswSingle), by dofs or by points
   std::vector<float>     cPwTs_, cThetaTs_, cQs_;     // ... its weights (M x rp rounded up to 8), theta' and Q (dofs)
-  std::vector<float>     cXs_;                        // ... kappa's used columns (M x Na, point-major; points)
+  std::vector<float>     cXs_;                        // ... kappa's used columns (M x ldf, Na rounded up to 8, point-major; points)
+  std::vector<float>     cThetaFs_;                   // ... theta's used columns (nnode dim x ldf; points: the nodal displacement, kappa's rows from cNt_, cRow_, cCoef_)
+  bool                   kapStale_ = false;           // the last evaluation formed kappa in float only (kap_ not its rows)
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;

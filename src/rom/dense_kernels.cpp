@@ -145,12 +145,32 @@ void RowDotsPortable(PetscInt rows, PetscInt n, const PetscReal *A, const PetscR
   }
 }
 
+void RowDotsPortableF(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out)
+{
+  for (PetscInt r = 0; r < rows; ++r) {
+    const float *a = A + (size_t)r * n;
+    float        s = 0;
+    for (PetscInt k = 0; k < n; ++k) s += a[k] * v[k];
+    out[r] = b[r] + s;
+  }
+}
+
 void CombinePortable(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out)
 {
   for (PetscInt k = 0; k < n; ++k) out[k] = 0;
   for (PetscInt j = 0; j < nt; ++j) {
     const PetscReal *t = rows[j];
     const PetscReal  a = coef[j];
+    for (PetscInt k = 0; k < n; ++k) out[k] += a * t[k];
+  }
+}
+
+void CombinePortableF(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out)
+{
+  for (PetscInt k = 0; k < n; ++k) out[k] = 0;
+  for (PetscInt j = 0; j < nt; ++j) {
+    const float *t = rows[j];
+    const float  a = (float)coef[j];
     for (PetscInt k = 0; k < n; ++k) out[k] += a * t[k];
   }
 }
@@ -330,6 +350,22 @@ __attribute__((target("avx2,fma"))) void RowDotsAvx2(PetscInt rows, PetscInt n, 
   }
 }
 
+__attribute__((target("avx2,fma"))) void RowDotsAvx2F(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out)
+{
+  for (PetscInt r = 0; r < rows; ++r) {
+    const float *a   = A + (size_t)r * n;
+    __m256       acc = _mm256_setzero_ps();
+    PetscInt     k   = 0;
+    for (; k + 8 <= n; k += 8) acc = _mm256_fmadd_ps(_mm256_loadu_ps(a + k), _mm256_loadu_ps(v + k), acc);
+    __m128 h = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps(acc, 1));
+    h        = _mm_add_ps(h, _mm_movehl_ps(h, h));
+    h        = _mm_add_ss(h, _mm_shuffle_ps(h, h, 1));
+    float s  = _mm_cvtss_f32(h);
+    for (; k < n; ++k) s += a[k] * v[k];
+    out[r] = b[r] + s;
+  }
+}
+
 // out (NB blocks of 4) held in registers over the terms: per term one broadcast and NB load-FMAs
 template <int NB>
 __attribute__((target("avx2,fma"))) void CombineAvx2Fixed(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscReal *out)
@@ -363,6 +399,32 @@ __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscRea
   }
 }
 
+// out[k0, k0 + 8 NB) held in NB registers of 8 floats over the terms
+template <int NB>
+__attribute__((target("avx2,fma"))) void CombineAvx2FFixed(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt k0, float *out)
+{
+  __m256 acc[NB];
+  for (int b = 0; b < NB; ++b) acc[b] = _mm256_setzero_ps();
+  for (PetscInt j = 0; j < nt; ++j) {
+    const __m256 cf = _mm256_set1_ps((float)coef[j]);
+    const float *t  = rows[j] + k0;
+    for (int b = 0; b < NB; ++b) acc[b] = _mm256_fmadd_ps(cf, _mm256_loadu_ps(t + 8 * b), acc[b]);
+  }
+  for (int b = 0; b < NB; ++b) _mm256_storeu_ps(out + k0 + 8 * b, acc[b]);
+}
+
+__attribute__((target("avx2,fma"))) void CombineAvx2F(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out)
+{
+  PetscInt k = 0;
+  // passes of up to 12 blocks of 8 in registers, then the tail entry by entry
+  for (PetscInt nb; (nb = std::min<PetscInt>((n - k) / 8, 12)) > 0; k += 8 * nb) WithRegisterBlocks(nb, [&](auto b) { CombineAvx2FFixed<decltype(b)::value>(nt, coef, rows, k, out); });
+  for (; k < n; ++k) {
+    float s = 0;
+    for (PetscInt j = 0; j < nt; ++j) s += (float)coef[j] * rows[j][k];
+    out[k] = s;
+  }
+}
+
 // The same loops vectorized 4-wide with FMA by the compiler (the inner loops run over the r rows, contiguous)
 __attribute__((target("avx2,fma"))) void RightSolveTAvx2(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
 __attribute__((target("avx2,fma"))) void LowerGramAvx2(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
@@ -388,6 +450,14 @@ void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *row
   if (HaveAvx2()) return CombineAvx2(nt, coef, rows, n, out);
 #endif
   CombinePortable(nt, coef, rows, n, out);
+}
+
+void CombineRowsSingle(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return CombineAvx2F(nt, coef, rows, n, out);
+#endif
+  CombinePortableF(nt, coef, rows, n, out);
 }
 
 namespace {
@@ -503,6 +573,14 @@ void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, 
   if (HaveAvx2()) return RowDotsAvx2(rows, n, A, v, b, out);
 #endif
   RowDotsPortable(rows, n, A, v, b, out);
+}
+
+void RowDotsSingle(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return RowDotsAvx2F(rows, n, A, v, b, out);
+#endif
+  RowDotsPortableF(rows, n, A, v, b, out);
 }
 
 } // namespace rbc

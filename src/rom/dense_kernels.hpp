@@ -9,6 +9,9 @@ namespace rbc {
 
 // out[0:n) = sum_j coef[j] * rows[j][0:n)   (nt terms)
 void CombineRows(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out);
+// The same in float (coefficients rounded to float): kappa's rows for the points' sum in single precision, from a
+// float copy of theta's used columns (half the bytes read, twice the entries per vector operation)
+void CombineRowsSingle(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out);
 
 // Sum of outer products over M points: K(:, c) = sum_p W(p, :) X(c, p) for c < nc, with W (M x rp,
 // point-major, rp a multiple of 4, padding zero) and X (nc x M, row-major); K is rp x nc, column-major.
@@ -38,6 +41,9 @@ void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float 
 // out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major; b and out may be the same array): the patch's
 // nodal displacement U = uD + theta v (ContactPatch::SetReduced), the cubature points' multipliers (ResultantForce).
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out);
+// The same with A and v in float, the dots summed in float and added to b in double: the patch's nodal displacement
+// from the float copy of theta that the single-precision points' sum keeps (half the bytes of the double theta)
+void RowDotsSingle(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out);
 
 // The reduced QP's set-up (src/rom/reduced_qp.cpp): X = D L^{-T} (D, X: r x n column-major, leading
 // dimension r; L lower n x n, column-major) and the lower triangle of S = X X' (S r x r).

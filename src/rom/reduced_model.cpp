@@ -507,22 +507,26 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     // (single precision: the sums do twice the work per vector operation, count half; the gemm of the BLAS half
     // the built-in kernels' time per flop, measured: docs/online.md "The BLAS for the cubature's sums")
     const double sp = ecswSingle ? 0.5 : 1.0, gm = gemmBlas ? 0.5 : 1.0;
-    const double byPoints = (double)Mc * (2.0 * nt * Nfull) + sp * gm * (double)Mc * rp * (Na + 1), byDofs = sp * ((double)Mc * rp * (nt + 1) + gm * (double)nd * rp * Na);
+    // (the points' row combination: every stored column in double, kappa's used columns in float in single precision)
+    const double byPoints = (double)Mc * (2.0 * nt * (ecswSingle ? sp * PaddedRows(Na, 8) : Nfull)) + sp * gm * (double)Mc * rp * (Na + 1), byDofs = sp * ((double)Mc * rp * (nt + 1) + gm * (double)nd * rp * Na);
     cDofs_ = Mc > 0 && (ecswSum == EcswSum::Dofs || (ecswSum == EcswSum::Auto && byDofs < byPoints));
     cNd_   = nd;
     cThetaT_.clear();
+    cSingle_ = Mc > 0 && ecswSingle;
     if (cDofs_) {
       cThetaT_.assign((size_t)Na * nd, 0.0);
       for (PetscInt c = 0; c < Na; ++c)
         for (PetscInt a = 0; a < nd; ++a) cThetaT_[(size_t)c * nd + a] = patch.theta[(size_t)a * patch.N + cols_[c]];
       cQ_.assign((size_t)nd * rp, 0.0);
+    }
+    if (cDofs_ || cSingle_) { // the points' terms (the single points' sum combines kappa from them in float)
       cNt_.assign(Mc, 0);
       cRow_.assign((size_t)Mc * ContactPatch::MaxTerms, 0);
       cCoef_.assign((size_t)Mc * ContactPatch::MaxTerms, 0.0);
     }
-    cSingle_ = Mc > 0 && ecswSingle;
     cPwTs_.clear();
     cThetaTs_.clear();
+    cThetaFs_.clear();
     cXs_.clear();
     if (cSingle_) {
       const PetscInt rps = PaddedRows(r, 8);
@@ -530,7 +534,14 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
       for (PetscInt p = 0; p < Mc; ++p)
         for (PetscInt i = 0; i < r; ++i) cPwTs_[(size_t)p * rps + i] = (float)cPwT_[(size_t)p * rp + i];
       if (cDofs_) cThetaTs_.assign(cThetaT_.begin(), cThetaT_.end());
-      else cXs_.assign((size_t)Mc * Na, 0.0f);
+      else { // theta's used columns in float, rows padded to 8 with zeros (every patch dof x ldf): the nodal
+        // displacement and kappa's rows in float
+        const PetscInt ldf = PaddedRows(Na, 8), nr = patch.nnode * patch.dim;
+        cThetaFs_.assign((size_t)nr * ldf, 0.0f);
+        for (PetscInt a = 0; a < nr; ++a)
+          for (PetscInt c = 0; c < Na; ++c) cThetaFs_[(size_t)a * ldf + c] = (float)patch.theta[(size_t)a * patch.N + cols_[c]];
+        cXs_.assign((size_t)Mc * ldf, 0.0f);
+      }
     }
   }
   if (!P_.empty()) {
@@ -671,13 +682,23 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       patch.SetGeometry(&par.map, mu);
       geomMu_ = mu;
     }
-    patch.SetReduced(vfull.data());
+    if (cSingle_ && !cDofs_) { // U = uD + theta(:, cols) v from theta's float copy (half the bytes of the double theta)
+      const PetscInt       ldf = PaddedRows(Na, 8);
+      thread_local std::vector<float>     vf;
+      thread_local std::vector<PetscReal> U;
+      vf.assign(ldf, 0.0f);
+      for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)v[i];
+      U.resize((size_t)patch.nnode * patch.dim);
+      RowDotsSingle(patch.nnode * patch.dim, ldf, cThetaFs_.data(), vf.data(), patch.uD.data(), U.data());
+      patch.SetNodal(U);
+    } else patch.SetReduced(vfull.data());
     const PetscInt rp = PaddedRows(r);
     SetGemmBlas(gemmBlas); // this model's choice for the sums below (-rom_gemm)
     wn_.resize((size_t)M * patch.dim);
     wnMode_ = ContactMode::Cubature;
-    out = cDofs_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
-                 : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    out = cDofs_ || cSingle_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
+                             : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    kapStale_ = cSingle_ && !cDofs_; // kappa's double rows not formed (EstimateError forms them from the terms)
     if (cSingle_) {
       const PetscInt rps = PaddedRows(r, 8), nd = cNd_;
       cK_.resize((size_t)rps * Na);
@@ -685,10 +706,15 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         cQs_.assign((size_t)nd * rps, 0.0f);
         ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
         SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
-      } else { // the points' sum: kappa's used columns in float, then one sum
-        for (PetscInt p = 0; p < M; ++p)
-          for (PetscInt c = 0; c < Na; ++c) cXs_[(size_t)p * Na + c] = (float)kap_[(size_t)p * Nfull + cols_[c]];
-        SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), Na, cK_.data());
+      } else { // the points' sum: kappa's used columns combined in float from theta's (cThetaFs_), then one sum
+        const PetscInt ldf = PaddedRows(Na, 8);
+        const float   *rows[ContactPatch::MaxTerms];
+        for (PetscInt p = 0; p < M; ++p) {
+          const PetscInt *ri = &cRow_[(size_t)p * ContactPatch::MaxTerms];
+          for (PetscInt t = 0; t < cNt_[p]; ++t) rows[t] = &cThetaFs_[(size_t)ri[t] * ldf];
+          CombineRowsSingle(cNt_[p], &cCoef_[(size_t)p * ContactPatch::MaxTerms], rows, ldf, &cXs_[(size_t)p * ldf]);
+        }
+        SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), ldf, cK_.data());
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
       cX_.resize(rp);
@@ -937,6 +963,10 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
         eKp_[i + (size_t)rpf * Nf] += wp * gam_[p];
       }
   } else {
+    if (kapStale_) { // the single points' sum left kappa in float, used columns only: its double rows from the terms
+      for (PetscInt p = 0; p < M; ++p) patch.KappaRow(cNt_[p], &cRow_[(size_t)p * ContactPatch::MaxTerms], &cCoef_[(size_t)p * ContactPatch::MaxTerms], &kap_[(size_t)p * Nf]);
+      kapStale_ = false;
+    }
     SetGemmBlas(gemmBlas);
     CubatureSum(rpf, ePwT_, eThetaT_, nullptr, Nf, &eQ_, &eX_, &eKp_); // the answer's sum, every stored row and column
   }
