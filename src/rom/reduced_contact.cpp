@@ -232,7 +232,8 @@ void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector
     Point P = points[keep[i]];
     P.facet = snew[P.facet];
     out->points.push_back(P);
-    // nearest first (reference centroids): ClosestPoint::FindAmong scans in this order and prunes the rest
+    // nearest first (reference centroids): ClosestPoint::FindAmong starts from the candidate with the nearest deformed
+    // centroid, then scans in this order and prunes the rest
     const SurfaceFacet &S = slave[points[keep[i]].facet];
     PetscReal           z[3] = {0, 0, 0};
     for (PetscInt k = 0; k < S.nv; ++k)
