@@ -106,6 +106,14 @@ int main(int argc, char **argv)
     }
     const PetscReal d = GramMismatch(G, Q, H);
     Check(d <= 1e-13, "CubatureGram = G'G of the explicit fitting rows (max |diff| / max |G'G|)", d, 1e-13);
+    // the Hadamard product accumulated 2 columns at a time (17: a partial last block); by default one block holds
+    // every column up to about 64 MB, so only the finest 3D level's Gram systems are split
+    std::vector<PetscReal> H2;
+    SetCubatureGramColumnBlock(2);
+    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H2);
+    SetCubatureGramColumnBlock(0);
+    const PetscReal d2 = GramMismatch(G, Q, H2);
+    Check(d2 <= 1e-13, "CubatureGram, its products 2 columns at a time = G'G of the explicit rows", d2, 1e-13);
   }
 
   { // 1b. the action fit's Gram matrix against its explicit rows: per state s and training solution j,
@@ -191,13 +199,24 @@ int main(int argc, char **argv)
     CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HB, Sw, dim, 2);
     const PetscReal dB = GramMismatch(GG, Q, HB);
     Check(ms > 2 && dB <= 1e-13, "CubatureActionGram with the states in blocks of 2 = G'G of the explicit rows", dB, 1e-13);
+    // the Hadamard products 2 columns at a time (a partial last block), the states in blocks of 2
+    std::vector<PetscReal> HK;
+    SetCubatureGramColumnBlock(2);
+    CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HK, Sw, dim, 2);
+    SetCubatureGramColumnBlock(0);
+    const PetscReal dK = GramMismatch(GG, Q, HK);
+    Check(dK <= 1e-13, "CubatureActionGram, products 2 columns at a time, states in blocks of 2 = G'G of the explicit rows", dK, 1e-13);
     // on candidate points C (every third point): H_CC, (H 1)_C and 1'H1 of the explicit rows over every point,
-    // with the states in one block and in blocks of 2
+    // with the states in one block and in blocks of 2, and (cols 2) the products 2 columns at a time (6 candidates)
     CubatureCandidates cand;
     for (PetscInt p = 1; p < Q; p += 3) cand.points.push_back(p);
-    for (PetscInt blk : {0, 2}) {
+    for (PetscInt blk : {0, 2, -2}) {
+      const bool cols2 = blk < 0;
+      blk              = std::abs(blk);
       std::vector<PetscReal> HC;
+      SetCubatureGramColumnBlock(cols2 ? 2 : 0);
       CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HC, Sw, dim, blk, &cand);
+      SetCubatureGramColumnBlock(0);
       PetscReal d = 0, sc = 0, db = 0, sb = 0, c = 0;
       const size_t rows = GG.size() / Q, nc = cand.points.size();
       std::vector<PetscReal> G1(rows, 0.0);
@@ -216,7 +235,8 @@ int main(int argc, char **argv)
           sc = std::max(sc, std::abs(h));
         }
       }
-      Check(HC.size() == nc * nc && d <= 1e-13 * sc, blk ? "candidates, blocks of 2: H_CC = (G'G)_CC (max |diff| / max)" : "candidates: H_CC = (G'G)_CC of the explicit rows (max |diff| / max)", d / sc, 1e-13);
+      Check(HC.size() == nc * nc && d <= 1e-13 * sc, cols2 ? "candidates, blocks of 2, products 2 columns at a time: H_CC = (G'G)_CC" : blk ? "candidates, blocks of 2: H_CC = (G'G)_CC (max |diff| / max)" : "candidates: H_CC = (G'G)_CC of the explicit rows (max |diff| / max)", d / sc, 1e-13);
+      if (cols2) continue; // (the rest as with blocks of 2)
       Check(db <= 1e-13 * sb, blk ? "candidates, blocks of 2: b_C = (G'G 1)_C over every point" : "candidates: b_C = (G'G 1)_C over every point (max |diff| / max)", db / sb, 1e-13);
       Check(std::abs(c - cand.c) <= 1e-13 * c, "candidates: c = |G 1|^2 over every point (rel diff)", std::abs(c - cand.c) / c, 1e-13);
       // the per-state scalings formed by a first call and reused by a second: the same Gram system bit for bit

@@ -32,7 +32,7 @@ struct CubatureOptions {
   PetscReal tol       = 1e-4;  // stop when ||G (xi - 1)|| <= tol ||G 1|| (relative RMS error of the fitted terms)
   PetscInt  maxPoints = 1000;  // at most this many points (the tolerance decides; a safeguard)
   PetscInt  groupPoints = 8000; // -ecsw_group_points: more quadrature points than this: the hierarchical fit
-                                // (HierarchicalCubature); the Gram memory stays 3 x 8 bytes x (this or the union)^2
+                                // (HierarchicalCubature); the Gram memory stays about 2.25 x 8 bytes x (this or the union)^2
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
   bool      incremental = false; // the Cholesky factor of H(S, S) updated as points enter (O(k^2) a step) instead of
                                  // refactored (O(k^3)); the hierarchical fit's groups and union use it, the one-Gram
@@ -112,6 +112,10 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
 // With cand (points nonempty): H is the candidates' Gram matrix, b and c come from cand, the selected points are
 // returned as indices into 0..Q-1.
 PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand = nullptr);
+// The Gram matrices' Hadamard products are accumulated a block of columns at a time (at most this many columns; 0, the
+// default: n / 8 of n, at least 64; the candidates' states are also gathered up to this many columns, or n^2 / 8 entries, before each
+// product). For tests, which exercise the blocks on small sizes; the result changes by rounding only.
+void SetCubatureGramColumnBlock(PetscInt columns);
 
 // The Gram system of the fit on candidates (nullptr: every point, H Q x Q): CubatureGram or CubatureActionGram bound to
 // their data.

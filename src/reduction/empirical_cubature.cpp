@@ -70,6 +70,29 @@ PetscInt StatesPerBlock(PetscInt Q, PetscInt per, PetscInt ms, PetscInt block)
   return std::max<PetscInt>(1, std::min<PetscInt>(std::max<PetscInt>(ms, 1), (PetscInt)((64u << 20) / std::max<size_t>(bytes, 1))));
 }
 
+PetscInt gramColumnBlock = 0; // SetCubatureGramColumnBlock (tests); 0: by memory
+
+// H (n x n, column-major) += GA o (X X') for X (n x k, leading dimension n), X X' formed a block of columns at a time
+// (n / 8 of them, at least 64; W the block's scratch): no second n x n matrix beside GA and H, so that the Gram system
+// of n points takes about 2.25 n^2 doubles, not 3 (the finest 3D level's final fit: docs/hyper_reduction.md "Memory").
+static void AddHadamardProductColumns(PetscInt n, PetscInt k, const PetscReal *X, const PetscReal *GA, PetscReal *H, std::vector<PetscReal> *W)
+{
+  if (n <= 0 || k <= 0) return;
+  const PetscInt jb = gramColumnBlock > 0 ? std::min(gramColumnBlock, n) : std::min<PetscInt>(n, std::max<PetscInt>(64, n / 8)); // W: n^2 / 8
+  W->resize((size_t)n * jb);
+  const PetscBLASInt m = (PetscBLASInt)n, kk = (PetscBLASInt)k;
+  const PetscReal    one = 1, zero = 0;
+  for (PetscInt j0 = 0; j0 < n; j0 += jb) {
+    const PetscBLASInt nj = (PetscBLASInt)std::min(jb, n - j0);
+    BLASgemm_("N", "T", &m, &nj, &kk, &one, X, &m, X + j0, &m, &zero, W->data(), &m);
+    for (PetscInt j = 0; j < nj; ++j) {
+      const PetscReal *ga = GA + (size_t)n * (j0 + j), *w = W->data() + (size_t)n * j;
+      PetscReal       *h  = H + (size_t)n * (j0 + j);
+      for (PetscInt i = 0; i < n; ++i) h[i] += ga[i] * w[i];
+    }
+  }
+}
+
 // H += (A A') o (B B') for A (Q x ka) and B (Q x kb), column-major: the Gram matrix of the fitting rows
 // whose coefficient of point p is A(p, a) B(p, b) (a Hadamard product of two Gram matrices, two GEMMs).
 void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand);
@@ -81,12 +104,11 @@ void AddHadamardGram(PetscInt Q, const PetscReal *A, PetscInt ka, const PetscRea
     AddHadamardGramBlocks(Q, A, ka, kb, 1, StatesPerBlock(Q, 1, kb, 0), [&](PetscInt c0, PetscInt cnt, PetscReal *Bb) { std::copy(B + (size_t)Q * c0, B + (size_t)Q * (c0 + cnt), Bb); }, H, cand);
     return;
   }
-  std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q);
-  const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka, b = (PetscBLASInt)kb;
+  std::vector<PetscReal> GA((size_t)Q * Q), W;
+  const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka;
   const PetscReal        one = 1, zero = 0;
   BLASgemm_("N", "T", &q, &q, &a, &one, A, &q, A, &q, &zero, GA.data(), &q);
-  BLASgemm_("N", "T", &q, &q, &b, &one, B, &q, B, &q, &zero, GB.data(), &q);
-  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
+  AddHadamardProductColumns(Q, kb, B, GA.data(), H->data(), &W);
 }
 
 // H += (A A') o (sum_b B_b B_b'), the columns B_b produced a block at a time by fill(first, count, B_b) (column-major
@@ -100,14 +122,13 @@ static void AddHadamardGramCandidates(PetscInt Q, const PetscReal *A, PetscInt k
   const std::vector<PetscInt> &C  = cand->points;
   const PetscInt               nc = (PetscInt)C.size();
   const bool                   gramToo = !cand->targetOnly;
-  std::vector<PetscReal>       AC((size_t)nc * ka), GA, GB, B, BC, T, U;
+  std::vector<PetscReal>       AC((size_t)nc * ka), GA, W, B, BC, T, U, Pend;
   for (PetscInt a = 0; a < ka; ++a)
     for (PetscInt i = 0; i < nc; ++i) AC[i + (size_t)nc * a] = A[C[i] + (size_t)Q * a];
   const PetscBLASInt q = (PetscBLASInt)Q, n = (PetscBLASInt)nc, a = (PetscBLASInt)ka;
   const PetscReal    one = 1, zero = 0;
   if (gramToo) {
     GA.resize((size_t)nc * nc);
-    GB.assign((size_t)nc * nc, 0.0);
     BLASgemm_("N", "T", &n, &n, &a, &one, AC.data(), &n, AC.data(), &n, &zero, GA.data(), &n);
     cand->b.resize(nc, 0.0);
   }
@@ -127,21 +148,29 @@ static void AddHadamardGramCandidates(PetscInt Q, const PetscReal *A, PetscInt k
       for (PetscReal t : T) cand->cOwn += t * t;
       continue;
     }
-    BLASgemm_("N", "T", &n, &n, &b, &one, BC.data(), &n, BC.data(), &n, &one, GB.data(), &n);
+    // H_CC += GA o (B_C B_C'), the blocks' B_C gathered up to n^2 / 8 entries first: each product's pass over H and
+    // GA then serves several states (one pass a state would move 2.5x the memory of the gemm's own updates)
+    const size_t cap = gramColumnBlock > 0 ? (size_t)gramColumnBlock * nc : (size_t)nc * nc / 8; // (tests: flush often)
+    if (Pend.empty() && BC.size() >= cap) AddHadamardProductColumns(nc, kb, BC.data(), GA.data(), H->data(), &W); // large enough alone: no copy
+    else {
+      Pend.insert(Pend.end(), BC.begin(), BC.end());
+      if (s0 + block >= ms || Pend.size() + BC.size() > cap) {
+        AddHadamardProductColumns(nc, (PetscInt)(Pend.size() / std::max<PetscInt>(nc, 1)), Pend.data(), GA.data(), H->data(), &W);
+        Pend.clear();
+      }
+    }
     U.resize((size_t)nc * ka); // B_C T
     BLASgemm_("N", "N", &n, &a, &b, &one, BC.data(), &n, T.data(), &b, &zero, U.data(), &n);
     for (PetscInt k = 0; k < ka; ++k)
       for (PetscInt i = 0; i < nc; ++i) cand->b[i] += AC[i + (size_t)nc * k] * U[i + (size_t)nc * k];
   }
-  if (gramToo)
-    for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
 
 void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt ms, PetscInt per, PetscInt block, const std::function<void(PetscInt, PetscInt, PetscReal *)> &fill, std::vector<PetscReal> *H, CubatureCandidates *cand)
 {
   if (ka <= 0 || per <= 0 || ms <= 0) return;
   if (cand && !cand->points.empty()) return AddHadamardGramCandidates(Q, A, ka, ms, per, block, fill, H, cand);
-  std::vector<PetscReal> GA((size_t)Q * Q), GB((size_t)Q * Q, 0.0), B;
+  std::vector<PetscReal> GA((size_t)Q * Q), B, W;
   const PetscBLASInt     q = (PetscBLASInt)Q, a = (PetscBLASInt)ka;
   const PetscReal        one = 1, zero = 0;
   BLASgemm_("N", "T", &q, &q, &a, &one, A, &q, A, &q, &zero, GA.data(), &q);
@@ -149,10 +178,8 @@ void AddHadamardGramBlocks(PetscInt Q, const PetscReal *A, PetscInt ka, PetscInt
     const PetscInt cnt = std::min(block, ms - s0);
     B.assign((size_t)Q * cnt * per, 0.0);
     fill(s0, cnt, B.data());
-    const PetscBLASInt b = (PetscBLASInt)(cnt * per);
-    BLASgemm_("N", "T", &q, &q, &b, &one, B.data(), &q, B.data(), &q, &one, GB.data(), &q);
+    AddHadamardProductColumns(Q, cnt * per, B.data(), GA.data(), H->data(), &W); // H += GA o (B_b B_b')
   }
-  for (size_t i = 0; i < GA.size(); ++i) (*H)[i] += GA[i] * GB[i];
 }
 
 // H zeroed at its size (Q x Q, or the candidates' |C| x |C| with their target pieces b, c zeroed too; empty with
@@ -170,6 +197,8 @@ void ResetGram(PetscInt Q, std::vector<PetscReal> *H, CubatureCandidates *cand)
   }
 }
 } // namespace
+
+void SetCubatureGramColumnBlock(PetscInt columns) { gramColumnBlock = std::max<PetscInt>(columns, 0); }
 
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
 {
