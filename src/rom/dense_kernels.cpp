@@ -188,6 +188,7 @@ struct Avx2Reg<double> {
   __attribute__((target("avx2,fma"))) static RBC_INLINE V Bcast(const double *x) { return _mm256_broadcast_sd(x); }
   __attribute__((target("avx2,fma"))) static RBC_INLINE V Fma(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
   __attribute__((target("avx2,fma"))) static RBC_INLINE void Store(PetscReal *k, V a) { _mm256_storeu_pd(k, a); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE void StoreSame(double *k, V a) { _mm256_storeu_pd(k, a); }
 };
 template <>
 struct Avx2Reg<float> {
@@ -202,6 +203,7 @@ struct Avx2Reg<float> {
     _mm256_storeu_pd(k, _mm256_cvtps_pd(_mm256_castps256_ps128(a)));
     _mm256_storeu_pd(k + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)));
   }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE void StoreSame(float *k, V a) { _mm256_storeu_ps(k, a); }
 };
 
 // 3 registers of rows x 4 columns in 12 registers: 3 loads and 4 broadcasts per 12 FMAs (the 1 x 4 block below
@@ -366,18 +368,21 @@ __attribute__((target("avx2,fma"))) void RowDotsAvx2F(PetscInt rows, PetscInt n,
   }
 }
 
-// out (NB blocks of 4) held in registers over the terms: per term one broadcast and NB load-FMAs
-template <int NB>
-__attribute__((target("avx2,fma"))) void CombineAvx2Fixed(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscReal *out)
+// out[k0, k0 + NB w) (w = 4 doubles or 8 floats) held in NB registers over the terms: per term one broadcast and NB
+// load-FMAs (double: kappa's rows; float: the single points' sum, the coefficients rounded to float)
+template <class T, int NB>
+__attribute__((target("avx2,fma"))) void CombineAvx2Fixed(PetscInt nt, const PetscReal *coef, const T *const *rows, PetscInt k0, T *out)
 {
-  __m256d acc[NB];
-  for (int b = 0; b < NB; ++b) acc[b] = _mm256_setzero_pd();
+  using R = Avx2Reg<T>;
+  typename R::V acc[NB];
+  for (int b = 0; b < NB; ++b) acc[b] = R::Zero();
   for (PetscInt j = 0; j < nt; ++j) {
-    const __m256d    cf = _mm256_broadcast_sd(coef + j);
-    const PetscReal *t  = rows[j];
-    for (int b = 0; b < NB; ++b) acc[b] = _mm256_fmadd_pd(cf, _mm256_loadu_pd(t + 4 * b), acc[b]);
+    const T             c  = (T)coef[j];
+    const typename R::V cf = R::Bcast(&c);
+    const T            *t  = rows[j] + k0;
+    for (int b = 0; b < NB; ++b) acc[b] = R::Fma(cf, R::Load(t + R::width * b), acc[b]);
   }
-  for (int b = 0; b < NB; ++b) _mm256_storeu_pd(out + 4 * b, acc[b]);
+  for (int b = 0; b < NB; ++b) R::StoreSame(out + k0 + R::width * b, acc[b]);
 }
 
 __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscReal *coef, const PetscReal *const *rows, PetscInt n, PetscReal *out)
@@ -385,7 +390,7 @@ __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscRea
   PetscInt k = 0;
   // the first up to 48 entries with the output in registers (12 blocks), the rest block by block
   const PetscInt nb = std::min<PetscInt>(n / 4, 12);
-  WithRegisterBlocks(nb, [&](auto b) { CombineAvx2Fixed<decltype(b)::value>(nt, coef, rows, out); });
+  WithRegisterBlocks(nb, [&](auto b) { CombineAvx2Fixed<double, decltype(b)::value>(nt, coef, rows, 0, out); });
   k = 4 * nb;
   for (; k + 4 <= n; k += 4) {
     __m256d a = _mm256_setzero_pd();
@@ -399,25 +404,11 @@ __attribute__((target("avx2,fma"))) void CombineAvx2(PetscInt nt, const PetscRea
   }
 }
 
-// out[k0, k0 + 8 NB) held in NB registers of 8 floats over the terms
-template <int NB>
-__attribute__((target("avx2,fma"))) void CombineAvx2FFixed(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt k0, float *out)
-{
-  __m256 acc[NB];
-  for (int b = 0; b < NB; ++b) acc[b] = _mm256_setzero_ps();
-  for (PetscInt j = 0; j < nt; ++j) {
-    const __m256 cf = _mm256_set1_ps((float)coef[j]);
-    const float *t  = rows[j] + k0;
-    for (int b = 0; b < NB; ++b) acc[b] = _mm256_fmadd_ps(cf, _mm256_loadu_ps(t + 8 * b), acc[b]);
-  }
-  for (int b = 0; b < NB; ++b) _mm256_storeu_ps(out + k0 + 8 * b, acc[b]);
-}
-
 __attribute__((target("avx2,fma"))) void CombineAvx2F(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out)
 {
   PetscInt k = 0;
   // passes of up to 12 blocks of 8 in registers, then the tail entry by entry
-  for (PetscInt nb; (nb = std::min<PetscInt>((n - k) / 8, 12)) > 0; k += 8 * nb) WithRegisterBlocks(nb, [&](auto b) { CombineAvx2FFixed<decltype(b)::value>(nt, coef, rows, k, out); });
+  for (PetscInt nb; (nb = std::min<PetscInt>((n - k) / 8, 12)) > 0; k += 8 * nb) WithRegisterBlocks(nb, [&](auto b) { CombineAvx2Fixed<float, decltype(b)::value>(nt, coef, rows, k, out); });
   for (; k < n; ++k) {
     float s = 0;
     for (PetscInt j = 0; j < nt; ++j) s += (float)coef[j] * rows[j][k];
