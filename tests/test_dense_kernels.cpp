@@ -6,7 +6,7 @@
 // residual X L' - D) and LowerGram of the reduced QP's set-up, n 1..60; RowDots (U = uD + theta v). The dispatched version (AVX2+FMA
 // where the CPU has it) must agree with the plain sums to rounding (1e-13 relative to the sum of |terms|). The single-precision
 // dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) and the float row combination
-// (CombineRowsSingle) within the float accumulation bound.
+// (CombineRowsSingle) and dots (RowDotsSingle) within the float accumulation bound.
 // The sums of outer products each by the BLAS's gemm and by the built-in kernels (SetGemmBlas), and from point-major
 // rows (SumOfOuterProductsRows*, the points' sum of the cubature).
 #include "../src/rom/dense_kernels.hpp"
@@ -248,6 +248,31 @@ int main(int argc, char **argv)
         if (!(e <= 1e-13)) {
           ++failures;
           PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL RowDots rows %d n %d entry %d: %g vs %g\n", (int)rows, (int)n, (int)r, out[r], s));
+        }
+      }
+    }
+  // RowDotsSingle: out = b + A v with A, v in float (the dots in float, b added in double): within the float bound of
+  // the dots' terms, n around the 8-wide blocks
+  for (PetscInt rows : {0, 1, 7})
+    for (PetscInt n : {0, 1, 7, 8, 9, 16, 17, 192, 197}) {
+      std::vector<float>  A((size_t)rows * n), v(n);
+      std::vector<double> b(rows), out(rows, -7.0);
+      for (auto &x : A) x = (float)u(gen);
+      for (auto &x : v) x = (float)u(gen);
+      for (auto &x : b) x = u(gen);
+      RowDotsSingle(rows, n, A.data(), v.data(), b.data(), out.data());
+      for (PetscInt r = 0; r < rows; ++r) {
+        double s = b[r], a = 0;
+        for (PetscInt k = 0; k < n; ++k) {
+          s += (double)A[(size_t)r * n + k] * v[k];
+          a += std::abs((double)A[(size_t)r * n + k] * v[k]);
+        }
+        const double e = std::abs(out[r] - s);
+        worst32        = std::max(worst32, a > 0 ? e / a : e);
+        ++checks;
+        if (!(e <= (n + 2) * uf * a + 1e-15 * std::abs(b[r]))) {
+          ++failures;
+          PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL RowDotsSingle rows %d n %d entry %d: %g vs %g\n", (int)rows, (int)n, (int)r, out[r], s));
         }
       }
     }
