@@ -82,7 +82,7 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
   // scan, then in a second pass over the candidates (docs/rom3d.md); the lists are sorted nearest first offline, at
   // the training states, but on the finest 3D level's model (48 candidates a point) that first one was the closest
   // for 1 % of the points, and the nearest centre first takes it from 6.4-9.2 to 3.0-3.1 triangle distances a point
-  // (5 % of its online time); lists of at most 32 keep the single pass below.
+  // (5 % of its online time); lists of at most 32 start from the stored first.
   auto visit = [&](PetscInt f) {
     PetscReal       bb[3];
     const PetscReal dd = DistToFacet2(f, p, bb);
@@ -92,38 +92,23 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
       for (PetscInt k = 0; k < nv_; ++k) b[k] = bb[k];
     }
   };
-  if (dim_ == 3 && nc <= 32) { // short lists (sphere_block3d: 19 a point, the stored first the closest for half the
-    // points): one pass in the stored order, the bound from the first visit (the nearest centroid first cost 7 % there)
-    PetscReal sb = PETSC_MAX_REAL;
-    for (PetscInt i = 0; i < nc; ++i) {
+  if (dim_ == 3) { // sphere_ is set with the vertices
+    auto centre2 = [&](PetscInt i) {
       const PetscReal *c = &sphere_[4 * cand[i]];
-      if (*facet >= 0) {
-        const PetscReal d2c = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]), reach = sb + c[3];
-        if (d2c > reach * reach) continue;
-      }
-      const PetscReal before = best;
-      visit(cand[i]);
-      if (best != before) sb = std::sqrt(best);
-    }
-  } else if (dim_ == 3) { // sphere_ is set with the vertices
-    thread_local std::vector<PetscReal> d2;
-    d2.resize(nc);
-    PetscInt  first = -1;
-    PetscReal dmin  = PETSC_MAX_REAL;
-    for (PetscInt i = 0; i < nc; ++i) {
-      const PetscReal *c = &sphere_[4 * cand[i]];
-      d2[i]              = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
-      if (d2[i] < dmin) {
-        dmin  = d2[i];
-        first = i;
-      }
-    }
-    if (first >= 0) visit(cand[first]);
+      return (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
+    };
+    // the first visit: the stored first for short lists (sphere_block3d: 19 a point, the closest for half the points;
+    // a pass over the centres cost 7 % there), the nearest centre above 32
+    PetscInt first = 0;
+    if (nc > 32)
+      for (PetscInt i = 1; i < nc; ++i)
+        if (centre2(i) < centre2(first)) first = i;
+    if (nc > 0) visit(cand[first]);
     PetscReal sb = std::sqrt(best);
     for (PetscInt i = 0; i < nc; ++i) {
       if (i == first) continue;
       const PetscReal reach = sb + sphere_[4 * cand[i] + 3];
-      if (d2[i] > reach * reach) continue;
+      if (centre2(i) > reach * reach) continue;
       const PetscReal before = best;
       visit(cand[i]);
       if (best != before) sb = std::sqrt(best);

@@ -189,6 +189,11 @@ struct Avx2Reg<double> {
   __attribute__((target("avx2,fma"))) static RBC_INLINE V Fma(V a, V b, V c) { return _mm256_fmadd_pd(a, b, c); }
   __attribute__((target("avx2,fma"))) static RBC_INLINE void Store(PetscReal *k, V a) { _mm256_storeu_pd(k, a); }
   __attribute__((target("avx2,fma"))) static RBC_INLINE void StoreSame(double *k, V a) { _mm256_storeu_pd(k, a); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE double HSum(V a)
+  {
+    const __m128d h = _mm_add_pd(_mm256_castpd256_pd128(a), _mm256_extractf128_pd(a, 1));
+    return _mm_cvtsd_f64(_mm_add_sd(h, _mm_unpackhi_pd(h, h)));
+  }
 };
 template <>
 struct Avx2Reg<float> {
@@ -204,6 +209,12 @@ struct Avx2Reg<float> {
     _mm256_storeu_pd(k + 4, _mm256_cvtps_pd(_mm256_extractf128_ps(a, 1)));
   }
   __attribute__((target("avx2,fma"))) static RBC_INLINE void StoreSame(float *k, V a) { _mm256_storeu_ps(k, a); }
+  __attribute__((target("avx2,fma"))) static RBC_INLINE float HSum(V a)
+  {
+    __m128 h = _mm_add_ps(_mm256_castps256_ps128(a), _mm256_extractf128_ps(a, 1));
+    h        = _mm_add_ps(h, _mm_movehl_ps(h, h));
+    return _mm_cvtss_f32(_mm_add_ss(h, _mm_shuffle_ps(h, h, 1)));
+  }
 };
 
 // 3 registers of rows x 4 columns in 12 registers: 3 loads and 4 broadcasts per 12 FMAs (the 1 x 4 block below
@@ -338,33 +349,26 @@ __attribute__((target("avx2,fma"))) void ScatterAvx2F(PetscInt M, PetscInt rp, c
   ScatterPortableF(M, rp, nt, maxTerms, rowIdx, coef, W, Q);
 }
 
-__attribute__((target("avx2,fma"))) void RowDotsAvx2(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
+// out[r] = b[r] + A(r, :) v with the dots in T (double: b added before the tail, as always; float: after it, the float
+// dot then added in double)
+template <class T>
+__attribute__((target("avx2,fma"))) void RowDotsAvx2T(PetscInt rows, PetscInt n, const T *A, const T *v, const PetscReal *b, PetscReal *out)
 {
+  using R = Avx2Reg<T>;
   for (PetscInt r = 0; r < rows; ++r) {
-    const PetscReal *a   = A + (size_t)r * n;
-    __m256d          acc = _mm256_setzero_pd();
-    PetscInt         k   = 0;
-    for (; k + 4 <= n; k += 4) acc = _mm256_fmadd_pd(_mm256_loadu_pd(a + k), _mm256_loadu_pd(v + k), acc);
-    const __m128d h = _mm_add_pd(_mm256_castpd256_pd128(acc), _mm256_extractf128_pd(acc, 1));
-    PetscReal     s = b[r] + _mm_cvtsd_f64(_mm_add_sd(h, _mm_unpackhi_pd(h, h)));
-    for (; k < n; ++k) s += a[k] * v[k];
-    out[r] = s;
-  }
-}
-
-__attribute__((target("avx2,fma"))) void RowDotsAvx2F(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out)
-{
-  for (PetscInt r = 0; r < rows; ++r) {
-    const float *a   = A + (size_t)r * n;
-    __m256       acc = _mm256_setzero_ps();
-    PetscInt     k   = 0;
-    for (; k + 8 <= n; k += 8) acc = _mm256_fmadd_ps(_mm256_loadu_ps(a + k), _mm256_loadu_ps(v + k), acc);
-    __m128 h = _mm_add_ps(_mm256_castps256_ps128(acc), _mm256_extractf128_ps(acc, 1));
-    h        = _mm_add_ps(h, _mm_movehl_ps(h, h));
-    h        = _mm_add_ss(h, _mm_shuffle_ps(h, h, 1));
-    float s  = _mm_cvtss_f32(h);
-    for (; k < n; ++k) s += a[k] * v[k];
-    out[r] = b[r] + s;
+    const T      *a   = A + (size_t)r * n;
+    typename R::V acc = R::Zero();
+    PetscInt      k   = 0;
+    for (; k + R::width <= n; k += R::width) acc = R::Fma(R::Load(a + k), R::Load(v + k), acc);
+    if constexpr (std::is_same<T, double>::value) {
+      PetscReal s = b[r] + R::HSum(acc);
+      for (; k < n; ++k) s += a[k] * v[k];
+      out[r] = s;
+    } else {
+      float s = R::HSum(acc);
+      for (; k < n; ++k) s += a[k] * v[k];
+      out[r] = b[r] + s;
+    }
   }
 }
 
@@ -561,7 +565,7 @@ void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt max
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out)
 {
 #ifdef RBC_KERNEL_DISPATCH
-  if (HaveAvx2()) return RowDotsAvx2(rows, n, A, v, b, out);
+  if (HaveAvx2()) return RowDotsAvx2T<double>(rows, n, A, v, b, out);
 #endif
   RowDotsPortable(rows, n, A, v, b, out);
 }
@@ -569,7 +573,7 @@ void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, 
 void RowDotsSingle(PetscInt rows, PetscInt n, const float *A, const float *v, const PetscReal *b, PetscReal *out)
 {
 #ifdef RBC_KERNEL_DISPATCH
-  if (HaveAvx2()) return RowDotsAvx2F(rows, n, A, v, b, out);
+  if (HaveAvx2()) return RowDotsAvx2T<float>(rows, n, A, v, b, out);
 #endif
   RowDotsPortableF(rows, n, A, v, b, out);
 }
