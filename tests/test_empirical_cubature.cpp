@@ -56,6 +56,15 @@ static PetscReal GramMismatch(const std::vector<PetscReal> &G, PetscInt Q, const
   return sc > 0 ? d / sc : d;
 }
 
+// (K' lam_j) (N) for K (R x N, row-major) and the training multipliers Lam (nt x R, row-major): the action fit's force rows.
+static std::vector<PetscReal> ForceAction(const std::vector<PetscReal> &K, const std::vector<PetscReal> &Lam, PetscInt j, PetscInt R, PetscInt N)
+{
+  std::vector<PetscReal> f(N, 0.0);
+  for (PetscInt n = 0; n < N; ++n)
+    for (PetscInt r = 0; r < R; ++r) f[n] += K[(size_t)r * N + n] * Lam[(size_t)j * R + r];
+  return f;
+}
+
 static PetscReal Norm2(const std::vector<PetscReal> &v)
 {
   PetscReal s = 0;
@@ -155,11 +164,7 @@ int main(int argc, char **argv)
       Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
       PetscReal n1 = 0, n2 = 0;
       for (PetscInt j = 0; j < nt; ++j) {
-        for (PetscInt n = 0; n < N; ++n) {
-          PetscReal t = 0;
-          for (PetscInt r = 0; r < R; ++r) t += K[(size_t)r * N + n] * Lam[(size_t)j * R + r];
-          n1 += t * t;
-        }
+        for (PetscReal t : ForceAction(K, Lam, j, R, N)) n1 += t * t;
         for (PetscInt r = 0; r < R; ++r) {
           PetscReal t = 0;
           for (PetscInt n = 0; n < N; ++n) t += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
@@ -173,11 +178,8 @@ int main(int argc, char **argv)
           std::fill(e.begin(), e.end(), 0.0);
           e[p] = 1;
           Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
-          for (PetscInt n = 0; n < N; ++n) {
-            PetscReal t = 0;
-            for (PetscInt r = 0; r < R; ++r) t += K[(size_t)r * N + n] * Lam[(size_t)j * R + r];
-            rows1[(size_t)n * Q + p] = t / std::sqrt(n1);
-          }
+          const std::vector<PetscReal> f = ForceAction(K, Lam, j, R, N);
+          for (PetscInt n = 0; n < N; ++n) rows1[(size_t)n * Q + p] = f[n] / std::sqrt(n1);
           for (PetscInt r = 0; r < R; ++r) {
             PetscReal t = -g[r];
             for (PetscInt n = 0; n < N; ++n) t += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
@@ -206,6 +208,138 @@ int main(int argc, char **argv)
     SetCubatureGramColumnBlock(0);
     const PetscReal dK = GramMismatch(GG, Q, HK);
     Check(dK <= 1e-13, "CubatureActionGram, products 2 columns at a time, states in blocks of 2 = G'G of the explicit rows", dK, 1e-13);
+    // the lambda fit (metric T_j, k_j x R: 2, 0 and 3 rows): the constraint rows T_j (K_s(e_p) v_j - g_s(e_p)) / sqrt(sum_j
+    // |T_j K_s v_j|^2 + |T_j g_s|^2) in place of the plain ones; with the force rows; kappa_s v_j from the blocks and
+    // from a kappaTimes callback
+    {
+      CubatureLambdaMetric metric;
+      const PetscInt       ks[] = {2, 0, 3};
+      for (PetscInt j = 0; j < nt; ++j) {
+        metric.T.emplace_back((size_t)ks[j] * R);
+        for (auto &x : metric.T.back()) x = U(gen);
+      }
+      std::vector<PetscReal> GL, HL, HL2;
+      for (PetscInt s = 0; s < ms; ++s) {
+        Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
+        PetscReal n1 = 0, n2 = 0;
+        for (PetscInt j = 0; j < nt; ++j) {
+          for (PetscReal t : ForceAction(K, Lam, j, R, N)) n1 += t * t;
+          const std::vector<PetscReal> &T = metric.T[j];
+          for (PetscInt i = 0; i < ks[j]; ++i) {
+            PetscReal a = 0, b = 0;
+            for (PetscInt r = 0; r < R; ++r) {
+              PetscReal kv = 0;
+              for (PetscInt n = 0; n < N; ++n) kv += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+              a += T[(size_t)i * R + r] * kv;
+              b += T[(size_t)i * R + r] * g[r];
+            }
+            n2 += a * a + b * b;
+          }
+        }
+        for (PetscInt j = 0; j < nt; ++j) {
+          std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)ks[j] * Q);
+          for (PetscInt p = 0; p < Q; ++p) {
+            std::fill(e.begin(), e.end(), 0.0);
+            e[p] = 1;
+            Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
+            const std::vector<PetscReal> f = ForceAction(K, Lam, j, R, N);
+            for (PetscInt n = 0; n < N; ++n) rows1[(size_t)n * Q + p] = f[n] / std::sqrt(n1);
+            for (PetscInt i = 0; i < ks[j]; ++i) {
+              PetscReal t = 0;
+              for (PetscInt r = 0; r < R; ++r) {
+                PetscReal c = -g[r];
+                for (PetscInt n = 0; n < N; ++n) c += K[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+                t += metric.T[j][(size_t)i * R + r] * c;
+              }
+              rows2[(size_t)i * Q + p] = t / std::sqrt(n2);
+            }
+          }
+          GL.insert(GL.end(), rows1.begin(), rows1.end());
+          GL.insert(GL.end(), rows2.begin(), rows2.end());
+        }
+      }
+      GL.insert(GL.end(), GF.begin(), GF.end());
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HL, Sw, dim, 2, nullptr, nullptr, &metric);
+      const PetscReal dL = GramMismatch(GL, Q, HL);
+      Check(dL <= 1e-13, "CubatureActionGram with the lambda metric (T_j (K v_j - g) rows, force rows, blocks of 2) = G'G of the explicit rows", dL, 1e-13);
+      metric.kappaTimes = [&](PetscInt s, PetscInt j, PetscReal *y) {
+        for (PetscInt p = 0; p < Q; ++p) {
+          y[p] = 0;
+          for (PetscInt n = 0; n < N; ++n) y[p] += Sk[((size_t)s * Q + p) * N + n] * Vs[(size_t)j * N + n];
+        }
+      };
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HL2, Sw, dim, 0, nullptr, nullptr, &metric);
+      const PetscReal dL2 = GramMismatch(GL, Q, HL2);
+      Check(dL2 <= 1e-13, "CubatureActionGram with the lambda metric, kappa_s v_j by the callback = G'G of the explicit rows", dL2, 1e-13);
+    }
+    // CubatureLambdaWeights against the reduced saddle point solved directly: for a change dr of the constraint values,
+    // [A K_F'; K_F 0] [x; y] = [0; dr_F] (Gaussian elimination with partial pivoting) gives the multiplier change y, and
+    // |T dr|^2 must equal y' M_F y (free set F: the positive coefficients, 3 of 4)
+    {
+      const PetscInt         Rw = 4, Nw = 5;
+      std::vector<PetscReal> A((size_t)Nw * Nw, 0.0), B((size_t)Nw * Nw), Kw((size_t)Rw * Nw), lam = {0.3, 0.0, 1.2, 0.7}, M((size_t)Rw * Rw, 0.0), C((size_t)Rw * Rw), T;
+      for (auto &x : B) x = U(gen);
+      for (PetscInt i = 0; i < Nw; ++i)
+        for (PetscInt j = 0; j < Nw; ++j) {
+          for (PetscInt k = 0; k < Nw; ++k) A[i + (size_t)Nw * j] += B[i + (size_t)Nw * k] * B[j + (size_t)Nw * k];
+          if (i == j) A[i + (size_t)Nw * j] += 0.5;
+        }
+      for (auto &x : Kw) x = U(gen);
+      for (auto &x : C) x = U(gen);
+      for (PetscInt i = 0; i < Rw; ++i)
+        for (PetscInt j = 0; j < Rw; ++j) {
+          for (PetscInt k = 0; k < Rw; ++k) M[(size_t)i * Rw + j] += C[(size_t)i * Rw + k] * C[(size_t)j * Rw + k];
+          if (i == j) M[(size_t)i * Rw + j] += 0.1;
+        }
+      const PetscInt k = CubatureLambdaWeights(Rw, Nw, A.data(), Kw.data(), lam.data(), M, &T);
+      const std::vector<PetscInt> F = {0, 2, 3};
+      PetscReal                   worst = 0;
+      for (PetscInt trial = 0; trial < 3; ++trial) {
+        std::vector<PetscReal> dr(Rw);
+        for (auto &x : dr) x = U(gen);
+        const PetscInt         n = Nw + 3;
+        std::vector<PetscReal> Sd((size_t)n * n, 0.0), rhs(n, 0.0); // row-major saddle matrix
+        for (PetscInt i = 0; i < Nw; ++i)
+          for (PetscInt j = 0; j < Nw; ++j) Sd[(size_t)i * n + j] = A[i + (size_t)Nw * j];
+        for (PetscInt c = 0; c < 3; ++c) {
+          for (PetscInt i = 0; i < Nw; ++i) Sd[(size_t)i * n + Nw + c] = Sd[(size_t)(Nw + c) * n + i] = Kw[F[c] + (size_t)Rw * i];
+          rhs[Nw + c] = dr[F[c]];
+        }
+        for (PetscInt c = 0; c < n; ++c) { // elimination with partial pivoting
+          PetscInt piv = c;
+          for (PetscInt r = c + 1; r < n; ++r)
+            if (std::abs(Sd[(size_t)r * n + c]) > std::abs(Sd[(size_t)piv * n + c])) piv = r;
+          for (PetscInt j = 0; j < n; ++j) std::swap(Sd[(size_t)c * n + j], Sd[(size_t)piv * n + j]);
+          std::swap(rhs[c], rhs[piv]);
+          for (PetscInt r = c + 1; r < n; ++r) {
+            const PetscReal f = Sd[(size_t)r * n + c] / Sd[(size_t)c * n + c];
+            for (PetscInt j = c; j < n; ++j) Sd[(size_t)r * n + j] -= f * Sd[(size_t)c * n + j];
+            rhs[r] -= f * rhs[c];
+          }
+        }
+        std::vector<PetscReal> x(n);
+        for (PetscInt r = n - 1; r >= 0; --r) {
+          PetscReal t = rhs[r];
+          for (PetscInt j = r + 1; j < n; ++j) t -= Sd[(size_t)r * n + j] * x[j];
+          x[r] = t / Sd[(size_t)r * n + r];
+        }
+        PetscReal yMy = 0, Tdr = 0;
+        for (PetscInt a = 0; a < 3; ++a)
+          for (PetscInt b = 0; b < 3; ++b) yMy += x[Nw + a] * M[(size_t)F[a] * Rw + F[b]] * x[Nw + b];
+        for (PetscInt i = 0; i < k; ++i) {
+          PetscReal t = 0;
+          for (PetscInt r = 0; r < Rw; ++r) t += T[(size_t)i * Rw + r] * dr[r];
+          Tdr += t * t;
+        }
+        worst = std::max(worst, std::abs(Tdr - yMy) / yMy);
+      }
+      PetscReal inactive = 0; // the inactive row's column of T is zero
+      for (PetscInt i = 0; i < k; ++i) inactive = std::max(inactive, std::abs(T[(size_t)i * Rw + 1]));
+      Check(k == 3 && worst <= 1e-10 && inactive == 0, "CubatureLambdaWeights: |T dr|^2 = y' M_F y of the saddle point's multiplier change (max rel diff, 3 trials)", worst, 1e-10);
+      std::vector<PetscReal> zero(Rw, 0.0);
+      const PetscInt k0 = CubatureLambdaWeights(Rw, Nw, A.data(), Kw.data(), zero.data(), M, &T);
+      Check(k0 == 0 && T.empty(), "CubatureLambdaWeights: no contact, no rows (T's size)", (double)T.size(), 0);
+    }
     // on candidate points C (every third point): H_CC, (H 1)_C and 1'H1 of the explicit rows over every point,
     // with the states in one block and in blocks of 2, and (cols 2) the products 2 columns at a time (6 candidates)
     CubatureCandidates cand;

@@ -25,6 +25,9 @@ public:
   PetscInt Size() const { return (PetscInt)base_.size(); }
   // The kappa block of state s (Q x N, row-major) in a buffer that the next call overwrites.
   const PetscReal *Kappa(PetscInt s) const;
+  // y(p) = kappa_s(p, :) . v for every point from thetaV = theta v (one value per patch dof): the terms' combination
+  // without forming the block (the lambda fit's constraint values, docs/hyper_reduction.md), equal to Kappa(s) v to rounding.
+  void KappaTimes(PetscInt s, const PetscReal *thetaV, PetscReal *y) const;
   // Every state's gamma (Size() blocks of Q) and w n2 (Size() blocks of Q x dim), contiguous.
   const std::vector<PetscReal> &Gamma() const { return gamma_; }
   const std::vector<PetscReal> &ForceWeights() const { return wn_; }

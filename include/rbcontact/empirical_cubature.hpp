@@ -24,8 +24,9 @@ namespace rbc {
 
 // What the fit measures (-ecsw_fit): every entry of each state's K^ and g^ (Frobenius), or what the reduced
 // QP uses of them at the training solutions (lambda_j, v_j): the contact force on the primal modes K^' lambda_j
-// and the constraint values K^ v_j - g^ (CubatureActionGram).
-enum class CubatureFit { Terms, Action };
+// and the constraint values K^ v_j - g^ (CubatureActionGram); lambda: the action fit with the constraint values
+// measured by the multiplier error they cause (CubatureLambdaMetric, docs/hyper_reduction.md "The lambda fit").
+enum class CubatureFit { Terms, Action, Lambda };
 
 struct CubatureOptions {
   CubatureFit fit     = CubatureFit::Action; // -ecsw_fit (docs/hyper_reduction.md: fewer points for the same errors)
@@ -86,6 +87,23 @@ struct CubatureScalings {
   std::vector<PetscReal> s1, s2; // ms each
 };
 
+// The lambda fit's metric at the training solutions: per solution j, T_j (k_j x R, row-major) such that ||T_j dr|| is the
+// first-order change of the multiplier lambda = W lambda^ in the slave-mass norm caused by an error dr of the reduced
+// constraint values K^ v_j - g^ (on the free set F_j = {r : lambda^_j(r) > 0}, the reduced QP's equality rows):
+// d lambda^_F = S_F^{-1} dr_F, S_F = K^_F A^{-1} K^_F', so T_j = L_F' S_F^{-1} E_F with M_F = L_F L_F' (M: W' diag(w) W
+// on the free set). Empty rows for a solution without contact.
+struct CubatureLambdaMetric {
+  std::vector<std::vector<PetscReal>> T; // nt blocks, k_j x R row-major
+  // y(p) = kappa_s(p, :) . v_j at every point (Q), for state s and training solution j; empty: from the kappa blocks
+  // (the fit takes one solution at a time: the blocks would be formed nt times)
+  std::function<void(PetscInt s, PetscInt j, PetscReal *y)> kappaTimes;
+};
+// One solution's T (k x R, row-major, returned k): A (N x N, column-major, SPD) the reduced stiffness, K (R x N,
+// column-major) the exact reduced constraint at the solution, lam (R) its coefficients, M (R x R) the mass Gram of W.
+// S_F, M_F (and A) are factored with a ridge of 1e-12, then 1e-9, of their largest diagonal entry when rounding makes them
+// indefinite; T empty (k = 0) if even that fails.
+PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T);
+
 // The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
 // and Vs (nt x N, row-major),
 //   sum_j ||dK_s' lam_j||^2 / sum_j ||K^_s' lam_j||^2 + sum_j ||dK_s v_j - dg_s||^2 / sum_j (||K^_s v_j||^2 + ||g^_s||^2),
@@ -96,10 +114,12 @@ struct CubatureScalings {
 // ContactPatch::Evaluate's wn), a third term fits the resultant contact force F_s(lam_j) = sum_p
 // (P' lam_j)(p) w_p n2(x_p), the output of interest the online stage computes from the cubature (docs/online.md):
 //   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
+// With metric (the lambda fit), the constraint term is measured by the multiplier error it causes:
+//   sum_j ||T_j (dK_s v_j - dg_s)||^2 / sum_j (||T_j K^_s v_j||^2 + ||T_j g^_s||^2),  H += sum_j ((T_j P)'(T_j P)) o (Y_j Y_j').
 // Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
 // they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding. With cand, as CubatureGram.
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr);
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr);
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr, const CubatureLambdaMetric *metric = nullptr);
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr, const CubatureLambdaMetric *metric = nullptr);
 
 // Per state, the relative errors of the cubature's K^ (Frobenius) and g^ (l2) against the exact ones.
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG);

@@ -43,6 +43,17 @@ const PetscReal *ContactStates::Kappa(PetscInt s) const
   return block_.data();
 }
 
+void ContactStates::KappaTimes(PetscInt s, const PetscReal *thetaV, PetscReal *y) const
+{
+  const uint32_t *st = &start_[(size_t)s * (Q_ + 1)];
+  const size_t    b  = base_[s];
+  for (PetscInt p = 0; p < Q_; ++p) {
+    PetscReal t = 0;
+    for (uint32_t k = st[p]; k < st[p + 1]; ++k) t += coef_[b + k] * thetaV[row_[b + k]];
+    y[p] = t;
+  }
+}
+
 size_t ContactStates::Bytes() const
 {
   return base_.size() * sizeof(size_t) + start_.size() * sizeof(uint32_t) + row_.size() * sizeof(PetscInt) + (coef_.size() + gamma_.size() + wn_.size()) * sizeof(PetscReal);

@@ -204,6 +204,45 @@ PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMa
   PetscFunctionReturn(0);
 }
 
+// The lambda fit's metric (CubatureLambdaMetric) at the training solutions of the exact-contact ROM (rm's warm-start
+// table): per solution, the exact reduced constraint, A^(mu_j) and the slave-mass Gram of W (CubatureLambdaWeights);
+// kappa_s v_j from the states' terms and theta v_j (one value per patch dof), not from the Q x N blocks. dropped: the
+// solutions in contact whose metric did not factor.
+static PetscErrorCode LambdaFitMetric(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const DualBasisResult &dual, ContactPatch *full, const ContactStates &cs, ReducedModel *rm, CubatureLambdaMetric *metric, PetscInt *dropped)
+{
+  const PetscInt N = rm->N(), R = rm->R(), nt = (PetscInt)(rm->warmL.size() / std::max<PetscInt>(R, 1));
+  std::vector<PetscReal> wc, Kj((size_t)R * N), gj(R), Aj, fj;
+
+  PetscFunctionBeginUser;
+  PetscCheck(N == full->N && R == dual.W.cols, PetscObjectComm((PetscObject)fom.dm), PETSC_ERR_PLIB, "offline: the exact reduced model's sizes differ from the bases'");
+  PetscCall(ReferenceSlaveMass(fom, cmap, order, &wc));
+  const std::vector<PetscReal>    M    = SlaveMassGram(dual.W, wc);
+  const size_t                    npar = rm->warmMu.size() / std::max<PetscInt>(nt, 1);
+  const ReducedModel::ContactMode mode = rm->Mode();
+  rm->SetContactMode(ReducedModel::ContactMode::Exact);
+  metric->T.assign(nt, {});
+  *dropped = 0;
+  for (PetscInt j = 0; j < nt; ++j) {
+    const std::vector<PetscReal> mu(rm->warmMu.begin() + j * npar, rm->warmMu.begin() + (j + 1) * npar);
+    full->SetGeometry(&fom.map, mu);
+    (void)rm->ContactTerms(mu, &rm->warmV[(size_t)j * N], Kj.data(), gj.data());
+    rm->Operators(mu, &Aj, &fj);
+    const PetscReal *lam = &rm->warmL[(size_t)j * R];
+    if (CubatureLambdaWeights(R, N, Aj.data(), Kj.data(), lam, M, &metric->T[j]) == 0 && std::any_of(lam, lam + R, [](PetscReal l) { return l > 0; })) ++*dropped;
+  }
+  rm->SetContactMode(mode);
+  const size_t rows = full->theta.size() / std::max<PetscInt>(N, 1);
+  auto         tv   = std::make_shared<std::vector<PetscReal>>((size_t)nt * rows, 0.0);
+  for (PetscInt j = 0; j < nt; ++j)
+    for (size_t i = 0; i < rows; ++i) {
+      PetscReal t = 0;
+      for (PetscInt n = 0; n < N; ++n) t += full->theta[i * N + n] * rm->warmV[(size_t)j * N + n];
+      (*tv)[(size_t)j * rows + i] = t;
+    }
+  metric->kappaTimes = [&cs, tv, rows](PetscInt s, PetscInt j, PetscReal *y) { cs.KappaTimes(s, &(*tv)[(size_t)j * rows], y); };
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault, PetscInt rDefault)
 {
   PetscLogDouble t0, t1, t2;
@@ -471,6 +510,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   CubatureResult  cr;
   std::vector<PetscReal> errK, errG;
   CubatureHierarchy      hier;
+  PetscInt               metricDropped = 0; // -ecsw_fit lambda: training solutions in contact whose metric failed
   if (hyper.ecsw) {
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
@@ -487,6 +527,13 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       fitAll = f == 1 ? PETSC_TRUE : PETSC_FALSE;
     }
     const PetscInt nt = (PetscInt)(rm.warmL.size() / R);
+    // the lambda fit's metric at the training solutions (docs/hyper_reduction.md "The lambda fit")
+    CubatureLambdaMetric metric;
+    if (co.fit == CubatureFit::Lambda) {
+      PetscCheck(!((nDefault > 0 || rDefault > 0) && !fitAll), world, PETSC_ERR_SUP, "offline: -ecsw_fit lambda fits every stored basis function; it does not combine with -estimate_cubature answer");
+      PetscCall(LambdaFitMetric(fom, cmap, order, dual, full.get(), cs, &rm, &metric, &metricDropped));
+    }
+    const CubatureLambdaMetric *pm = co.fit == CubatureFit::Lambda ? &metric : nullptr;
     CubatureGramFunction gram;
     CubatureScalings     scalings; // the action fit's per-state scalings, formed by the first call (hierarchical: many calls)
     std::vector<PetscReal> PA, LA, VA, blockA;
@@ -511,7 +558,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       }
       if (co.fit == CubatureFit::Action) gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(PA, rA, Q, Na, SkA, Sg, ms, LA, VA, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c, &scalings); };
       else gram = [&, rA, Na](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(PA, rA, Q, Na, SkA, Sg, ms, Hc, c); };
-    } else if (co.fit == CubatureFit::Action) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c, &scalings); };
+    } else if (co.fit != CubatureFit::Terms) gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureActionGram(P, R, Q, N, Sk, Sg, ms, rm.warmL, rm.warmV, nt, Hc, co.fitForce ? Sw : std::vector<PetscReal>(), full->dim, 0, c, &scalings, pm); };
     else gram = [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); };
     if (distribute) // this rank's states' share of the Gram system, summed over the ranks
       gram = [&world, local = gram](CubatureCandidates *c, std::vector<PetscReal> *Hc) {
@@ -635,8 +682,9 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     JsonValue &c = rep->root["ecsw"];
     c["M"]            = (long long)cr.points.size();
     c["tol"]          = (double)co.tol;
-    c["fit"]          = co.fit == CubatureFit::Action ? "action" : "terms";
-    c["fit_force"]    = co.fit == CubatureFit::Action && co.fitForce;
+    c["fit"]          = co.fit == CubatureFit::Lambda ? "lambda" : co.fit == CubatureFit::Action ? "action" : "terms";
+    c["fit_force"]    = co.fit != CubatureFit::Terms && co.fitForce;
+    if (co.fit == CubatureFit::Lambda) c["lambda_metric_dropped"] = (long long)metricDropped;
     c["residual"]     = (double)cr.residual;
     c["quadrature_points"] = (long long)Q;
     c["groups"]       = (long long)hier.groups;     // > 1: the hierarchical fit (-ecsw_group_points)

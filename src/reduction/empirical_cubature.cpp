@@ -16,13 +16,13 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, pre, "Empirical cubature of the reduced contact terms", "rbcontact");
   {
-    const char *fits[] = {"terms", "action"};
-    PetscInt    f      = opt->fit == CubatureFit::Action ? 1 : 0;
-    PetscCall(PetscOptionsEList("-fit", "what the fit measures: K^' lambda and K^ v - g^ at the training solutions (action) or every entry of K^, g^ (terms)", "", fits, 2, fits[f], &f, NULL));
-    opt->fit = f == 1 ? CubatureFit::Action : CubatureFit::Terms;
+    const char *fits[] = {"terms", "action", "lambda"};
+    PetscInt    f      = (PetscInt)opt->fit;
+    PetscCall(PetscOptionsEList("-fit", "what the fit measures: K^' lambda and K^ v - g^ at the training solutions (action), the same with K^ v - g^ by the multiplier error it causes (lambda), or every entry of K^, g^ (terms)", "", fits, 3, fits[f], &f, NULL));
+    opt->fit = (CubatureFit)f;
   }
   flg = opt->fitForce ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscOptionsBool("-fit_force", "with -fit action: fit the resultant contact force too (the online stage's output of interest)", "", flg, &flg, NULL));
+  PetscCall(PetscOptionsBool("-fit_force", "with -fit action or lambda: fit the resultant contact force too (the online stage's output of interest)", "", flg, &flg, NULL));
   opt->fitForce = flg;
   PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
   PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
@@ -35,6 +35,64 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   PetscCheck(opt->maxPoints >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%smax_points %" PetscInt_FMT " must be >= 1", pre, opt->maxPoints);
   PetscCheck(opt->groupPoints == 0 || opt->groupPoints >= 100, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sgroup_points %" PetscInt_FMT " must be 0 (one group) or >= 100", pre, opt->groupPoints);
   PetscFunctionReturn(0);
+}
+
+// Cholesky factor (lower, in place, n x n column-major) of a symmetric positive semidefinite matrix, regularized by
+// 1e-12 of its largest diagonal entry when rounding makes it indefinite.
+static bool FactorRegularized(PetscInt n, std::vector<PetscReal> *A)
+{
+  if (n == 0) return true;
+  const std::vector<PetscReal> A0 = *A;
+  PetscReal                    dmax = 0;
+  for (PetscInt i = 0; i < n; ++i) dmax = std::max(dmax, A0[i + (size_t)n * i]);
+  const PetscBLASInt m = (PetscBLASInt)n;
+  for (PetscReal ridge : {0.0, 1e-12, 1e-9}) {
+    *A = A0;
+    for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * i] += ridge * dmax;
+    PetscBLASInt info = 0;
+    LAPACKpotrf_("L", &m, A->data(), &m, &info);
+    if (info == 0) return true;
+  }
+  return false;
+}
+
+PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T)
+{
+  std::vector<PetscInt> F;
+  for (PetscInt r = 0; r < R; ++r)
+    if (lam[r] > 0) F.push_back(r);
+  const PetscInt k = (PetscInt)F.size();
+  T->assign((size_t)k * R, 0.0);
+  if (k == 0) return 0;
+  // Y = A^{-1} K_F' (N x k), S = K_F Y
+  std::vector<PetscReal> LA(A, A + (size_t)N * N), Y((size_t)N * k), S((size_t)k * k, 0.0), LM((size_t)k * k), Z((size_t)k * k, 0.0);
+  if (!FactorRegularized(N, &LA)) {
+    T->clear();
+    return 0;
+  }
+  for (PetscInt c = 0; c < k; ++c)
+    for (PetscInt n = 0; n < N; ++n) Y[n + (size_t)N * c] = K[F[c] + (size_t)R * n];
+  const PetscBLASInt nn = (PetscBLASInt)N, kk = (PetscBLASInt)k;
+  PetscBLASInt       info = 0;
+  LAPACKpotrs_("L", &nn, &kk, LA.data(), &nn, Y.data(), &nn, &info);
+  for (PetscInt b = 0; b < k; ++b)
+    for (PetscInt a = 0; a < k; ++a)
+      for (PetscInt n = 0; n < N; ++n) S[a + (size_t)k * b] += K[F[a] + (size_t)R * n] * Y[n + (size_t)N * b];
+  for (PetscInt b = 0; b < k; ++b)
+    for (PetscInt a = 0; a < k; ++a) LM[a + (size_t)k * b] = M[(size_t)F[a] * R + F[b]];
+  if (!FactorRegularized(k, &S) || !FactorRegularized(k, &LM)) {
+    T->clear();
+    return 0;
+  }
+  for (PetscInt i = 0; i < k; ++i) Z[i + (size_t)k * i] = 1;
+  LAPACKpotrs_("L", &kk, &kk, S.data(), &kk, Z.data(), &kk, &info); // Z = S^{-1}
+  for (PetscInt i = 0; i < k; ++i) // T_F = L_M' Z, rows i, columns F
+    for (PetscInt c = 0; c < k; ++c) {
+      PetscReal t = 0;
+      for (PetscInt l = i; l < k; ++l) t += LM[l + (size_t)k * i] * Z[l + (size_t)k * c];
+      (*T)[(size_t)i * R + F[c]] = t;
+    }
+  return k;
 }
 
 namespace {
@@ -238,10 +296,10 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   AddHadamardGram(Q, P.data(), R, Z.data(), ms * nc, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings, const CubatureLambdaMetric *metric)
 {
   // Lam P (nt x Q): the points' rows seen through the training multipliers
-  std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh;
+  std::vector<PetscReal> LP((size_t)nt * Q, 0.0), s1(ms), s2(ms), Kh, gh, Kv;
   for (PetscInt j = 0; j < nt; ++j)
     for (PetscInt r = 0; r < R; ++r) {
       const PetscReal l = Lam[(size_t)j * R + r];
@@ -264,12 +322,20 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
         for (PetscInt r = 0; r < R; ++r) t += Kh[(size_t)r * N + n] * Lam[(size_t)j * R + r];
         n1 += t * t;
       }
-      for (PetscInt r = 0; r < R; ++r) { // (K^ v_j)_r
-        PetscReal t = 0;
-        for (PetscInt n = 0; n < N; ++n) t += Kh[(size_t)r * N + n] * Vs[(size_t)j * N + n];
-        n2 += t * t;
-      }
-      n2 += gg;
+      Kv.assign(R, 0.0);
+      for (PetscInt r = 0; r < R; ++r) // (K^ v_j)_r
+        for (PetscInt n = 0; n < N; ++n) Kv[r] += Kh[(size_t)r * N + n] * Vs[(size_t)j * N + n];
+      if (metric) { // ||T_j K^ v_j||^2 + ||T_j g^||^2
+        const std::vector<PetscReal> &T = metric->T[j];
+        for (size_t i = 0; i < T.size() / std::max<PetscInt>(R, 1); ++i) {
+          PetscReal a = 0, b = 0;
+          for (PetscInt r = 0; r < R; ++r) {
+            a += T[i * R + r] * Kv[r];
+            b += T[i * R + r] * gh[r];
+          }
+          n2 += a * a + b * b;
+        }
+      } else n2 += SumSquares(Kv) + gg;
     }
     s1[s] = n1 > 0 ? 1 / std::sqrt(n1) : 0;
     s2[s] = n2 > 0 ? 1 / std::sqrt(n2) : 0;
@@ -290,7 +356,36 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
       }
     }
   }, H, cand);
-  AddHadamardGramBlocks(Q, P.data(), R, ms, nt, StatesPerBlock(Q, nt, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
+  if (metric) // sum_j ((T_j P)'(T_j P)) o (Y_j Y_j'), one training solution at a time
+    for (PetscInt j = 0; j < nt; ++j) {
+      const std::vector<PetscReal> &T = metric->T[j];
+      const PetscInt                k = (PetscInt)(T.size() / std::max<PetscInt>(R, 1));
+      if (k == 0) continue;
+      std::vector<PetscReal> TP((size_t)k * Q, 0.0);
+      for (PetscInt i = 0; i < k; ++i)
+        for (PetscInt r = 0; r < R; ++r) {
+          const PetscReal t = T[(size_t)i * R + r];
+          if (t == 0.0) continue;
+          for (PetscInt p = 0; p < Q; ++p) TP[(size_t)i * Q + p] += t * P[(size_t)r * Q + p];
+        }
+      AddHadamardGramBlocks(Q, TP.data(), k, ms, 1, StatesPerBlock(Q, 1, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
+        for (PetscInt s = s0; s < s0 + cnt; ++s) {
+          const PetscReal *gam = &Sg[(size_t)s * Q];
+          PetscReal       *y   = &Y[(size_t)(s - s0) * Q];
+          if (metric->kappaTimes) metric->kappaTimes(s, j, y);
+          else {
+            const PetscReal *kap = Sk(s);
+            for (PetscInt p = 0; p < Q; ++p) {
+              PetscReal t = 0;
+              for (PetscInt n = 0; n < N; ++n) t += kap[(size_t)p * N + n] * Vs[(size_t)j * N + n];
+              y[p] = t;
+            }
+          }
+          for (PetscInt p = 0; p < Q; ++p) y[p] = s2[s] * (y[p] - gam[p]);
+        }
+      }, H, cand);
+    }
+  else AddHadamardGramBlocks(Q, P.data(), R, ms, nt, StatesPerBlock(Q, nt, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Y) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
       const PetscReal *kap = Sk(s), *gam = &Sg[(size_t)s * Q];
       for (PetscInt j = 0; j < nt; ++j) {
@@ -341,9 +436,9 @@ void CubatureGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, Petsc
   CubatureGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, H, cand);
 }
 
-void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings)
+void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw, PetscInt dim, PetscInt block, CubatureCandidates *cand, CubatureScalings *scalings, const CubatureLambdaMetric *metric)
 {
-  CubatureActionGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, Lam, Vs, nt, H, Sw, dim, block, cand, scalings);
+  CubatureActionGram(P, R, Q, N, Blocks(Sk, Q, N), Sg, ms, Lam, Vs, nt, H, Sw, dim, block, cand, scalings, metric);
 }
 
 namespace {
