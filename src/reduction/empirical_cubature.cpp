@@ -37,8 +37,8 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   PetscFunctionReturn(0);
 }
 
-// Cholesky factor (lower, in place, n x n column-major) of a symmetric positive semidefinite matrix, regularized by
-// 1e-12 of its largest diagonal entry when rounding makes it indefinite.
+// Cholesky factor (lower, in place, n x n column-major) of a symmetric positive semidefinite matrix, regularized by a
+// ridge of 1e-12, then 1e-9, of its largest diagonal entry when rounding makes it indefinite; false if even that fails.
 static bool FactorRegularized(PetscInt n, std::vector<PetscReal> *A)
 {
   if (n == 0) return true;
