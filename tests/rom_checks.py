@@ -139,6 +139,15 @@ def pipeline(args):
         run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", romf, "-validate_repeat", "1", "-report", d + "/fit_%s/val.json" % fit])
         vf = report(d + "/fit_%s/val.json" % fit)
         lam_errs[fit] = (vf["test"]["max_rel_err_lambda"], vf["test_exact"]["max_rel_err_lambda"], cf["M"])
+    # the lambda fit on 1 rank (every state on the one rank, the same weighted Gram sum in another order): the same points,
+    # the weights to the rounding times cond(H_SS), as for the states split over the ranks below (1e-5)
+    os.makedirs(d + "/fit_lambda_np1")
+    _, off1r = offline(args, d + "/fit_lambda_np1", np_=1, extra=["-ecsw_fit", "lambda", "-ecsw_tol", "3e-4", "-snapshots", d + "/rom.snapshots.h5", "-snapshots_restart"])
+    with h5py.File(d + "/fit_lambda/rom.h5", "r") as f, h5py.File(d + "/fit_lambda_np1/rom.h5", "r") as g:
+        same_pts = np.array_equal(np.array(f["online/ecsw/points"]), np.array(g["online/ecsw/points"]))
+    w2, w1 = np.array(report(d + "/fit_lambda/off.json")["ecsw"]["weights"]), np.array(off1r["ecsw"]["weights"])
+    dwl = np.abs(w2 - w1).max() / w1.max() if same_pts and w1.shape == w2.shape else np.inf
+    check(same_pts and dwl <= 1e-5, "lambda fit on 1 and 2 ranks: the same %d points, weights to %.1e (<= 1e-5)" % (len(w1), dwl))
     (ll, lx, lm), (al, ax, am) = lam_errs["lambda"], lam_errs["action"]
     check(ll <= 1.2 * lx and ll < al, "lambda fit at 3e-4: lambda %.3e within 1.2x of the exact-contact ROM's %.3e (%d points); action fit %.3e (%d points)" % (ll, lx, lm, al, am))
     # the hierarchical cubature (-ecsw_group_points, docs/hyper_reduction.md): groups of at most 100 points, each
