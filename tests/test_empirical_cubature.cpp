@@ -65,6 +65,30 @@ static std::vector<PetscReal> ForceAction(const std::vector<PetscReal> &K, const
   return f;
 }
 
+// x = S^{-1} b by Gaussian elimination with partial pivoting (S n x n, row-major, copied)
+static std::vector<PetscReal> SolveDense(PetscInt n, std::vector<PetscReal> S, std::vector<PetscReal> b)
+{
+  for (PetscInt c = 0; c < n; ++c) {
+    PetscInt piv = c;
+    for (PetscInt r = c + 1; r < n; ++r)
+      if (std::abs(S[(size_t)r * n + c]) > std::abs(S[(size_t)piv * n + c])) piv = r;
+    for (PetscInt j = 0; j < n; ++j) std::swap(S[(size_t)c * n + j], S[(size_t)piv * n + j]);
+    std::swap(b[c], b[piv]);
+    for (PetscInt r = c + 1; r < n; ++r) {
+      const PetscReal f = S[(size_t)r * n + c] / S[(size_t)c * n + c];
+      for (PetscInt j = c; j < n; ++j) S[(size_t)r * n + j] -= f * S[(size_t)c * n + j];
+      b[r] -= f * b[c];
+    }
+  }
+  std::vector<PetscReal> x(n);
+  for (PetscInt r = n - 1; r >= 0; --r) {
+    PetscReal t = b[r];
+    for (PetscInt j = r + 1; j < n; ++j) t -= S[(size_t)r * n + j] * x[j];
+    x[r] = t / S[(size_t)r * n + r];
+  }
+  return x;
+}
+
 static PetscReal Norm2(const std::vector<PetscReal> &v)
 {
   PetscReal s = 0;
@@ -218,7 +242,10 @@ int main(int argc, char **argv)
         metric.T.emplace_back((size_t)ks[j] * R);
         for (auto &x : metric.T.back()) x = U(gen);
       }
-      std::vector<PetscReal> GL, HL, HL2;
+      std::vector<PetscReal> GL, GLF, HL, HL2, HL3;
+      const PetscInt         rg = 2; // the forces' part: a random factor Fg (N x rg), rows Fg' K_s(e_p)' lam_j / sqrt(n2)
+      std::vector<PetscReal> Fg((size_t)N * rg);
+      for (auto &x : Fg) x = U(gen);
       for (PetscInt s = 0; s < ms; ++s) {
         Terms(P, R, Q, N, Sk, Sg, s, one, &K, &g);
         PetscReal n1 = 0, n2 = 0;
@@ -237,13 +264,15 @@ int main(int argc, char **argv)
           }
         }
         for (PetscInt j = 0; j < nt; ++j) {
-          std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)ks[j] * Q);
+          std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)ks[j] * Q), rows3((size_t)rg * Q, 0.0);
           for (PetscInt p = 0; p < Q; ++p) {
             std::fill(e.begin(), e.end(), 0.0);
             e[p] = 1;
             Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
             const std::vector<PetscReal> f = ForceAction(K, Lam, j, R, N);
             for (PetscInt n = 0; n < N; ++n) rows1[(size_t)n * Q + p] = f[n] / std::sqrt(n1);
+            for (PetscInt c = 0; c < rg; ++c)
+              for (PetscInt n = 0; n < N; ++n) rows3[(size_t)c * Q + p] += Fg[(size_t)n * rg + c] * f[n] / std::sqrt(n2);
             for (PetscInt i = 0; i < ks[j]; ++i) {
               PetscReal t = 0;
               for (PetscInt r = 0; r < R; ++r) {
@@ -256,9 +285,11 @@ int main(int argc, char **argv)
           }
           GL.insert(GL.end(), rows1.begin(), rows1.end());
           GL.insert(GL.end(), rows2.begin(), rows2.end());
+          GLF.insert(GLF.end(), rows3.begin(), rows3.end());
         }
       }
       GL.insert(GL.end(), GF.begin(), GF.end());
+      GLF.insert(GLF.begin(), GL.begin(), GL.end());
       CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HL, Sw, dim, 2, nullptr, nullptr, &metric);
       const PetscReal dL = GramMismatch(GL, Q, HL);
       Check(dL <= 1e-13, "CubatureActionGram with the lambda metric (T_j (K v_j - g) rows, force rows, blocks of 2) = G'G of the explicit rows", dL, 1e-13);
@@ -271,6 +302,11 @@ int main(int argc, char **argv)
       CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HL2, Sw, dim, 0, nullptr, nullptr, &metric);
       const PetscReal dL2 = GramMismatch(GL, Q, HL2);
       Check(dL2 <= 1e-13, "CubatureActionGram with the lambda metric, kappa_s v_j by the callback = G'G of the explicit rows", dL2, 1e-13);
+      metric.forceFactor = Fg;
+      metric.forceRank   = rg;
+      CubatureActionGram(P, R, Q, N, Sk, Sg, ms, Lam, Vs, nt, &HL3, Sw, dim, 2, nullptr, nullptr, &metric);
+      const PetscReal dL3 = GramMismatch(GLF, Q, HL3);
+      Check(dL3 <= 1e-13, "CubatureActionGram with the lambda metric and its force factor (rows Fg' K_s(e_p)' lam_j in the constraint scaling) = G'G of the explicit rows", dL3, 1e-13);
     }
     // CubatureLambdaWeights against the reduced saddle point solved directly: for a change dr of the constraint values,
     // [A K_F'; K_F 0] [x; y] = [0; dr_F] (Gaussian elimination with partial pivoting) gives the multiplier change y, and
@@ -305,24 +341,7 @@ int main(int argc, char **argv)
           for (PetscInt i = 0; i < Nw; ++i) Sd[(size_t)i * n + Nw + c] = Sd[(size_t)(Nw + c) * n + i] = Kw[F[c] + (size_t)Rw * i];
           rhs[Nw + c] = dr[F[c]];
         }
-        for (PetscInt c = 0; c < n; ++c) { // elimination with partial pivoting
-          PetscInt piv = c;
-          for (PetscInt r = c + 1; r < n; ++r)
-            if (std::abs(Sd[(size_t)r * n + c]) > std::abs(Sd[(size_t)piv * n + c])) piv = r;
-          for (PetscInt j = 0; j < n; ++j) std::swap(Sd[(size_t)c * n + j], Sd[(size_t)piv * n + j]);
-          std::swap(rhs[c], rhs[piv]);
-          for (PetscInt r = c + 1; r < n; ++r) {
-            const PetscReal f = Sd[(size_t)r * n + c] / Sd[(size_t)c * n + c];
-            for (PetscInt j = c; j < n; ++j) Sd[(size_t)r * n + j] -= f * Sd[(size_t)c * n + j];
-            rhs[r] -= f * rhs[c];
-          }
-        }
-        std::vector<PetscReal> x(n);
-        for (PetscInt r = n - 1; r >= 0; --r) {
-          PetscReal t = rhs[r];
-          for (PetscInt j = r + 1; j < n; ++j) t -= Sd[(size_t)r * n + j] * x[j];
-          x[r] = t / Sd[(size_t)r * n + r];
-        }
+        const std::vector<PetscReal> x = SolveDense(n, Sd, rhs);
         PetscReal yMy = 0, Tdr = 0;
         for (PetscInt a = 0; a < 3; ++a)
           for (PetscInt b = 0; b < 3; ++b) yMy += x[Nw + a] * M[(size_t)F[a] * Rw + F[b]] * x[Nw + b];
@@ -333,6 +352,46 @@ int main(int argc, char **argv)
         }
         worst = std::max(worst, std::abs(Tdr - yMy) / yMy);
       }
+      // C against the same saddle point with a change df of the forces: [A K_F'; K_F 0] [x; y] = [df; 0] gives
+      // y = S_F^{-1} K_F A^{-1} df, and |C df|^2 must equal y' M_F y; CubatureLambdaForceFactor: Fg Fg' = (C'C + C'C) / 2
+      // (a second, empty block not counted)
+      std::vector<PetscReal> Cw, Fgw;
+      (void)CubatureLambdaWeights(Rw, Nw, A.data(), Kw.data(), lam.data(), M, &T, &Cw);
+      PetscReal worstC = 0;
+      for (PetscInt trial = 0; trial < 3; ++trial) {
+        std::vector<PetscReal> df(Nw);
+        for (auto &x : df) x = U(gen);
+        const PetscInt         n = Nw + 3;
+        std::vector<PetscReal> Sd((size_t)n * n, 0.0), rhs(n, 0.0);
+        for (PetscInt i = 0; i < Nw; ++i) {
+          for (PetscInt j = 0; j < Nw; ++j) Sd[(size_t)i * n + j] = A[i + (size_t)Nw * j];
+          rhs[i] = df[i];
+        }
+        for (PetscInt c = 0; c < 3; ++c)
+          for (PetscInt i = 0; i < Nw; ++i) Sd[(size_t)i * n + Nw + c] = Sd[(size_t)(Nw + c) * n + i] = Kw[F[c] + (size_t)Rw * i];
+        const std::vector<PetscReal> x = SolveDense(n, Sd, rhs);
+        PetscReal                    yMy = 0, Cdf = 0;
+        for (PetscInt a = 0; a < 3; ++a)
+          for (PetscInt b = 0; b < 3; ++b) yMy += x[Nw + a] * M[(size_t)F[a] * Rw + F[b]] * x[Nw + b];
+        for (PetscInt i = 0; i < 3; ++i) {
+          PetscReal t = 0;
+          for (PetscInt m = 0; m < Nw; ++m) t += Cw[(size_t)i * Nw + m] * df[m];
+          Cdf += t * t;
+        }
+        worstC = std::max(worstC, std::abs(Cdf - yMy) / yMy);
+      }
+      Check(Cw.size() == (size_t)3 * Nw && worstC <= 1e-10, "CubatureLambdaWeights: |C df|^2 = y' M_F y of the saddle point's multiplier change under a force change (max rel diff, 3 trials)", worstC, 1e-10);
+      const PetscInt rgw = CubatureLambdaForceFactor(Nw, {Cw, {}, Cw}, &Fgw);
+      PetscReal      dG = 0, gmax = 0;
+      for (PetscInt a = 0; a < Nw; ++a)
+        for (PetscInt b = 0; b < Nw; ++b) {
+          PetscReal g = 0, ff = 0;
+          for (PetscInt i = 0; i < 3; ++i) g += Cw[(size_t)i * Nw + a] * Cw[(size_t)i * Nw + b];
+          for (PetscInt c = 0; c < rgw; ++c) ff += Fgw[(size_t)a * rgw + c] * Fgw[(size_t)b * rgw + c];
+          dG   = std::max(dG, std::abs(g - ff));
+          gmax = std::max(gmax, std::abs(g));
+        }
+      Check(rgw == 3 && dG <= 1e-12 * gmax, "CubatureLambdaForceFactor: Fg Fg' = the mean of C'C, rank 3 (max abs diff / max entry)", dG / gmax, 1e-12);
       PetscReal inactive = 0; // the inactive row's column of T is zero
       for (PetscInt i = 0; i < k; ++i) inactive = std::max(inactive, std::abs(T[(size_t)i * Rw + 1]));
       Check(k == 3 && worst <= 1e-10 && inactive == 0, "CubatureLambdaWeights: |T dr|^2 = y' M_F y of the saddle point's multiplier change (max rel diff, 3 trials)", worst, 1e-10);

@@ -40,6 +40,8 @@ struct CubatureOptions {
                                  // fit keeps the refactoring (its points and weights as before, bit for bit)
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
+  bool      lambdaForce = true; // -ecsw_fit_lambda_force: with -ecsw_fit lambda, also the multiplier error that the
+                                // forces' error causes through the displacement (CubatureLambdaMetric::forceFactor)
 };
 
 struct CubatureResult {
@@ -92,8 +94,14 @@ struct CubatureScalings {
 // constraint values K^ v_j - g^ (on the free set F_j = {r : lambda^_j(r) > 0}, the reduced QP's equality rows):
 // d lambda^_F = S_F^{-1} dr_F, S_F = K^_F A^{-1} K^_F', so T_j = L_F' S_F^{-1} E_F with M_F = L_F L_F' (M: W' diag(w) W
 // on the free set). Empty rows for a solution without contact.
+// The multiplier error has a second first-order part, from an error dF = dK' lambda_j of the contact forces through the
+// displacement: d lambda^_F = -S_F^{-1} K^_F A^{-1} dF, i.e. ||C_j dF|| with C_j = L_F' S_F^{-1} K^_F A^{-1} (k_j x N).
+// The fit takes it with one metric for all solutions, G = mean_j C_j' C_j = Fg Fg' (forceFactor, N x rank, row-major;
+// empty: the term is left out): sum_j ||Fg' dK_s' lam_j||^2 in the constraint term's per-state scaling.
 struct CubatureLambdaMetric {
   std::vector<std::vector<PetscReal>> T; // nt blocks, k_j x R row-major
+  std::vector<PetscReal>              forceFactor;
+  PetscInt                            forceRank = 0;
   // y(p) = kappa_s(p, :) . v_j at every point (Q), for state s and training solution j; empty: from the kappa blocks
   // (the fit takes one solution at a time: the blocks would be formed nt times)
   std::function<void(PetscInt s, PetscInt j, PetscReal *y)> kappaTimes;
@@ -101,8 +109,11 @@ struct CubatureLambdaMetric {
 // One solution's T (k x R, row-major, returned k): A (N x N, column-major, SPD) the reduced stiffness, K (R x N,
 // column-major) the exact reduced constraint at the solution, lam (R) its coefficients, M (R x R) the mass Gram of W.
 // S_F, M_F (and A) are factored with a ridge of 1e-12, then 1e-9, of their largest diagonal entry when rounding makes them
-// indefinite; T empty (k = 0) if even that fails.
-PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T);
+// indefinite; T empty (k = 0) if even that fails. With C: also C_j (k x N, row-major; empty with T).
+PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T, std::vector<PetscReal> *C = nullptr);
+// The factor Fg (N x rank, row-major) of G = (1/n) sum of the n blocks' C' C (each k x N, row-major; empty ones skipped and
+// not counted): the eigenvectors of G scaled by the square roots of its eigenvalues, those above 1e-8 of the largest.
+PetscInt CubatureLambdaForceFactor(PetscInt N, const std::vector<std::vector<PetscReal>> &C, std::vector<PetscReal> *Fg);
 
 // The Gram matrix of the action fit: per state s, with the nt training solutions Lam (nt x R, row-major)
 // and Vs (nt x N, row-major),
@@ -115,7 +126,9 @@ PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const
 // (P' lam_j)(p) w_p n2(x_p), the output of interest the online stage computes from the cubature (docs/online.md):
 //   + sum_j ||dF_s(lam_j)||^2 / sum_j ||F_s(lam_j)||^2,   i.e. H += ((P'Lam')(Lam P)) o (Zf Zf').
 // With metric (the lambda fit), the constraint term is measured by the multiplier error it causes:
-//   sum_j ||T_j (dK_s v_j - dg_s)||^2 / sum_j (||T_j K^_s v_j||^2 + ||T_j g^_s||^2),  H += sum_j ((T_j P)'(T_j P)) o (Y_j Y_j').
+//   sum_j ||T_j (dK_s v_j - dg_s)||^2 / sum_j (||T_j K^_s v_j||^2 + ||T_j g^_s||^2),  H += sum_j ((T_j P)'(T_j P)) o (Y_j Y_j'),
+// and, with its forceFactor, the forces' part in the same scaling, sum_j ||Fg' dK_s' lam_j||^2, i.e. the force term's
+// columns Zk extended by the scaled columns kappa_s Fg.
 // Zk and Y are formed `block` states at a time (0: as many as fit in about 64 MB), never whole: at 41k 3D dofs
 // they were 2.9 + 2.3 GB (docs/rom3d.md). The block size changes H only by rounding. With cand, as CubatureGram.
 void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const std::vector<PetscReal> &Lam, const std::vector<PetscReal> &Vs, PetscInt nt, std::vector<PetscReal> *H, const std::vector<PetscReal> &Sw = {}, PetscInt dim = 0, PetscInt block = 0, CubatureCandidates *cand = nullptr, CubatureScalings *scalings = nullptr, const CubatureLambdaMetric *metric = nullptr);

@@ -206,12 +206,14 @@ PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMa
 
 // The lambda fit's metric (CubatureLambdaMetric) at the training solutions of the exact-contact ROM (rm's warm-start
 // table): per solution, the exact reduced constraint, A^(mu_j) and the slave-mass Gram of W (CubatureLambdaWeights);
-// kappa_s v_j from the states' terms and theta v_j (one value per patch dof), not from the Q x N blocks. dropped: the
-// solutions in contact whose metric did not factor.
-static PetscErrorCode LambdaFitMetric(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const DualBasisResult &dual, ContactPatch *full, const ContactStates &cs, ReducedModel *rm, CubatureLambdaMetric *metric, PetscInt *dropped)
+// kappa_s v_j from the states' terms and theta v_j (one value per patch dof), not from the Q x N blocks; withForce: the
+// forces' part too (C_j per solution, their mean metric's factor). dropped: the solutions in contact whose metric did
+// not factor.
+static PetscErrorCode LambdaFitMetric(ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const DualBasisResult &dual, ContactPatch *full, const ContactStates &cs, ReducedModel *rm, bool withForce, CubatureLambdaMetric *metric, PetscInt *dropped)
 {
   const PetscInt N = rm->N(), R = rm->R(), nt = (PetscInt)(rm->warmL.size() / std::max<PetscInt>(R, 1));
   std::vector<PetscReal> wc, Kj((size_t)R * N), gj(R), Aj, fj;
+  std::vector<std::vector<PetscReal>> C(nt);
 
   PetscFunctionBeginUser;
   PetscCheck(N == full->N && R == dual.W.cols, PetscObjectComm((PetscObject)fom.dm), PETSC_ERR_PLIB, "offline: the exact reduced model's sizes differ from the bases'");
@@ -228,9 +230,10 @@ static PetscErrorCode LambdaFitMetric(ElasticFOM &fom, ContactMap &cmap, Canonic
     (void)rm->ContactTerms(mu, &rm->warmV[(size_t)j * N], Kj.data(), gj.data());
     rm->Operators(mu, &Aj, &fj);
     const PetscReal *lam = &rm->warmL[(size_t)j * R];
-    if (CubatureLambdaWeights(R, N, Aj.data(), Kj.data(), lam, M, &metric->T[j]) == 0 && std::any_of(lam, lam + R, [](PetscReal l) { return l > 0; })) ++*dropped;
+    if (CubatureLambdaWeights(R, N, Aj.data(), Kj.data(), lam, M, &metric->T[j], withForce ? &C[j] : nullptr) == 0 && std::any_of(lam, lam + R, [](PetscReal l) { return l > 0; })) ++*dropped;
   }
   rm->SetContactMode(mode);
+  if (withForce) metric->forceRank = CubatureLambdaForceFactor(N, C, &metric->forceFactor);
   const size_t rows = full->theta.size() / std::max<PetscInt>(N, 1);
   auto         tv   = std::make_shared<std::vector<PetscReal>>((size_t)nt * rows, 0.0);
   for (PetscInt j = 0; j < nt; ++j)
@@ -511,6 +514,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   std::vector<PetscReal> errK, errG;
   CubatureHierarchy      hier;
   PetscInt               metricDropped = 0; // -ecsw_fit lambda: training solutions in contact whose metric failed
+  PetscInt               metricForceRank = 0; // -ecsw_fit lambda: the rank of its force metric (0: left out)
   if (hyper.ecsw) {
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
     if (wrank != 0) co.monitor = false;
@@ -531,7 +535,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     CubatureLambdaMetric metric;
     if (co.fit == CubatureFit::Lambda) {
       PetscCheck(!((nDefault > 0 || rDefault > 0) && !fitAll), world, PETSC_ERR_SUP, "offline: -ecsw_fit lambda fits every stored basis function; it does not combine with -estimate_cubature answer");
-      PetscCall(LambdaFitMetric(fom, cmap, order, dual, full.get(), cs, &rm, &metric, &metricDropped));
+      PetscCall(LambdaFitMetric(fom, cmap, order, dual, full.get(), cs, &rm, co.lambdaForce, &metric, &metricDropped));
+      metricForceRank = metric.forceRank;
     }
     const CubatureLambdaMetric *pm = co.fit == CubatureFit::Lambda ? &metric : nullptr;
     CubatureGramFunction gram;
@@ -684,7 +689,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     c["tol"]          = (double)co.tol;
     c["fit"]          = co.fit == CubatureFit::Lambda ? "lambda" : co.fit == CubatureFit::Action ? "action" : "terms";
     c["fit_force"]    = co.fit != CubatureFit::Terms && co.fitForce;
-    if (co.fit == CubatureFit::Lambda) c["lambda_metric_dropped"] = (long long)metricDropped;
+    if (co.fit == CubatureFit::Lambda) {
+      c["lambda_metric_dropped"] = (long long)metricDropped;
+      c["lambda_force_rank"]     = (long long)metricForceRank;
+    }
     c["residual"]     = (double)cr.residual;
     c["quadrature_points"] = (long long)Q;
     c["groups"]       = (long long)hier.groups;     // > 1: the hierarchical fit (-ecsw_group_points)

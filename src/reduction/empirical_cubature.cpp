@@ -24,6 +24,9 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   flg = opt->fitForce ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-fit_force", "with -fit action or lambda: fit the resultant contact force too (the online stage's output of interest)", "", flg, &flg, NULL));
   opt->fitForce = flg;
+  flg = opt->lambdaForce ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-fit_lambda_force", "with -fit lambda: also the multiplier error caused by the contact forces' error through the displacement", "", flg, &flg, NULL));
+  opt->lambdaForce = flg;
   PetscCall(PetscOptionsReal("-tol", "relative residual of the fitted reduced terms", "", opt->tol, &opt->tol, NULL));
   PetscCall(PetscOptionsInt("-max_points", "largest number of cubature points", "", opt->maxPoints, &opt->maxPoints, NULL));
   PetscCall(PetscOptionsInt("-group_points", "more quadrature points than this: fit groups of at most this many points, then their union against every point's terms (0: one Gram matrix of every point)", "", opt->groupPoints, &opt->groupPoints, NULL));
@@ -56,13 +59,14 @@ static bool FactorRegularized(PetscInt n, std::vector<PetscReal> *A)
   return false;
 }
 
-PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T)
+PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const PetscReal *K, const PetscReal *lam, const std::vector<PetscReal> &M, std::vector<PetscReal> *T, std::vector<PetscReal> *C)
 {
   std::vector<PetscInt> F;
   for (PetscInt r = 0; r < R; ++r)
     if (lam[r] > 0) F.push_back(r);
   const PetscInt k = (PetscInt)F.size();
   T->assign((size_t)k * R, 0.0);
+  if (C) C->clear();
   if (k == 0) return 0;
   // Y = A^{-1} K_F' (N x k), S = K_F Y
   std::vector<PetscReal> LA(A, A + (size_t)N * N), Y((size_t)N * k), S((size_t)k * k, 0.0), LM((size_t)k * k), Z((size_t)k * k, 0.0);
@@ -92,7 +96,52 @@ PetscInt CubatureLambdaWeights(PetscInt R, PetscInt N, const PetscReal *A, const
       for (PetscInt l = i; l < k; ++l) t += LM[l + (size_t)k * i] * Z[l + (size_t)k * c];
       (*T)[(size_t)i * R + F[c]] = t;
     }
+  if (C) { // C = T_F Y' = L_M' S^{-1} K_F A^{-1}
+    C->assign((size_t)k * N, 0.0);
+    for (PetscInt i = 0; i < k; ++i)
+      for (PetscInt c = 0; c < k; ++c) {
+        const PetscReal t = (*T)[(size_t)i * R + F[c]];
+        for (PetscInt n = 0; n < N; ++n) (*C)[(size_t)i * N + n] += t * Y[n + (size_t)N * c];
+      }
+  }
   return k;
+}
+
+PetscInt CubatureLambdaForceFactor(PetscInt N, const std::vector<std::vector<PetscReal>> &C, std::vector<PetscReal> *Fg)
+{
+  std::vector<PetscReal> G((size_t)N * N, 0.0);
+  PetscInt               cnt = 0;
+  for (const auto &Cj : C) {
+    const size_t k = Cj.size() / std::max<PetscInt>(N, 1);
+    if (k == 0) continue;
+    ++cnt;
+    for (size_t i = 0; i < k; ++i)
+      for (PetscInt a = 0; a < N; ++a) {
+        const PetscReal ca = Cj[i * N + a];
+        if (ca == 0.0) continue;
+        for (PetscInt b = 0; b < N; ++b) G[a + (size_t)N * b] += ca * Cj[i * N + b];
+      }
+  }
+  Fg->clear();
+  if (cnt == 0 || N == 0) return 0;
+  for (auto &x : G) x /= cnt;
+  std::vector<PetscReal> ev(N), work(1);
+  const PetscBLASInt     nn = (PetscBLASInt)N;
+  PetscBLASInt           lwork = -1, info = 0;
+  LAPACKsyev_("V", "U", &nn, G.data(), &nn, ev.data(), work.data(), &lwork, &info);
+  lwork = (PetscBLASInt)work[0];
+  work.resize((size_t)std::max<PetscBLASInt>(lwork, 1));
+  LAPACKsyev_("V", "U", &nn, G.data(), &nn, ev.data(), work.data(), &lwork, &info);
+  if (info != 0 || !(ev[N - 1] > 0)) return 0;
+  std::vector<PetscInt> keep;
+  for (PetscInt i = N - 1; i >= 0 && ev[i] > 1e-8 * ev[N - 1]; --i) keep.push_back(i);
+  const PetscInt r = (PetscInt)keep.size();
+  Fg->assign((size_t)N * r, 0.0);
+  for (PetscInt c = 0; c < r; ++c) {
+    const PetscReal sq = std::sqrt(ev[keep[c]]);
+    for (PetscInt n = 0; n < N; ++n) (*Fg)[(size_t)n * r + c] = sq * G[n + (size_t)N * keep[c]];
+  }
+  return r;
 }
 
 namespace {
@@ -346,14 +395,23 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
   }
   // (Lam P)'(Lam P) o Zk Zk' + P'P o Y Y', Zk (the scaled kappa columns) and Y(p, (s, j)) = s2 (kappa_s(p, :) v_j -
   // gamma_s(p)) formed a block of states at a time
+  // with the lambda metric's force factor, each state's N columns are followed by its rg columns s2 kappa_s Fg
+  const PetscInt   rg  = metric ? metric->forceRank : 0;
+  const PetscInt   per = N + rg;
+  const PetscReal *Fg  = rg > 0 ? metric->forceFactor.data() : nullptr;
   ResetGram(Q, H, cand);
-  AddHadamardGramBlocks(Q, LP.data(), nt, ms, N, StatesPerBlock(Q, N, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Z) {
+  AddHadamardGramBlocks(Q, LP.data(), nt, ms, per, StatesPerBlock(Q, per, ms, block), [&](PetscInt s0, PetscInt cnt, PetscReal *Z) {
     for (PetscInt s = s0; s < s0 + cnt; ++s) {
       const PetscReal *kap = Sk(s);
       for (PetscInt n = 0; n < N; ++n) {
-        PetscReal *z = &Z[(size_t)((s - s0) * N + n) * Q];
+        PetscReal *z = &Z[(size_t)((s - s0) * per + n) * Q];
         for (PetscInt p = 0; p < Q; ++p) z[p] = s1[s] * kap[(size_t)p * N + n];
       }
+      if (rg == 0) continue;
+      // zg (Q x rg, column-major) = s2 kappa_s Fg, kappa_s and Fg row-major: the transposes of column-major arrays
+      const PetscBLASInt bq = (PetscBLASInt)Q, br = (PetscBLASInt)rg, bn = (PetscBLASInt)N;
+      const PetscReal    zero = 0;
+      BLASgemm_("T", "T", &bq, &br, &bn, &s2[s], kap, &bn, Fg, &br, &zero, &Z[(size_t)((s - s0) * per + N) * Q], &bq);
     }
   }, H, cand);
   if (metric) // sum_j ((T_j P)'(T_j P)) o (Y_j Y_j'), one training solution at a time
