@@ -65,6 +65,16 @@ static std::vector<PetscReal> ForceAction(const std::vector<PetscReal> &K, const
   return f;
 }
 
+// State s's terms K, g at the single point p with unit weight (e: the weights, reset to e_p) and the force action
+// K' lam_j of them: the coefficient of xi_p in the explicit rows
+static std::vector<PetscReal> UnitPointForce(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const std::vector<PetscReal> &Sk, const std::vector<PetscReal> &Sg, PetscInt s, PetscInt p, const std::vector<PetscReal> &Lam, PetscInt j, std::vector<PetscReal> *e, std::vector<PetscReal> *K, std::vector<PetscReal> *g)
+{
+  std::fill(e->begin(), e->end(), 0.0);
+  (*e)[p] = 1;
+  Terms(P, R, Q, N, Sk, Sg, s, *e, K, g);
+  return ForceAction(*K, Lam, j, R, N);
+}
+
 // x = S^{-1} b by Gaussian elimination with partial pivoting (S n x n, row-major, copied)
 static std::vector<PetscReal> SolveDense(PetscInt n, std::vector<PetscReal> S, std::vector<PetscReal> b)
 {
@@ -199,10 +209,7 @@ int main(int argc, char **argv)
       for (PetscInt j = 0; j < nt; ++j) {
         std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)R * Q);
         for (PetscInt p = 0; p < Q; ++p) {
-          std::fill(e.begin(), e.end(), 0.0);
-          e[p] = 1;
-          Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
-          const std::vector<PetscReal> f = ForceAction(K, Lam, j, R, N);
+          const std::vector<PetscReal> f = UnitPointForce(P, R, Q, N, Sk, Sg, s, p, Lam, j, &e, &K, &g);
           for (PetscInt n = 0; n < N; ++n) rows1[(size_t)n * Q + p] = f[n] / std::sqrt(n1);
           for (PetscInt r = 0; r < R; ++r) {
             PetscReal t = -g[r];
@@ -266,10 +273,7 @@ int main(int argc, char **argv)
         for (PetscInt j = 0; j < nt; ++j) {
           std::vector<PetscReal> rows1((size_t)N * Q), rows2((size_t)ks[j] * Q), rows3((size_t)rg * Q, 0.0);
           for (PetscInt p = 0; p < Q; ++p) {
-            std::fill(e.begin(), e.end(), 0.0);
-            e[p] = 1;
-            Terms(P, R, Q, N, Sk, Sg, s, e, &K, &g);
-            const std::vector<PetscReal> f = ForceAction(K, Lam, j, R, N);
+            const std::vector<PetscReal> f = UnitPointForce(P, R, Q, N, Sk, Sg, s, p, Lam, j, &e, &K, &g);
             for (PetscInt n = 0; n < N; ++n) rows1[(size_t)n * Q + p] = f[n] / std::sqrt(n1);
             for (PetscInt c = 0; c < rg; ++c)
               for (PetscInt n = 0; n < N; ++n) rows3[(size_t)c * Q + p] += Fg[(size_t)n * rg + c] * f[n] / std::sqrt(n2);
