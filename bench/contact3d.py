@@ -17,7 +17,10 @@ Tables:
      ~10 s). With --rom-workdir DIR every step is kept in DIR/<mesh> and resumed by the next run (the finest level needs
      it: 36 + 20 FOM solves of 6-8 min): training snapshots, the test set's FOM solutions (offline -offline_stop
      snapshots, read by validate -test_snapshots: the FOM median is theirs), the ROM, validate; each command and its
-     output go to DIR/<mesh>/bench.log.
+     output go to DIR/<mesh>/bench.log. --rom-refine K (meshes trained with sensitivity snapshots, with --rom-workdir):
+     after the grid's snapshots, share/refine_training.py adds the centres of the K grid cells whose multipliers the
+     corners' sensitivities predict worst, offline -snapshots_from copies the grid's snapshots and solves those K, and
+     the ROM is built on the refined set (files *_refineK.*, the grid's own kept; docs/greedy_training.md).
   5. --large (printed before table 4): one FOM at about 5e5 dofs on 2 ranks (hertz3d h_fine 0.028 refined once) with the
      iterative saddle-point preset, against refine 1 with the same settings: time, peak resident memory, and the
      memory growth against the dof growth between the two levels (target: no faster than linear).
@@ -25,7 +28,8 @@ Tables:
 Extra options for every fom run: --extra "...". Runs that fail are reported as such and the script goes on.
 It exits 0 unless the executable is missing. Timings depend on the machine's load.
 Usage: /usr/bin/python3 bench/contact3d.py [--exe build/bin/rbcontact] [--refine 0 1] [--np 1 2] [--extra "-fom_saddle_solver gamg"]
-       [--large] [--no-rom] [--rom-meshes scene hertz3d finest] [--rom-np 2] [--rom-workdir DIR] [--rom-only]
+       [--large] [--no-rom] [--rom-meshes scene hertz3d finest] [--rom-np 2] [--rom-workdir DIR] [--rom-refine K]
+       [--rom-only]
 """
 import argparse
 import json
@@ -82,7 +86,12 @@ def main():
                     help="keep table 4's files in this directory (one subdirectory per mesh) and resume every step from them: the "
                          "training snapshots (-snapshots_restart), the test set's FOM solutions (a snapshot file read by validate "
                          "-test_snapshots), the ROM; needed for --rom-meshes finest (hours of FOM solves)")
+    ap.add_argument("--rom-refine", type=int, default=0,
+                    help="with --rom-workdir, on the meshes trained with sensitivity snapshots (finest): add the centres of the K "
+                         "grid cells ranked worst by share/refine_training.py to the training set (docs/greedy_training.md)")
     args = ap.parse_args()
+    if args.rom_refine < 0 or (args.rom_refine and not args.rom_workdir):
+        sys.exit("contact3d.py: --rom-refine %d needs K >= 0 and --rom-workdir" % args.rom_refine)
     if not os.path.exists(args.exe):
         sys.exit("contact3d.py: %s not found (build first)" % args.exe)
     extra = shlex.split(args.extra)
@@ -191,20 +200,41 @@ def rom3d(args, extra):
         ok = True
         steps = [("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-report", out + "/off.json"]),
                  ("validate", ["-rom", out + "/rom.h5", "-report", out + "/val.json"])]
+        refine = args.rom_refine if "-snapshots_sensitivities" in base else 0
+        sfx = "_refine%d" % refine if refine else ""
+        snapjson = out + "/snap%s.json" % sfx
         if args.rom_workdir:  # every step resumable: the snapshots of training and test set checkpointed, a finished step kept
-            test = out + "/test.h5"
+            test, train = out + "/test.h5", out + "/snap%s.h5" % sfx
             steps = [("offline", ["-offline_stop", "snapshots", "-snapshots", out + "/snap.h5", "-snapshots_restart", "-snapshots_monitor",
                                   "-report", out + "/snap.json"]),
                      ("offline:test", ["-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
-                                  "-snapshots_subcomm", "1", "-snapshots", test, "-snapshots_restart", "-snapshots_monitor", "-report", out + "/test.json"]),
-                     ("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-snapshots_restart", "-report", out + "/off.json"]),
-                     ("validate", ["-rom", out + "/rom.h5", "-test_snapshots", test, "-report", out + "/val.json"])]
-            if os.path.exists(out + "/off.json") and os.path.exists(out + "/rom.h5"):
-                steps = steps[:2] + steps[3:]  # the ROM of an earlier run (delete off.json to rebuild it)
+                                  "-snapshots_subcomm", "1", "-snapshots", test, "-snapshots_restart", "-snapshots_monitor", "-report", out + "/test.json"])]
+            trainset = []
+            if refine:  # the grid's worst cells' centres added, the grid's snapshots copied (docs/greedy_training.md)
+                tfile = out + "/train%s.txt" % sfx
+                trainset = ["-train_type", "file", "-train_file", tfile]
+                steps += [("refine", [sys.executable, os.path.join(ROOT, "share", "refine_training.py"), out + "/snap.h5", "--count", str(refine),
+                                      "--with-grid", "--out", tfile]),
+                          ("offline", trainset + ["-offline_stop", "snapshots", "-snapshots", train, "-snapshots_from", out + "/snap.h5",
+                                                  "-snapshots_restart", "-snapshots_monitor", "-report", snapjson])]
+            steps += [("offline", trainset + ["-rom", out + "/rom%s.h5" % sfx, "-snapshots", train, "-snapshots_restart", "-report", out + "/off%s.json" % sfx]),
+                      ("validate", ["-rom", out + "/rom%s.h5" % sfx, "-test_snapshots", test, "-report", out + "/val%s.json" % sfx])]
+            if os.path.exists(out + "/off%s.json" % sfx) and os.path.exists(out + "/rom%s.h5" % sfx):
+                steps = steps[:-2] + steps[-1:]  # the ROM of an earlier run (delete off*.json to rebuild it)
         for stage, more in steps:
             opts = base
             if stage == "offline:test":  # the test set's FOM solutions: no sensitivities
                 stage, opts = "offline", [o for o in base if o != "-snapshots_sensitivities"]
+            if stage == "refine":  # a script, not a stage
+                with open(out + "/bench.log", "a") as log:
+                    log.write("\n$ %s\n" % " ".join(more))
+                    log.flush()
+                    p = subprocess.run(more, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT, text=True)
+                if p.returncode != 0:
+                    print("| %s | failed in share/refine_training.py (log %s) |||||||||||||" % (tag, out + "/bench.log"))
+                    ok = False
+                    break
+                continue
             with open(out + "/bench.log", "a") as log:
                 log.write("\n$ %s\n" % " ".join(mpi + [args.exe, stage] + opts + more))
                 log.flush()
@@ -217,12 +247,13 @@ def rom3d(args, extra):
                 break
         if not ok:
             continue
-        with open(out + "/off.json") as f:
+        with open(out + "/off%s.json" % sfx) as f:
             off = json.load(f)
         if args.rom_workdir:  # the snapshot step's counts (a resumed offline stage solves none)
-            with open(out + "/snap.json") as f:
+            with open(snapjson) as f:
                 off["ntrain"] = json.load(f).get("ntrain", 0)
-        with open(out + "/val.json") as f:
+        label = tag + (" + %d centres" % refine if refine else "")
+        with open(out + "/val%s.json" % sfx) as f:
             v = json.load(f)
         t, ro = v["test"], v["rom"]
         met = t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3
@@ -232,7 +263,7 @@ def rom3d(args, extra):
         if tag == "finest":
             verdict += ", speedup %s" % ("met" if v["speedup_median"] >= 1e4 else "MISSED")
         print("| %s | %d | %d | %d | %d | %d | %.2e | %.2e | %.2e | %.2e | %.0f us | %.2f s | %.0f | %.1f | accuracy %s, %s |"
-              % (tag, off.get("ndofs", 0), off.get("ntrain", 0), ro["N"], ro["R"], ro["Mc"], t["max_rel_err_u"], t["max_rel_err_lambda"],
+              % (label, off.get("ndofs", 0), off.get("ntrain", 0), ro["N"], ro["R"], ro["Mc"], t["max_rel_err_u"], t["max_rel_err_lambda"],
                  t["max_rel_err_force"], t["max_rel_err_force_online"], 1e6 * v["online_time_s"]["median"], v["fom_time_s"]["median"],
                  v["speedup_median"], off["time_s"]["total"], "met" if met else "MISSED", verdict))
 

@@ -10,6 +10,9 @@
   greedy      -train_type greedy on ring_on_block: the same picks on 1 and 2 ranks, each round's first pick
               the largest indicator, the separation, the snapshot file holding exactly the picks, a
               resumed run continuing where the budget stopped, the ROM validated against the targets.
+  snapshots_from  -snapshots_from: a training set extended by new points copies the done snapshots of older files
+              (the rows bit for bit), solves only the new points (equal to a clean run's), on 1 and 2 ranks; a missing
+              file, another scene's file and a file without the sensitivities this run stores are refused by name.
   sensitivities  -snapshots_sensitivities on half_disks: du/dmu against central differences of FOM solutions,
               the dense, saddle and CG solves, 1 and 2 ranks, the POD and dual basis enriched (on a 3 x 3 grid: the best
               approximation of u, the ROM's u and lambda errors smaller), a file without them and a bad step refused.
@@ -330,6 +333,66 @@ def greedy(args):
         check(p.returncode != 0 and needle in p.stdout, "refused with a message naming '%s'" % needle)
 
 
+def snapshots_from(args):
+    d = workdir("rbc_off_")
+    opts = "runs/ring_on_block.opts"
+
+    def points(name, radii):
+        with open(d + "/" + name, "w") as f:
+            f.write("# radii\n" + "".join("%r\n" % r for r in radii))
+        return ["-train_type", "file", "-train_file", d + "/" + name]
+
+    run(args, 1, opts, ["-train_type", "grid", "-train_size", "3", "-snapshots", d + "/a.h5"])          # 0.95, 1.05, 1.15
+    run(args, 1, opts, points("b.txt", [1.0, 1.12]) + ["-snapshots", d + "/b.h5"])                      # 1.12: not in the new set
+    ext = points("ext.txt", [0.95, 1.0, 1.05, 1.1, 1.15])
+    run(args, 1, opts, ext + ["-snapshots", d + "/clean.h5"])
+    a, clean = arrays(d + "/a.h5"), arrays(d + "/clean.h5")
+    for np_ in (1, 2):
+        out = d + "/ext%d.h5" % np_
+        run(args, np_, opts, ext + ["-snapshots", out, "-snapshots_from", d + "/a.h5," + d + "/b.h5", "-report", d + "/r%d.json" % np_, "-snapshots_monitor"])
+        r, e = report(d + "/r%d.json" % np_), arrays(out)
+        print("  np %d: imported %d, solved %d, resumed %d" % (np_, r["imported"], r["fom_solves"], r["resumed"]))
+        check(r["imported"] == 4 and r["fom_solves"] == 1 and r["resumed"] == 0, "np %d: 4 snapshots imported (3 of a.h5, 1.0 of b.h5), only 1.1 solved" % np_)
+        check(np.all(e["done"] == 1), "np %d: every point of the extended set done" % np_)
+        same = all(np.array_equal(e[k][[0, 2, 4]], a[k]) for k in ("u", "lambda", "mu", "extra/contact_gap", "kacanov_iterations"))
+        check(same, "np %d: the rows copied from a.h5 are bit for bit its rows" % np_)
+        compare(clean, e, 1e-10, "np %d: extended file vs a clean run of the 5 points" % np_)
+    # share/refine_training.py: the k cells of a grid with sensitivities whose corners' predictions disagree most,
+    # their centres appended to the grid; offline solves only those
+    run(args, 2, "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "3", "-snapshots_sensitivities", "-snapshots", d + "/hs.h5"])
+    rt = [sys.executable, "share/refine_training.py", d + "/hs.h5", "--count", "2", "--out", d + "/rt.txt", "--with-grid"]
+    p = subprocess.run(rt, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    print("\n".join("  " + l for l in p.stdout.splitlines()))
+    pts = np.loadtxt(d + "/rt.txt", ndmin=2)
+    hs = arrays(d + "/hs.h5")
+    ax = [np.unique(hs["mu"][:, i]) for i in range(2)]
+    mids = [(ax[i][:-1] + ax[i][1:]) / 2 for i in range(2)]
+    centres = pts[9:]
+    check(p.returncode == 0 and len(pts) == 11 and np.allclose(pts[:9], hs["mu"], rtol=0, atol=0), "refine_training.py: the 9 grid points, then 2 more")
+    check(all(np.min(np.abs(mids[i] - c[i])) < 1e-12 for c in centres for i in range(2)) and len({tuple(c) for c in centres}) == 2,
+          "refine_training.py: the 2 added points are distinct cell centres %s" % centres.tolist())
+    run(args, 2, "runs/half_disks.opts", ["-train_type", "file", "-train_file", d + "/rt.txt", "-snapshots_sensitivities", "-snapshots", d + "/hs11.h5",
+                                          "-snapshots_from", d + "/hs.h5", "-report", d + "/rt.json"])
+    r = report(d + "/rt.json")
+    check(r["imported"] == 9 and r["fom_solves"] == 2, "the refined set: 9 imported, the 2 centres solved (imported %d, solved %d)" % (r["imported"], r["fom_solves"]))
+    p = subprocess.run(rt[:2] + [d + "/a.h5"] + rt[3:], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "a.h5" in p.stdout and "sensitivity_lambda" in p.stdout, "refine_training.py on a file without sensitivities: refused by name (%s)" % p.stdout.strip()[-160:])
+    # bad input: each refused naming the file, nothing written
+    bad = [("a missing file", ["-snapshots_from", d + "/none.h5"], "none.h5", "no such file"),
+           ("another scene's file", None, "hd.h5", "differs"),
+           ("a file without the sensitivities", ["-snapshots_from", d + "/a.h5", "-snapshots_sensitivities"], "a.h5", "sensitivity_u")]
+    run(args, 1, "runs/half_disks.opts", ["-train_type", "grid", "-train_size", "2", "-snapshots", d + "/hd.h5"])
+    for what, extra, name, word in bad:
+        extra = extra or ["-snapshots_from", d + "/hd.h5"]
+        p = run(args, 1, opts, ext + ["-snapshots", d + "/never.h5"] + extra, expect_ok=False)
+        msg = [l for l in p.stdout.splitlines() if name in l][:1]
+        print("  %s -> exit %d: %s" % (what, p.returncode, msg[0] if msg else p.stdout[-300:]))
+        check(p.returncode != 0 and msg and word in p.stdout and "-snapshots_from" in p.stdout, "%s: refused, the message names the file and says why" % what)
+        check("Segmentation" not in p.stdout and "SEGV" not in p.stdout, "%s: no crash" % what)
+        with h5py.File(d + "/never.h5", "r") as f:
+            check(int(np.sum(np.array(f["snapshots/done"]))) == 0, "%s: no snapshot written" % what)
+
+
 def sensitivities(args):
     d = workdir("rbc_off_")
     # a point and its neighbours 1e-3 of each parameter's range away (the active set is the same at all five)
@@ -403,7 +466,7 @@ def sensitivities(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "sensitivities"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

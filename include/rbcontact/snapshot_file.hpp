@@ -62,6 +62,12 @@ public:
   // Rank 0 of comm writes s (others pass through): data, then H5Fflush, then the done flag, flush.
   PetscErrorCode Write(const Snapshot &s);
   PetscErrorCode Close();
+  // Copies into this open file the done snapshots of another snapshot file of the same problem (every header
+  // field Open compares but the training set) whose parameters are points of this file's training set (to 1e-14)
+  // not done here yet; the others are counted in *outside. extras: the extra arrays this run writes with every
+  // snapshot: a snapshot lacking one is refused (naming the file), extras not in the list are dropped. Collective;
+  // rank 0 reads. Errors name the file (missing, not a snapshot file, another scene/mesh/box).
+  PetscErrorCode Import(const std::string &from, const std::vector<std::string> &extras, PetscInt *imported, PetscInt *outside);
 
   // (Added) State of an open file: its path, the header it was opened with, whether it is open.
   bool                  IsOpen() const { return open_; }

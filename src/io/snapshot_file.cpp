@@ -41,11 +41,13 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -523,17 +525,15 @@ PetscErrorCode SnapshotFile::ReadHeader(const std::string &path, SnapshotHeader 
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapshot> *snaps)
-{
-  std::string err;
+namespace {
 
-  PetscFunctionBeginUser;
+// ReadAll's work (any rank): the header and every done snapshot of path; false with c.err on failure.
+bool ReadAllH5(Ctx &c, const std::string &path, SnapshotHeader *hOut, std::vector<Snapshot> *snaps)
+{
   snaps->clear();
   {
-    H5Quiet                  q;
-    Ctx                      c = FileCtx(path);
     H5Id                     f;
-    SnapshotHeader           h;
+    SnapshotHeader          &h = *hOut;
     std::vector<signed char> done;
     std::vector<std::pair<std::string, hsize_t>> extras; // name, length
     bool ok = OpenExisting(c, path, false, &f) && ReadHeaderH5(c, f.get(), &h) && ReadDone(c, f.get(), h.trainingPoints.size(), &done);
@@ -597,9 +597,83 @@ PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapsh
       if (ok) snaps->push_back(std::move(s));
     }
     if (ok) ok = CloseFile(c, &f);
-    if (!ok) err = c.err;
+    return ok;
+  }
+}
+
+} // namespace
+
+PetscErrorCode SnapshotFile::ReadAll(const std::string &path, std::vector<Snapshot> *snaps)
+{
+  std::string err;
+
+  PetscFunctionBeginUser;
+  {
+    H5Quiet        q;
+    Ctx            c = FileCtx(path);
+    SnapshotHeader h;
+    if (!ReadAllH5(c, path, &h, snaps)) err = c.err;
   }
   PetscCheck(err.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::Import(const std::string &from, const std::vector<std::string> &extras, PetscInt *imported, PetscInt *outside)
+{
+  PetscMPIInt           rank;
+  std::string           err;
+  std::vector<Snapshot> take; // rank 0: the snapshots to write, their index in this file's training set
+  PetscInt              counts[2] = {0, 0}; // imported, outside this training set
+
+  PetscFunctionBeginUser;
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::Import: no snapshot file is open");
+  PetscCallMPI(MPI_Comm_rank(comm_, &rank));
+  if (rank == 0) {
+    H5Quiet               q;
+    Ctx                   c{"Snapshot file '" + from + "' (-snapshots_from)", std::string()};
+    SnapshotHeader        fh;
+    std::vector<Snapshot> all;
+    bool                  ok = FileExists(from) || c.Fail("no such file", false);
+    ok                       = ok && ReadAllH5(c, from, &fh, &all);
+    if (ok) { // the same problem: every header field but the training set
+      SnapshotHeader now  = header_;
+      now.trainingPoints  = fh.trainingPoints;
+      const std::string d = SnapshotHeaderDiff(fh, now);
+      if (!d.empty()) ok = c.Fail("was made for another scene/mesh/parameter box: " + d, false);
+    }
+    for (auto &s : all) {
+      if (!ok) break;
+      for (const auto &e : extras)
+        if (!s.extra.count(e)) {
+          ok = c.Fail("snapshot " + std::to_string(s.index) + " has no /snapshots/extra/" + e + ", which this run stores with every snapshot (-snapshots_sensitivities on one side only?)", false);
+          break;
+        }
+      for (auto it = s.extra.begin(); it != s.extra.end();) // only what this run writes: no half-filled extra
+        it = std::find(extras.begin(), extras.end(), it->first) == extras.end() ? s.extra.erase(it) : std::next(it);
+      PetscInt i = -1;
+      for (size_t j = 0; i < 0 && j < header_.trainingPoints.size(); ++j) {
+        bool same = s.mu.size() == header_.trainingPoints[j].size();
+        for (size_t k = 0; same && k < s.mu.size(); ++k) same = Close14(s.mu[k], header_.trainingPoints[j][k]);
+        if (same) i = (PetscInt)j;
+      }
+      if (i < 0) ++counts[1];
+      else if (!done_[i]) {
+        s.index = i;
+        take.push_back(std::move(s));
+      }
+    }
+    if (!ok) {
+      err = c.err;
+      take.clear();
+    }
+    counts[0] = (PetscInt)take.size();
+  }
+  PetscCall(BcastString(comm_, &err));
+  PetscCheck(err.empty(), comm_, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  PetscCallMPI(MPI_Bcast(counts, 2, MPIU_INT, 0, comm_));
+  for (PetscInt k = 0; k < counts[0]; ++k) PetscCall(Write(rank == 0 ? take[k] : Snapshot()));
+  *imported = counts[0];
+  *outside  = counts[1];
   PetscFunctionReturn(0);
 }
 

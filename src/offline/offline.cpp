@@ -61,6 +61,16 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   PetscCall(PetscOptionsBool("-snapshots_sensitivities", "store du/dmu_i, dlambda/dmu_i with every contact snapshot (linear solves with its factor) for the POD and the dual greedy (docs/greedy_training.md)", "", sens, &sens, NULL));
   PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
   PetscCall(PetscOptionsString("-offline_basis_output", "write the POD modes, supremizers and dual basis on the mesh to this HDF5 file (+ .xmf for ParaView)", "", viewPath, viewPath, sizeof viewPath, NULL));
+  {
+    char     *from[16] = {NULL};
+    PetscInt  nfrom    = 16;
+    PetscBool set      = PETSC_FALSE;
+    PetscCall(PetscOptionsStringArray("-snapshots_from", "copy the done snapshots of these snapshot files (same scene and mesh) at points of this training set, before solving the rest", "", from, &nfrom, &set));
+    for (PetscInt i = 0; i < (set ? nfrom : 0); ++i) {
+      s->from.emplace_back(from[i]);
+      PetscCall(PetscFree(from[i]));
+    }
+  }
   PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));
   PetscOptionsEnd();
   PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
@@ -229,11 +239,23 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     }
     SnapshotFile file;
     PetscCall(file.Open(world, snapPath, h, restart));
+    PetscInt imported = 0;
+    for (const auto &from : s.from) { // before the done list: the imported snapshots are not solved again
+      PetscInt n = 0, outside = 0;
+      std::vector<std::string> extras;
+      if (scene.contact) extras.push_back("contact_gap");
+      if (s.sensitivities) extras.insert(extras.end(), {"sensitivity_u", "sensitivity_lambda"});
+      PetscCheck(from != s.snapshots, world, PETSC_ERR_ARG_WRONG, "-snapshots_from %s: that is the snapshot file being written (-snapshots)", from.c_str());
+      PetscCall(file.Import(from, extras, &n, &outside));
+      imported += n;
+      PetscCall(PetscInfo(NULL, "%s: %" PetscInt_FMT " snapshots imported, %" PetscInt_FMT " outside this training set\n", from.c_str(), n, outside));
+      if (wrank == 0 && monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  -snapshots_from %s: %" PetscInt_FMT " snapshots imported (%" PetscInt_FMT " at points outside this training set)\n", from.c_str(), n, outside));
+    }
     std::vector<PetscInt> done, todo;
     PetscCall(file.DoneIndices(&done));
     for (PetscInt i = 0; i < ntrain; ++i)
       if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
-    if (!restart) PetscCheck(done.empty(), world, PETSC_ERR_PLIB, "new snapshot file with done entries");
+    if (!restart) PetscCheck((PetscInt)done.size() == imported, world, PETSC_ERR_PLIB, "new snapshot file with done entries");
 
     // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], and with
     // -snapshots_sensitivities the scaled derivatives (mu_i range) du/dmu_i [np*ndofs], dlambda/dmu_i [np*R]
@@ -402,7 +424,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     rep.root["train_type"]  = trainType;
     rep.root["nparams"]     = (long long)np;
     rep.root["fom_solves"]  = (long long)allIts.size();
-    rep.root["resumed"]     = (long long)done.size();
+    rep.root["resumed"]     = (long long)(done.size() - (size_t)imported); // in the file before this run
+    rep.root["imported"]    = (long long)imported;       // copied by -snapshots_from
     rep.root["ndofs"]       = (long long)ndofs;
     rep.root["ncontact"]    = (long long)R;
     JsonValue &ki           = rep.root["kacanov_iterations"];
