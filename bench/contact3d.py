@@ -225,20 +225,12 @@ def rom3d(args, extra):
             opts = base
             if stage == "offline:test":  # the test set's FOM solutions: no sensitivities
                 stage, opts = "offline", [o for o in base if o != "-snapshots_sensitivities"]
-            if stage == "refine":  # a script, not a stage
-                with open(out + "/bench.log", "a") as log:
-                    log.write("\n$ %s\n" % " ".join(more))
-                    log.flush()
-                    p = subprocess.run(more, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT, text=True)
-                if p.returncode != 0:
-                    print("| %s | failed in share/refine_training.py (log %s) |||||||||||||" % (tag, out + "/bench.log"))
-                    ok = False
-                    break
-                continue
+            # a stage of the executable, or the refine step's script (its whole command line)
+            command = more if stage == "refine" else mpi + [args.exe, stage] + opts + more
             with open(out + "/bench.log", "a") as log:
-                log.write("\n$ %s\n" % " ".join(mpi + [args.exe, stage] + opts + more))
+                log.write("\n$ %s\n" % " ".join(command))
                 log.flush()
-                p = subprocess.run(mpi + [args.exe, stage] + opts + more, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT, text=True)
+                p = subprocess.run(command, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT, text=True)
             if p.returncode != 0:
                 with open(out + "/bench.log") as log:
                     last = log.read().strip().splitlines()

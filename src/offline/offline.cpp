@@ -142,6 +142,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   PetscCheck(!s.snapshots.empty(), world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
   if (bases) PetscCall(CheckOutputPath(world, s.rom, "-rom"));
   PetscCall(CheckOutputPath(world, s.snapshots, "-snapshots"));
+  for (const auto &from : s.from) PetscCheck(from != s.snapshots, world, PETSC_ERR_ARG_WRONG, "-snapshots_from %s: that is the snapshot file being written (-snapshots)", from.c_str());
   if (full) PetscCall(CheckOutputPath(world, s.basis, "-rom_basis"));
   PetscCheck(s.basisView.empty() || full, world, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
   if (!s.basisView.empty()) PetscCall(CheckOutputPath(world, s.basisView, "-offline_basis_output"));
@@ -239,13 +240,12 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     }
     SnapshotFile file;
     PetscCall(file.Open(world, snapPath, h, restart));
-    PetscInt imported = 0;
+    PetscInt                 imported = 0;
+    std::vector<std::string> extras; // what this run writes with every snapshot (the packing below)
+    if (scene.contact) extras.push_back("contact_gap");
+    if (s.sensitivities) extras.insert(extras.end(), {"sensitivity_u", "sensitivity_lambda"});
     for (const auto &from : s.from) { // before the done list: the imported snapshots are not solved again
       PetscInt n = 0, outside = 0;
-      std::vector<std::string> extras;
-      if (scene.contact) extras.push_back("contact_gap");
-      if (s.sensitivities) extras.insert(extras.end(), {"sensitivity_u", "sensitivity_lambda"});
-      PetscCheck(from != s.snapshots, world, PETSC_ERR_ARG_WRONG, "-snapshots_from %s: that is the snapshot file being written (-snapshots)", from.c_str());
       PetscCall(file.Import(from, extras, &n, &outside));
       imported += n;
       PetscCall(PetscInfo(NULL, "%s: %" PetscInt_FMT " snapshots imported, %" PetscInt_FMT " outside this training set\n", from.c_str(), n, outside));
