@@ -134,6 +134,11 @@ public:
   void AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
   // Reduced contact terms at (mu, v) in the current mode: K (R x N column-major), g (R). Returns the out-of-range count.
   PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g);
+  // Puts the cubature points (cPoint with cPw's columns) in the order of their slave facets, so that
+  // consecutive points share the rows of theta their terms fall on (read from cache, not from memory:
+  // docs/online.md "The cubature points in slave facet order"). The same points and weights; the sums
+  // change only by rounding. Needs the patch; called by Read and by the offline stage.
+  void OrderCubaturePoints();
 
   // --- stored data (file sizes; public so that the offline stage can fill it in memory) ---
   std::string            file;

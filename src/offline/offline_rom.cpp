@@ -585,6 +585,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
       for (PetscInt r = 0; r < R; ++r) rm.cPw[(size_t)r * M + j] = cr.weights[j] * P[(size_t)r * Q + cr.points[j]];
     }
     full->Restrict(keep, hitv, rings, &rm.patch);
+    rm.OrderCubaturePoints();
     CubatureStateErrors(P, R, Q, N, Sk, Sg, ms, cr, &errK, &errG); // the fit on every training state
     if (distribute) {
       PetscCall(GatherStates(world, &errK));

@@ -4,6 +4,7 @@
 #include "rbcontact/warm_start.hpp"
 #include "dense_kernels.hpp"
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -330,6 +331,7 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       cPoint = ToInt(d);
       for (PetscInt p : cPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw/points out of range", path.c_str());
       PetscCall(ReadChecked(path, "/online/ecsw/Pw", R * cPoint.size(), &cPw));
+      OrderCubaturePoints(); // files written before 2026-11-27 hold them in the fit's order
     }
     PetscCall(RomReadOptional(path, "/online/hyper_default", &d, &found));
     if (found) {
@@ -640,6 +642,25 @@ void ReducedModel::CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, c
   }
   SumOfOuterProductsRows(M, rp, nc, PwT.data(), kx, ldx, Kp->data());
   SumOfOuterProductsRows(M, rp, 1, PwT.data(), gam_.data(), 1, Kp->data() + (size_t)nc * rp); // g^
+}
+
+void ReducedModel::OrderCubaturePoints()
+{
+  const size_t M = cPoint.size();
+  if (M < 2 || cPw.size() % M) return;
+  const size_t R = cPw.size() / M; // Pw's rows (Rfull)
+  std::vector<size_t> perm(M);
+  std::iota(perm.begin(), perm.end(), (size_t)0);
+  const auto key = [&](size_t a) { return std::make_pair(patch.points[cPoint[a]].facet, cPoint[a]); };
+  std::stable_sort(perm.begin(), perm.end(), [&](size_t a, size_t b) { return key(a) < key(b); });
+  std::vector<PetscInt>  pt(M);
+  std::vector<PetscReal> pw(cPw.size());
+  for (size_t j = 0; j < M; ++j) {
+    pt[j] = cPoint[perm[j]];
+    for (size_t i = 0; i < R; ++i) pw[i * M + j] = cPw[i * M + perm[j]];
+  }
+  cPoint.swap(pt);
+  cPw.swap(pw);
 }
 
 PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
