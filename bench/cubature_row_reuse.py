@@ -55,9 +55,9 @@ def main():
     q = ((X - X.min(0)) / (np.ptp(X, 0) + 1e-30) * 1023).astype(np.int64)
     morton = [sum(((int(v[d]) >> b) & 1) << (dim * b + d) for b in range(10) for d in range(dim)) for v in q]
     orders = {"file": np.arange(len(cpts)), "slave facet": np.lexsort((cpts, P[cpts, 0])), "Morton": np.argsort(morton, kind="stable")}
-    reads = sum(len(r) for r in rows)
+    reads, distinct = sum(len(r) for r in rows), len({x for r in rows for x in r})
     print("%s: Mc %d, %d row reads (%.1f a point), %d distinct rows (the compulsory misses %.1f %%), %d bytes a float row (N %d, padded to 8)"
-          % (a.rom, len(cpts), reads, reads / len(cpts), len({x for r in rows for x in r}), 100.0 * len({x for r in rows for x in r}) / reads, 4 * N, N))
+          % (a.rom, len(cpts), reads, reads / len(cpts), distinct, 100.0 * distinct / reads, 4 * (-(-N // 8) * 8), N))
     print("| cache (rows) | " + " | ".join(orders) + " |")
     print("|---|" + "---|" * len(orders))
     for cap in a.rows:
