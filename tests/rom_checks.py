@@ -507,6 +507,11 @@ def sphere_block3d(args):
           "3D ROM at its training parameters within the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)")
     dmax = max(abs(a - b) / max(abs(b), 1e-300) for k in ("rel_err_u", "rel_err_lambda", "rel_err_force") for a, b in zip(vals[1][k], vals[2][k]))
     check(dmax <= 1e-6, "1 and 2 ranks: the same errors to %.1e relative (<= 1e-6)" % dmax)
+    # the online solves timed on rank 0 while the other ranks wait (-validate_time_all_ranks false, docs/online.md
+    # "Validation"): 9 medians, each of a real solve
+    ot = report("%s/val2.json" % d)["online_time_s"]
+    check(ot["timed_on"] == "rank 0, the other ranks waiting" and len(ot["per_parameter_median"]) == 9 and min(ot["per_parameter_median"]) > 0,
+          "validate on 2 ranks times on rank 0 alone: %s, %d medians > 0" % (ot["timed_on"], len(ot["per_parameter_median"])))
     # -fom_saddle_solver gamg (memory linear in the dofs, the finest 3D level): the supremizers' A^{-1} is CG + GAMG
     # as well, not a MUMPS factor of A (which outgrew the machine there); the same supremizers to the CG tolerance
     sup = {}
@@ -535,21 +540,34 @@ def sphere_block3d(args):
     # the points' sum has a single-precision path too (since 2026-11-26; it ran in double before), and the outer products
     # are summed by the BLAS's gemm or by the built-in kernels (-rom_gemm): the same reduced solution to the float sum's
     # noise (about 1e-6 on u: bound 1e-5; a misplaced row or column moves it by O(1))
+    # (since 2026-11-27 the default -rom_gemm auto runs the points' sum in single precision fused with the row
+    # combination where the CPU has AVX-512F: "psa"; docs/online.md "The fused points' sum")
+    with open("/proc/cpuinfo") as f:
+        avx512 = any(l.startswith("flags") and " avx512f " in l + " " for l in f)
     hs = {}
-    for tag, extra in (("pd", ["-rom_ecsw_sum", "points", "-rom_ecsw_precision", "double"]), ("ps", ["-rom_ecsw_sum", "points"]),
-                       ("psb", ["-rom_ecsw_sum", "points", "-rom_gemm", "builtin"]), ("ds", ["-rom_ecsw_sum", "dofs"]),
-                       ("dsb", ["-rom_ecsw_sum", "dofs", "-rom_gemm", "builtin"])):
+    for tag, extra in (("pd", ["-rom_ecsw_sum", "points", "-rom_ecsw_precision", "double"]), ("ps", ["-rom_ecsw_sum", "points", "-rom_gemm", "blas"]),
+                       ("psb", ["-rom_ecsw_sum", "points", "-rom_gemm", "builtin"]), ("psa", ["-rom_ecsw_sum", "points"]),
+                       ("ds", ["-rom_ecsw_sum", "dofs"]), ("dsb", ["-rom_ecsw_sum", "dofs", "-rom_gemm", "builtin"])):
         run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", "%s/sp_%s.json" % (d, tag)] + extra)
         hs[tag] = report("%s/sp_%s.json" % (d, tag))
-    check([hs[t]["rom"]["ecsw_sum"] + "/" + hs[t]["rom"]["ecsw_precision"] + "/" + hs[t]["rom"]["gemm"] for t in ("pd", "ps", "psb", "ds", "dsb")]
-          == ["points/double/blas", "points/single/blas", "points/single/builtin", "dofs/single/blas", "dofs/single/builtin"],
-          "the reports name the sum, its precision and its gemm")
-    for t in ("ps", "psb", "ds", "dsb"):
+    names = [hs[t]["rom"]["ecsw_sum"] + "/" + hs[t]["rom"]["ecsw_precision"] + "/" + hs[t]["rom"]["gemm"] for t in ("pd", "ps", "psb", "psa", "ds", "dsb")]
+    check(names == ["points/double/blas", "points/single/blas", "points/single/builtin", "points/single/" + ("fused" if avx512 else "blas"),
+                    "dofs/single/blas", "dofs/single/builtin"],
+          "the reports name the sum, its precision and its gemm (AVX-512F: %s): %s" % (avx512, names))
+    for t in ("ps", "psb", "psa", "ds", "dsb"):
         dv = np.linalg.norm(np.array(hs[t]["u_hat"]) - hs["pd"]["u_hat"]) / np.linalg.norm(hs["pd"]["u_hat"])
         df = abs(hs[t]["outputs"]["contact_force"] - hs["pd"]["outputs"]["contact_force"]) / hs["pd"]["outputs"]["contact_force"]
         print("  %s against the points' sum in double: |du|/|u| %.1e, force %.1e" % (t, dv, df))
         check(dv <= 1e-5 and df <= 1e-5, "%s: the same reduced solution as the points' sum in double to %.1e (u), %.1e (force) <= 1e-5" % (t, dv, df))
     expect_error(args, ["-rom", rom, "-mu", "0.93,0.043", "-rom_gemm", "mkl"], ["mkl", "-rom_gemm"], "unknown -rom_gemm")
+    # -rom_gemm fused without AVX-512F (RBC_KERNELS_PORTABLE=1 hides the CPU's vector units): a clear error, and auto
+    # falls back to the BLAS
+    env = dict(os.environ, RBC_KERNELS_PORTABLE="1")
+    c = ["mpirun", "-n", "1", "-x", "RBC_KERNELS_PORTABLE", args.exe, "online", "-rom", rom, "-mu", "0.93,0.043"]
+    p = subprocess.run(c + ["-rom_gemm", "fused"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+    check(p.returncode != 0 and "-rom_gemm fused" in p.stdout and "AVX-512F" in p.stdout, "-rom_gemm fused on a CPU without AVX-512F: error naming the option and AVX-512F")
+    p = subprocess.run(c + ["-report", d + "/sp_portable.json"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+    check(p.returncode == 0 and report(d + "/sp_portable.json")["rom"]["gemm"] == "blas", "-rom_gemm auto without AVX-512F: the BLAS")
     # the cubature points in slave facet order (ReducedModel::OrderCubaturePoints, docs/online.md): the offline stage
     # writes them so, and a file in another order (the fit's, before 2026-11-27) is put in that order when read: a
     # shuffled copy (points with their Pw columns) is read into the same order, so its sums and its reduced solution
@@ -568,8 +586,9 @@ def sphere_block3d(args):
         f["online/ecsw/Pw"][:] = pw[:, perm]
     run(args, 1, "online", ["-rom", shuf, "-mu", "0.93,0.043", "-report", "%s/sp_shuf.json" % d, "-rom_ecsw_sum", "points"])
     hsh = report("%s/sp_shuf.json" % d)
-    dv = np.linalg.norm(np.array(hsh["u_hat"]) - hs["ps"]["u_hat"]) / np.linalg.norm(hs["ps"]["u_hat"])
-    df = abs(hsh["outputs"]["contact_force"] - hs["ps"]["outputs"]["contact_force"]) / hs["ps"]["outputs"]["contact_force"]
+    # (against the same sum as the shuffled run's, the default -rom_gemm auto)
+    dv = np.linalg.norm(np.array(hsh["u_hat"]) - hs["psa"]["u_hat"]) / np.linalg.norm(hs["psa"]["u_hat"])
+    df = abs(hsh["outputs"]["contact_force"] - hs["psa"]["outputs"]["contact_force"]) / hs["psa"]["outputs"]["contact_force"]
     check(dv == 0 and df == 0, "a file with the points shuffled: the same reduced solution bit for bit (|du|/|u| %.1e, force %.1e)" % (dv, df))
     # the online Kacanov tolerances of the options file travel in the ROM file (/online/kacanov_rtol): an online
     # solve without options uses them (2 iterates from this 3 x 3 grid's warm start against 5 to 1e-9), and what the

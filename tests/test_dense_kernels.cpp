@@ -8,7 +8,8 @@
 // dof sum (SumOfOuterProductsSingle, ScatterRowsSingle: 1..15 blocks of 8 rows) and the float row combination
 // (CombineRowsSingle) and dots (RowDotsSingle) within the float accumulation bound.
 // The sums of outer products each by the BLAS's gemm and by the built-in kernels (SetGemmBlas), and from point-major
-// rows (SumOfOuterProductsRows*, the points' sum of the cubature).
+// rows (SumOfOuterProductsRows*, the points' sum of the cubature); PointSumSingle (the same sum with kappa's rows formed
+// from theta's, fused with AVX-512).
 #include "../src/rom/dense_kernels.hpp"
 #include <cmath>
 #include <random>
@@ -161,6 +162,57 @@ int main(int argc, char **argv)
             }
           }
       }
+  // PointSumSingle, the points' sum in single precision with kappa's rows formed on the way (fused with AVX-512:
+  // chunks of 64 points, tiles of 32 rows x 8 columns, a last tile of <= 16 rows; else combination + sum): sizes
+  // around the chunk and the tiles, 0..18 terms a point from 41 float rows of theta padded with zeros; against the
+  // double sum of the same float inputs within the float accumulation bound (M + terms + 4) 2^-24 sum |terms|, the
+  // padded rows of K exactly 0
+  for (PetscInt M : {0, 1, 63, 64, 65, 202, 631})
+    for (PetscInt r : {1, 8, 9, 16, 17, 31, 33, 47, 49, 162})
+      for (PetscInt nc : {1, 7, 8, 9, 17, 44, 225}) {
+        const PetscInt        rps = PaddedRows(r, 8), ldt = PaddedRows(nc, 8), nr = 41, maxT = 36;
+        std::vector<float>    W((size_t)M * rps, 0.0f), theta((size_t)nr * ldt, 0.0f), X((size_t)M * ldt, 99.0f);
+        std::vector<double>   coef((size_t)M * maxT, 99.0), K((size_t)rps * nc, -7.0);
+        std::vector<PetscInt> nt(M), row((size_t)M * maxT, -1);
+        for (PetscInt p = 0; p < M; ++p)
+          for (PetscInt i = 0; i < r; ++i) W[(size_t)p * rps + i] = (float)u(gen);
+        for (PetscInt a = 0; a < nr; ++a)
+          for (PetscInt c = 0; c < nc; ++c) theta[(size_t)a * ldt + c] = (float)u(gen);
+        for (PetscInt p = 0; p < M; ++p) {
+          nt[p] = p % 19;
+          for (PetscInt t = 0; t < nt[p]; ++t) {
+            coef[(size_t)p * maxT + t] = u(gen);
+            row[(size_t)p * maxT + t]  = (PetscInt)(gen() % nr);
+          }
+        }
+        PointSumSingle(M, rps, nc, nt.data(), maxT, row.data(), coef.data(), theta.data(), ldt, W.data(), X.data(), K.data());
+        std::vector<double> s((size_t)rps * nc, 0.0), a((size_t)rps * nc, 0.0), x(nc), xa(nc);
+        for (PetscInt p = 0; p < M; ++p) {
+          std::fill(x.begin(), x.end(), 0.0);
+          std::fill(xa.begin(), xa.end(), 0.0);
+          for (PetscInt t = 0; t < nt[p]; ++t)
+            for (PetscInt c = 0; c < nc; ++c) {
+              const double term = (double)(float)coef[(size_t)p * maxT + t] * theta[(size_t)row[(size_t)p * maxT + t] * ldt + c];
+              x[c] += term;
+              xa[c] += std::abs(term);
+            }
+          for (PetscInt c = 0; c < nc; ++c)
+            for (PetscInt i = 0; i < rps; ++i) {
+              s[(size_t)c * rps + i] += (double)W[(size_t)p * rps + i] * x[c];
+              a[(size_t)c * rps + i] += std::abs((double)W[(size_t)p * rps + i]) * xa[c];
+            }
+        }
+        for (size_t k = 0; k < K.size(); ++k) {
+          const double e = std::abs(K[k] - s[k]), bound = (M + 18 + 4) * uf * a[k];
+          worst32        = std::max(worst32, a[k] > 0 ? e / a[k] : e);
+          ++checks;
+          if (!(e <= bound)) {
+            ++failures;
+            PetscCall(PetscPrintf(PETSC_COMM_SELF, "FAIL PointSumSingle (%s) M %d r %d nc %d entry (%d, %d): %g vs %g\n", PointSumFusedAvailable() ? "fused" : "combination + sum", (int)M, (int)r, (int)nc, (int)(k % rps), (int)(k / rps), K[k], s[k]));
+          }
+        }
+      }
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "PointSumSingle: %s\n", PointSumFusedAvailable() ? "fused (AVX-512)" : "row combination + sum of outer products"));
   for (PetscInt M : {0, 1, 7, 202})
     for (PetscInt r : {1, 5, 8, 9, 24, 30, 45, 96, 97, 120}) {
       const PetscInt        rps = PaddedRows(r, 8), nd = 13, maxT = 36;

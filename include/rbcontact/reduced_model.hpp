@@ -194,10 +194,18 @@ public:
   // Since 2026-11-26 the points' sum has a single-precision path too (kappa's rows converted, then one sgemm).
   bool ecswSingle = false;
   bool EcswSingle() const { return cSingle_; }
-  // -rom_gemm blas|builtin: the cubature's sums of outer products (K^ = Pw' kappa, Q' theta) by the BLAS's gemm
+  // -rom_gemm auto|blas|builtin|fused: the cubature's sums of outer products (K^ = Pw' kappa, Q' theta) by the BLAS's gemm
   // (default; OpenBLAS 1.5-2.4x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for a
   // reference BLAS); docs/online.md "The BLAS for the cubature's sums".
   bool gemmBlas = true;
+  // -rom_gemm fused (and auto where the CPU has AVX-512F): the points' sum in single precision forms kappa's rows
+  // chunk by chunk and adds them to K^ in one AVX-512 kernel (PointSumSingle; docs/online.md "The fused points' sum").
+  // The other sums stay with the BLAS. Ignored by the dof sum and by double precision.
+  // The default (auto) requests it; it is in effect only on such a CPU (FusedPointSum).
+  bool gemmFused = true;
+  bool FusedPointSum() const; // the points' sum in single precision runs fused (requested, the CPU has AVX-512F)
+  // The name of the sum in effect (report key rom.gemm): fused, blas or builtin
+  const char *GemmName() const { return FusedPointSum() ? "fused" : gemmBlas ? "blas" : "builtin"; }
   bool      recordIterates = false;
   ReducedQP qp;
 
@@ -215,6 +223,7 @@ private:
   ContactMode            wnMode_ = ContactMode::EIM;  // the mode of that evaluation (EIM: none)
   ContactMode            mode_ = ContactMode::EIM;
   std::vector<PetscInt>  cols_;
+  std::vector<PetscReal> aAct_;                       // Aq of the active columns (QA x Na x Na, column-major; Truncate)
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;
   ContactPatch           active_;                     // patch with the active basis columns
   std::vector<PetscInt>  evalPoints_, kPos_, gPos_;   // unique patch points evaluated, positions

@@ -13,6 +13,8 @@ namespace rbc {
 
 struct ValidationSettings {
   PetscInt               repeat = 100;                        // -validate_repeat: timed online solves per parameter
+  bool                   timeAllRanks = false;                // -validate_time_all_ranks: time on every rank at once
+                                                              // (default: on rank 0 while the others wait)
   bool                   sweep  = false;                      // -validate_sweep: the speed-against-error table
   std::vector<PetscReal> fractions{0.2, 0.4, 0.6, 0.8, 1.0};  // -validate_sweep_fractions of N, R (and the EIM sizes)
   std::string            sweepOutput;                         // -validate_sweep_output stem (default: the report's + _sweep)
@@ -31,7 +33,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 // The ROM at romPath (built for scene as configured now: checked) against the FOM at every point of test.
 // Report keys: stage, scene, rom_file, nranks, test and test_exact (= test_no_eim) {n, max_rel_err_u,
 // mean_rel_err_u, max_rel_err_lambda, mean_rel_err_lambda, max_rel_err_force, rel_err_*, max_rel_err_force_online,
-// failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat}, fom_time_s {median, all},
+// failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat, timed_on}, fom_time_s {median, all},
 // speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}, test_snapshots (the file or
 // ""; with it, the FOM solutions and fom_time_s come from the file: docs/online.md "Validation"); with the sweep
 // also sweep [rows] and sweep_files; with -validate_residual also residual {indicator, rel_err_u_energy,

@@ -4,6 +4,7 @@
 #include "rbcontact/contact.hpp"
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace rbc {
 
@@ -99,16 +100,22 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
     };
     // the first visit: the stored first for short lists (sphere_block3d: 19 a point, the closest for half the points;
     // a pass over the centres cost 7 % there), the nearest centre above 32
-    PetscInt first = 0;
-    if (nc > 32)
+    // (above 32 the centre distances are computed once, kept for the pruning pass: the same values, so the same visits)
+    PetscInt                            first = 0;
+    thread_local std::vector<PetscReal> c2;
+    const bool                          kept = nc > 32;
+    if (kept) {
+      c2.resize(nc);
+      for (PetscInt i = 0; i < nc; ++i) c2[i] = centre2(i);
       for (PetscInt i = 1; i < nc; ++i)
-        if (centre2(i) < centre2(first)) first = i;
+        if (c2[i] < c2[first]) first = i;
+    }
     if (nc > 0) visit(cand[first]);
     PetscReal sb = std::sqrt(best);
     for (PetscInt i = 0; i < nc; ++i) {
       if (i == first) continue;
       const PetscReal reach = sb + sphere_[4 * cand[i] + 3];
-      if (centre2(i) > reach * reach) continue;
+      if ((kept ? c2[i] : centre2(i)) > reach * reach) continue;
       const PetscReal before = best;
       visit(cand[i]);
       if (best != before) sb = std::sqrt(best);

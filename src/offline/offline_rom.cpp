@@ -756,7 +756,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ro["kacanov_rtol_primal"] = (double)rm.loop.rtolPrimal; // stored in the file: the online default (/online/kacanov_rtol)
   ro["kacanov_rtol_dual"]   = (double)rm.loop.rtolDual;
   ro["ecsw_sum"]            = rm.EcswSumsByDofs() ? "dofs" : "points";                  // the online sum (-rom_ecsw_sum auto: by flops)
-  ro["gemm"]                = rm.gemmBlas ? "blas" : "builtin";                         // who sums its outer products (-rom_gemm)
+  ro["gemm"]                = rm.GemmName();                                            // who sums its outer products (-rom_gemm)
   ro["ecsw_precision"]      = rm.EcswSingle() ? "single" : "double";                    // ... and its arithmetic in effect
   ro["ecsw_precision_stored"] = rm.ecswSingle ? "single" : "double";                    // /online/ecsw_precision
   rep->root["time_s"]["eim_snapshots"] = (double)(t1 - t0);

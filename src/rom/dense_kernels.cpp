@@ -424,6 +424,127 @@ __attribute__((target("avx2,fma"))) void CombineAvx2F(PetscInt nt, const PetscRe
 __attribute__((target("avx2,fma"))) void RightSolveTAvx2(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
 __attribute__((target("avx2,fma"))) void LowerGramAvx2(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
 
+bool HaveAvx2();
+
+// The points' sum in single precision fused with kappa's row combination, AVX-512 (PointSumSingle): the points in
+// chunks of kPointChunk, each chunk's rows x_p combined into a block that stays in L2, then added to a float K (rp x nc,
+// column-major) tile by tile: a tile of IB x 16 rows and NC columns held in IB NC registers over the chunk's points
+// (per point IB loads of W's row, NC broadcasts, IB NC FMAs). The rows past rp are masked off (W and K are never read
+// or written there). The BLAS's sgemm of the same sum ran Haswell's AVX2 kernel on this VM's CPU (OpenBLAS 0.3.21 does
+// not know it) and read the M x ldx rows of kappa back from memory (docs/online.md "The fused points' sum").
+constexpr PetscInt kPointChunk = 64;
+
+template <int IB, int NC>
+__attribute__((target("avx512f"))) void PointTileAvx512(PetscInt np, PetscInt rp, PetscInt i0, const __mmask16 *mask, const float *W, const float *X, PetscInt ldx, PetscInt c0, float *K)
+{
+  __m512 acc[NC][IB];
+#pragma GCC unroll 16
+  for (int j = 0; j < NC; ++j)
+#pragma GCC unroll 4
+    for (int b = 0; b < IB; ++b) acc[j][b] = _mm512_maskz_loadu_ps(mask[b], K + (size_t)(c0 + j) * rp + i0 + 16 * b);
+  for (PetscInt p = 0; p < np; ++p) {
+    const float *w = W + (size_t)p * rp + i0;
+    const float *x = X + (size_t)p * ldx + c0;
+    // every load before the FMAs: __m512 may alias float, so a load between them would keep acc in memory
+    __m512 wv[IB], xb[NC];
+#pragma GCC unroll 4
+    for (int b = 0; b < IB; ++b) wv[b] = _mm512_maskz_loadu_ps(mask[b], w + 16 * b);
+#pragma GCC unroll 16
+    for (int j = 0; j < NC; ++j) xb[j] = _mm512_set1_ps(x[j]);
+  #pragma GCC unroll 16
+  for (int j = 0; j < NC; ++j)
+#pragma GCC unroll 4
+      for (int b = 0; b < IB; ++b) acc[j][b] = _mm512_fmadd_ps(wv[b], xb[j], acc[j][b]);
+  }
+#pragma GCC unroll 16
+  for (int j = 0; j < NC; ++j)
+#pragma GCC unroll 4
+    for (int b = 0; b < IB; ++b) _mm512_mask_storeu_ps(K + (size_t)(c0 + j) * rp + i0 + 16 * b, mask[b], acc[j][b]);
+}
+
+// out[k0, k0 + 16 NB) = sum_j cf[j] rows[j][k0, ...) in float, held in NB registers over the terms (the last one
+// masked by last); NB fixed so that the registers are not kept in memory (__m512 may alias float)
+template <int NB>
+__attribute__((target("avx512f"))) void CombineAvx512Fixed(PetscInt nt, const float *cf, const float *const *rows, PetscInt k0, __mmask16 last, float *out)
+{
+  __m512 acc[NB];
+#pragma GCC unroll 16
+  for (int b = 0; b < NB; ++b) acc[b] = _mm512_setzero_ps();
+  for (PetscInt j = 0; j < nt; ++j) {
+    const float *t = rows[j] + k0;
+    __m512       v[NB];
+#pragma GCC unroll 16
+    for (int b = 0; b < NB; ++b) v[b] = _mm512_maskz_loadu_ps(b == NB - 1 ? last : (__mmask16)0xFFFF, t + 16 * b);
+    const __m512 c = _mm512_set1_ps(cf[j]);
+#pragma GCC unroll 16
+    for (int b = 0; b < NB; ++b) acc[b] = _mm512_fmadd_ps(c, v[b], acc[b]);
+  }
+#pragma GCC unroll 16
+  for (int b = 0; b < NB; ++b) _mm512_mask_storeu_ps(out + k0 + 16 * b, b == NB - 1 ? last : (__mmask16)0xFFFF, acc[b]);
+}
+
+// out[0:n) = sum_j coef[j] rows[j][0:n) in float: passes of up to 12 registers of 16 entries
+__attribute__((target("avx512f"))) void CombineAvx512F(PetscInt nt, const PetscReal *coef, const float *const *rows, PetscInt n, float *out)
+{
+  float cf[64]; // >= ContactPatch::MaxTerms
+  for (PetscInt j = 0; j < nt; ++j) cf[j] = (float)coef[j];
+  for (PetscInt k0 = 0; k0 < n; k0 += 16 * 12) {
+    const PetscInt  nb   = std::min<PetscInt>(12, (n - k0 + 15) / 16), left = n - k0 - 16 * (nb - 1);
+    const __mmask16 last = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1);
+    WithRegisterBlocks(nb, [&](auto b) { CombineAvx512Fixed<decltype(b)::value>(nt, cf, rows, k0, last, out); });
+  }
+}
+
+// Calls f(std::integral_constant<int, C>()) for 1 <= nc <= 8 (the column counts of PointTileAvx512's tiles)
+template <int C = 1, class F>
+void WithTileColumns(PetscInt nc, F &&f)
+{
+  if constexpr (C <= 8) {
+    if (nc == C) f(std::integral_constant<int, C>());
+    else WithTileColumns<C + 1>(nc, std::forward<F>(f));
+  }
+}
+
+__attribute__((target("avx512f"))) void PointSumAvx512(PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, PetscReal *K)
+{
+  constexpr int IB = 2; // tiles of 32 rows x 8 columns: 16 accumulators, 2 W registers, 8 broadcasts
+  thread_local std::vector<float> Kf, X;
+  Kf.assign((size_t)rp * nc, 0.0f);
+  X.resize((size_t)kPointChunk * ldt);
+  const float *rows[64];
+  for (PetscInt p0 = 0; p0 < M; p0 += kPointChunk) {
+    const PetscInt np = std::min(kPointChunk, M - p0);
+    for (PetscInt q = 0; q < np; ++q) {
+      const PetscInt  p  = p0 + q;
+      const PetscInt *ri = rowIdx + (size_t)p * maxTerms;
+      for (PetscInt t = 0; t < nt[p]; ++t) rows[t] = theta + (size_t)ri[t] * ldt;
+      CombineAvx512F(nt[p], coef + (size_t)p * maxTerms, rows, nc, X.data() + (size_t)q * ldt);
+    }
+    for (PetscInt c0 = 0; c0 < nc; c0 += 8)
+      for (PetscInt i0 = 0; i0 < rp; i0 += 16 * IB) {
+        __mmask16 m[IB];
+        for (int b = 0; b < IB; ++b) {
+          const PetscInt left = rp - i0 - 16 * b;
+          m[b]                = left >= 16 ? (__mmask16)0xFFFF : left > 0 ? (__mmask16)((1u << left) - 1) : (__mmask16)0;
+        }
+        const float *Wc = W + (size_t)p0 * rp;
+        // a last tile of at most 16 rows in one register (the second would be all masked: FMAs for nothing)
+        if (rp - i0 <= 16) WithTileColumns(std::min<PetscInt>(8, nc - c0), [&](auto C) { PointTileAvx512<1, decltype(C)::value>(np, rp, i0, m, Wc, X.data(), ldt, c0, Kf.data()); });
+        else WithTileColumns(std::min<PetscInt>(8, nc - c0), [&](auto C) { PointTileAvx512<IB, decltype(C)::value>(np, rp, i0, m, Wc, X.data(), ldt, c0, Kf.data()); });
+      }
+  }
+  std::copy(Kf.begin(), Kf.end(), K);
+}
+
+bool HaveAvx512()
+{
+  static const bool have = [] {
+    __builtin_cpu_init();
+    return HaveAvx2() && __builtin_cpu_supports("avx512f");
+  }();
+  return have;
+}
+
 bool HaveAvx2()
 {
   static const bool have = [] {
@@ -576,6 +697,29 @@ void RowDotsSingle(PetscInt rows, PetscInt n, const float *A, const float *v, co
   if (HaveAvx2()) return RowDotsAvx2T<float>(rows, n, A, v, b, out);
 #endif
   RowDotsPortableF(rows, n, A, v, b, out);
+}
+
+bool PointSumFusedAvailable()
+{
+#ifdef RBC_KERNEL_DISPATCH
+  return HaveAvx512();
+#else
+  return false;
+#endif
+}
+
+void PointSumSingle(PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx512()) return PointSumAvx512(M, rp, nc, nt, maxTerms, rowIdx, coef, theta, ldt, W, K);
+#endif
+  const float *rows[64];
+  for (PetscInt p = 0; p < M; ++p) {
+    const PetscInt *ri = rowIdx + (size_t)p * maxTerms;
+    for (PetscInt t = 0; t < nt[p]; ++t) rows[t] = theta + (size_t)ri[t] * ldt;
+    CombineRowsSingle(nt[p], coef + (size_t)p * maxTerms, rows, ldt, X + (size_t)p * ldt);
+  }
+  SumOfOuterProductsRowsSingle(M, rp, nc, W, X, ldt, K);
 }
 
 } // namespace rbc

@@ -38,6 +38,14 @@ void ScatterRows(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms,
 void ScatterRowsSingle(PetscInt M, PetscInt rp, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *W, float *Q);
 void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float *W, const float *X, PetscReal *K);
 
+// The points' sum in single precision with kappa's rows formed on the way: K (rp x nc, column-major, double) =
+// sum_p W(p, :)' x_p(0:nc), x_p = sum_t coef[p][t] theta(rowIdx[p][t], :) (theta in float, leading dimension ldt >= nc,
+// rows padded with zeros; W M x rp point-major, rp a multiple of 8). With AVX-512 fused (chunks of points, the rows
+// combined into a block that stays in cache, K held in registers tile by tile; X unused), otherwise
+// CombineRowsSingle into X (M x ldt) and SumOfOuterProductsRowsSingle. PointSumFusedAvailable: the CPU has AVX-512F.
+void PointSumSingle(PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K);
+bool PointSumFusedAvailable();
+
 // out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major; b and out may be the same array): the patch's
 // nodal displacement U = uD + theta v (ContactPatch::SetReduced), the cubature points' multipliers (ResultantForce).
 void RowDots(PetscInt rows, PetscInt n, const PetscReal *A, const PetscReal *v, const PetscReal *b, PetscReal *out);

@@ -197,7 +197,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["hyper"]    = m.HyperName();
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
-  (*r)["gemm"]           = m.gemmBlas ? "blas" : "builtin";
+  (*r)["gemm"]           = m.GemmName();
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
   (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
@@ -400,6 +400,8 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
   PetscFunctionReturn(0);
 }
 
+bool ReducedModel::FusedPointSum() const { return cSingle_ && !cDofs_ && gemmFused && PointSumFusedAvailable(); }
+
 PetscErrorCode ReducedModel::SetFromOptions()
 {
   PetscInt  n = -1, r = -1, mk = -1, mg = -1, k = (PetscInt)ecswSum;
@@ -419,10 +421,15 @@ PetscErrorCode ReducedModel::SetFromOptions()
   if (!file.empty()) PetscCall(PetscOptionsString("-hyper", "hyper-reduction of the contact terms among those stored: ecsw or eim (default: the offline stage's first)", "", hyper, hyper, sizeof hyper, &hyperSet));
   PetscCall(PetscOptionsEList("-ecsw_sum", "how the cubature's K^ is summed: by points, by patch dofs, or auto (fewer flops)", "", sums, 3, sums[k], &k, &sumSet));
   {
-    const char *gemms[] = {"blas", "builtin"};
-    PetscInt    gm      = gemmBlas ? 0 : 1;
-    PetscCall(PetscOptionsEList("-gemm", "who sums the cubature's outer products (K^ = Pw' kappa, Q' theta): the BLAS's gemm or the built-in AVX2 kernels (for a reference BLAS)", "", gemms, 2, gemms[gm], &gm, NULL));
-    gemmBlas = gm == 0;
+    const char *gemms[] = {"auto", "blas", "builtin", "fused"};
+    PetscInt    gm      = gemmFused ? 0 : gemmBlas ? 1 : 2; // fused and auto differ only in the check below
+    PetscBool   gmSet   = PETSC_FALSE;
+    PetscCall(PetscOptionsEList("-gemm", "who sums the cubature's outer products (K^ = Pw' kappa, Q' theta): the BLAS's gemm, the built-in AVX2 kernels (for a reference BLAS), fused (the points' sum in single precision with kappa's rows, AVX-512) or auto (fused where the CPU has AVX-512F, else blas)", "", gemms, 4, gemms[gm], &gm, &gmSet));
+    if (gmSet) {
+      PetscCheck(gm != 3 || PointSumFusedAvailable(), PETSC_COMM_SELF, PETSC_ERR_SUP, "-rom_gemm fused needs a CPU with AVX-512F, which this one lacks: use -rom_gemm auto, blas or builtin");
+      gemmBlas  = gm != 2;
+      gemmFused = gm == 0 || gm == 3;
+    }
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
@@ -471,6 +478,13 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   mk_ = mk;
   mg_ = mg;
   const PetscInt Na = (PetscInt)cols_.size();
+  { // the affine terms of the active columns, contiguous (Operators: A(mu) by axpys instead of strided gathers)
+    const size_t qa = Nfull > 0 ? Aq.size() / ((size_t)Nfull * Nfull) : 0;
+    aAct_.resize(qa * Na * Na);
+    for (size_t q = 0; q < qa; ++q)
+      for (PetscInt j = 0; j < Na; ++j)
+        for (PetscInt i = 0; i < Na; ++i) aAct_[(q * Na + j) * Na + i] = Aq[(q * Nfull + cols_[i]) * Nfull + cols_[j]];
+  }
   // kappa terms restricted to the active rows/columns: Kc_[j] = C_j(0:r, cols) (R x N column-major)
   Kc_.assign((size_t)mk * r * Na, 0.0);
   for (PetscInt j = 0; j < mk; ++j)
@@ -584,7 +598,24 @@ void ReducedModel::SetExactContact(std::shared_ptr<ContactPatch> full, const std
   P_    = P;
 }
 
-void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const { AffineAt(mu, cols_.data(), (PetscInt)cols_.size(), A, f); }
+void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
+{
+  const PetscInt n = (PetscInt)cols_.size();
+  if (aAct_.size() != (size_t)par.NumA() * n * n) return AffineAt(mu, cols_.data(), n, A, f);
+  // AffineAt's sums in its order (q outer), from the contiguous copy of Truncate
+  thread_local std::vector<PetscReal> thA, thF;
+  par.ThetaA(mu, &thA);
+  par.ThetaF(mu, &thF);
+  f->assign(n, 0.0);
+  for (size_t q = 0; q < thF.size(); ++q)
+    for (PetscInt i = 0; i < n; ++i) (*f)[i] += thF[q] * fq[q * Nfull + cols_[i]];
+  A->assign((size_t)n * n, 0.0);
+  PetscReal *a = A->data();
+  for (size_t q = 0; q < thA.size(); ++q) {
+    const PetscReal  t = thA[q], *c = &aAct_[q * (size_t)n * n];
+    for (size_t e = 0; e < (size_t)n * n; ++e) a[e] += t * c[e];
+  }
+}
 
 void ReducedModel::AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
 {
@@ -729,13 +760,16 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
       } else { // the points' sum: kappa's used columns combined in float from theta's (cThetaFs_), then one sum
         const PetscInt ldf = PaddedRows(Na, 8);
-        const float   *rows[ContactPatch::MaxTerms];
-        for (PetscInt p = 0; p < M; ++p) {
-          const PetscInt *ri = &cRow_[(size_t)p * ContactPatch::MaxTerms];
-          for (PetscInt t = 0; t < cNt_[p]; ++t) rows[t] = &cThetaFs_[(size_t)ri[t] * ldf];
-          CombineRowsSingle(cNt_[p], &cCoef_[(size_t)p * ContactPatch::MaxTerms], rows, ldf, &cXs_[(size_t)p * ldf]);
+        if (FusedPointSum()) PointSumSingle(M, rps, Na, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cThetaFs_.data(), ldf, cPwTs_.data(), nullptr, cK_.data());
+        else {
+          const float *rows[ContactPatch::MaxTerms];
+          for (PetscInt p = 0; p < M; ++p) {
+            const PetscInt *ri = &cRow_[(size_t)p * ContactPatch::MaxTerms];
+            for (PetscInt t = 0; t < cNt_[p]; ++t) rows[t] = &cThetaFs_[(size_t)ri[t] * ldf];
+            CombineRowsSingle(cNt_[p], &cCoef_[(size_t)p * ContactPatch::MaxTerms], rows, ldf, &cXs_[(size_t)p * ldf]);
+          }
+          SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), ldf, cK_.data());
         }
-        SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), ldf, cK_.data());
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
       cX_.resize(rp);
