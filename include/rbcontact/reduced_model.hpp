@@ -195,8 +195,8 @@ public:
   bool ecswSingle = false;
   bool EcswSingle() const { return cSingle_; }
   // -rom_gemm auto|blas|builtin|fused: the cubature's sums of outer products (K^ = Pw' kappa, Q' theta) by the BLAS's gemm
-  // (default; OpenBLAS 1.5-2.4x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for a
-  // reference BLAS); docs/online.md "The BLAS for the cubature's sums".
+  // (auto and blas; OpenBLAS 1.5-2.4x the built-in kernels' rate at the 3D sizes) or by the built-in AVX2 kernels (for
+  // a reference BLAS); docs/online.md "The BLAS for the cubature's sums".
   bool gemmBlas = true;
   // -rom_gemm fused (and auto where the CPU has AVX-512F): the points' sum in single precision forms kappa's rows
   // chunk by chunk and adds them to K^ in one AVX-512 kernel (PointSumSingle; docs/online.md "The fused points' sum").

@@ -5,7 +5,8 @@
 // lambda in the l2 norm weighted by the slave mass (int psi_i), the resultant contact force.
 // Sweep: the same for a series of truncations (N, R, Mk, Mg) of the ROM, a table of online median time
 // against max error (CSV and JSON); share/plot_speed_error.py draws it. The FOM is distributed over the
-// ranks, the ROM runs redundantly on every rank (identical data, identical answers).
+// ranks, the ROM runs redundantly on every rank (identical data, identical answers); its timed solves run on rank 0
+// while the other ranks wait (-validate_time_all_ranks: on every rank at once).
 #include "rbcontact/validation.hpp"
 #include "rbcontact/greedy_indicator.hpp"
 #include "rbcontact/rom_fields.hpp"
@@ -398,8 +399,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
       PetscCall(m.Solve(F[j].mu, &sol)); // warm-up
       // timed on rank 0 while the other ranks wait in the broadcast of its median (-validate_time_all_ranks false):
-      // the same solve timed on every rank at once shares the cores' caches and memory bandwidth and measures
-      // something else than one online solve (docs/online.md "Validation")
+      // the same solve timed on every rank at once measures the ranks slowing each other down (on the 2-vCPU VM by a
+      // third, evenly over the solve's phases), not one online solve (docs/online.md "Validation")
       auto timeSolves = [&](std::vector<double> *meds) -> PetscErrorCode {
         std::vector<double> ts;
         double              med = 0;

@@ -6,7 +6,8 @@
 // blocked sum keeps a 4 x 4 (12 x 4) block of K in registers over all points; the plain rank-1 update loop
 // reloaded and stored K at every point. ScatterRows holds a point's row of W, CombineRows the output row in
 // registers (up to 12 blocks of 4, WithRegisterBlocks). Results differ from the portable ones by rounding (FMA);
-// RBC_KERNELS_PORTABLE=1 in the environment selects the portable ones.
+// RBC_KERNELS_PORTABLE=1 in the environment selects the portable ones. With AVX-512F, PointSumSingle fuses the
+// single-precision points' sum with kappa's row combination (chunks of points, K held in registers tile by tile).
 #include "dense_kernels.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -451,8 +452,8 @@ __attribute__((target("avx512f"))) void PointTileAvx512(PetscInt np, PetscInt rp
     for (int b = 0; b < IB; ++b) wv[b] = _mm512_maskz_loadu_ps(mask[b], w + 16 * b);
 #pragma GCC unroll 16
     for (int j = 0; j < NC; ++j) xb[j] = _mm512_set1_ps(x[j]);
-  #pragma GCC unroll 16
-  for (int j = 0; j < NC; ++j)
+#pragma GCC unroll 16
+    for (int j = 0; j < NC; ++j)
 #pragma GCC unroll 4
       for (int b = 0; b < IB; ++b) acc[j][b] = _mm512_fmadd_ps(wv[b], xb[j], acc[j][b]);
   }

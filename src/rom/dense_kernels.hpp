@@ -1,6 +1,7 @@
 // src/rom/dense_kernels.hpp: the small dense kernels the online stage spends its time in (docs/online.md,
 // "Where the online time goes"): the cubature's contact terms and the reduced QP's set-up, compiled twice: for the
-// baseline x86-64 and for AVX2+FMA, chosen once at run time from the CPU (no -march needed).
+// baseline x86-64 and for AVX2+FMA (the fused points' sum also for AVX-512F), chosen once at run time from the CPU
+// (no -march needed).
 // Internal to the library.
 #pragma once
 #include <petscsys.h>
