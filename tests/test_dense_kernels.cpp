@@ -185,7 +185,7 @@ int main(int argc, char **argv)
             row[(size_t)p * maxT + t]  = (PetscInt)(gen() % nr);
           }
         }
-        PointSumSingle(M, rps, nc, nt.data(), maxT, row.data(), coef.data(), theta.data(), ldt, W.data(), X.data(), K.data());
+        PointSumSingle(true, M, rps, nc, nt.data(), maxT, row.data(), coef.data(), theta.data(), ldt, W.data(), X.data(), K.data());
         std::vector<double> s((size_t)rps * nc, 0.0), a((size_t)rps * nc, 0.0), x(nc), xa(nc);
         for (PetscInt p = 0; p < M; ++p) {
           std::fill(x.begin(), x.end(), 0.0);

@@ -709,10 +709,10 @@ bool PointSumFusedAvailable()
 #endif
 }
 
-void PointSumSingle(PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K)
+void PointSumSingle(bool fused, PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K)
 {
 #ifdef RBC_KERNEL_DISPATCH
-  if (HaveAvx512()) return PointSumAvx512(M, rp, nc, nt, maxTerms, rowIdx, coef, theta, ldt, W, K);
+  if (fused && HaveAvx512()) return PointSumAvx512(M, rp, nc, nt, maxTerms, rowIdx, coef, theta, ldt, W, K);
 #endif
   const float *rows[64];
   for (PetscInt p = 0; p < M; ++p) {

@@ -41,10 +41,10 @@ void SumOfOuterProductsSingle(PetscInt M, PetscInt rp, PetscInt nc, const float 
 
 // The points' sum in single precision with kappa's rows formed on the way: K (rp x nc, column-major, double) =
 // sum_p W(p, :)' x_p(0:nc), x_p = sum_t coef[p][t] theta(rowIdx[p][t], :) (theta in float, leading dimension ldt >= nc,
-// rows padded with zeros; W M x rp point-major, rp a multiple of 8). With AVX-512 fused (chunks of points, the rows
-// combined into a block that stays in cache, K held in registers tile by tile; X unused), otherwise
-// CombineRowsSingle into X (M x ldt) and SumOfOuterProductsRowsSingle. PointSumFusedAvailable: the CPU has AVX-512F.
-void PointSumSingle(PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K);
+// rows padded with zeros; W M x rp point-major, rp a multiple of 8). fused and AVX-512: chunks of points, the rows
+// combined into a block that stays in cache, K held in registers tile by tile (X unused); otherwise CombineRowsSingle
+// into X (M x ldt) and SumOfOuterProductsRowsSingle (SetGemmBlas's choice). PointSumFusedAvailable: the CPU has AVX-512F.
+void PointSumSingle(bool fused, PetscInt M, PetscInt rp, PetscInt nc, const PetscInt *nt, PetscInt maxTerms, const PetscInt *rowIdx, const PetscReal *coef, const float *theta, PetscInt ldt, const float *W, float *X, PetscReal *K);
 bool PointSumFusedAvailable();
 
 // out[r] = b[r] + A(r, :) v for r < rows (A rows x n, row-major; b and out may be the same array): the patch's

@@ -598,36 +598,26 @@ void ReducedModel::SetExactContact(std::shared_ptr<ContactPatch> full, const std
   P_    = P;
 }
 
-void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
-{
-  const PetscInt n = (PetscInt)cols_.size();
-  if (aAct_.size() != (size_t)par.NumA() * n * n) return AffineAt(mu, cols_.data(), n, A, f);
-  // AffineAt's sums in its order (q outer), from the contiguous copy of Truncate
-  thread_local std::vector<PetscReal> thA, thF;
-  par.ThetaA(mu, &thA);
-  par.ThetaF(mu, &thF);
-  f->assign(n, 0.0);
-  for (size_t q = 0; q < thF.size(); ++q)
-    for (PetscInt i = 0; i < n; ++i) (*f)[i] += thF[q] * fq[q * Nfull + cols_[i]];
-  A->assign((size_t)n * n, 0.0);
-  PetscReal *a = A->data();
-  for (size_t q = 0; q < thA.size(); ++q) {
-    const PetscReal  t = thA[q], *c = &aAct_[q * (size_t)n * n];
-    for (size_t e = 0; e < (size_t)n * n; ++e) a[e] += t * c[e];
-  }
-}
+void ReducedModel::Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const { AffineAt(mu, cols_.data(), (PetscInt)cols_.size(), A, f); }
 
 void ReducedModel::AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const
 {
-  std::vector<PetscReal> thA, thF;
+  thread_local std::vector<PetscReal> thA, thF;
   par.ThetaA(mu, &thA);
   par.ThetaF(mu, &thF);
   auto col = [&](PetscInt i) { return cols ? cols[i] : i; };
   A->assign((size_t)n * n, 0.0);
   f->assign(n, 0.0);
-  for (size_t q = 0; q < thA.size(); ++q)
-    for (PetscInt j = 0; j < n; ++j)
-      for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * j] += thA[q] * Aq[(q * Nfull + col(i)) * Nfull + col(j)];
+  if (cols == cols_.data() && aAct_.size() == thA.size() * n * n) { // the active columns: Truncate's contiguous copy
+    PetscReal *a = A->data();
+    for (size_t q = 0; q < thA.size(); ++q) {
+      const PetscReal t = thA[q], *c = &aAct_[q * (size_t)n * n];
+      for (size_t e = 0; e < (size_t)n * n; ++e) a[e] += t * c[e];
+    }
+  } else
+    for (size_t q = 0; q < thA.size(); ++q)
+      for (PetscInt j = 0; j < n; ++j)
+        for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * j] += thA[q] * Aq[(q * Nfull + col(i)) * Nfull + col(j)];
   for (size_t q = 0; q < thF.size(); ++q)
     for (PetscInt i = 0; i < n; ++i) (*f)[i] += thF[q] * fq[q * Nfull + col(i)];
 }
@@ -760,16 +750,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
       } else { // the points' sum: kappa's used columns combined in float from theta's (cThetaFs_), then one sum
         const PetscInt ldf = PaddedRows(Na, 8);
-        if (FusedPointSum()) PointSumSingle(M, rps, Na, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cThetaFs_.data(), ldf, cPwTs_.data(), nullptr, cK_.data());
-        else {
-          const float *rows[ContactPatch::MaxTerms];
-          for (PetscInt p = 0; p < M; ++p) {
-            const PetscInt *ri = &cRow_[(size_t)p * ContactPatch::MaxTerms];
-            for (PetscInt t = 0; t < cNt_[p]; ++t) rows[t] = &cThetaFs_[(size_t)ri[t] * ldf];
-            CombineRowsSingle(cNt_[p], &cCoef_[(size_t)p * ContactPatch::MaxTerms], rows, ldf, &cXs_[(size_t)p * ldf]);
-          }
-          SumOfOuterProductsRowsSingle(M, rps, Na, cPwTs_.data(), cXs_.data(), ldf, cK_.data());
-        }
+        PointSumSingle(FusedPointSum(), M, rps, Na, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cThetaFs_.data(), ldf, cPwTs_.data(), cXs_.data(), cK_.data());
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
       cX_.resize(rp);
