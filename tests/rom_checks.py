@@ -631,6 +631,84 @@ def sphere_block3d(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def dual_select(args):
+    """The answer's number of dual vectors chosen by the offline stage on held-out FOM solutions (-dual_select_*,
+    docs/dual_basis.md "R chosen on held-out solutions"): the rule recomputed from the reported table, the file's
+    /online/dual_select used by online and validate (their errors = the table's row), the same table from a held-out
+    snapshot file and on 1 rank, bad input."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_dsel_")
+    opts = ["-options_file", "runs/sphere_block3d.opts", "-train_size", "4", "-snapshots_sensitivities", "-snapshots", d + "/snap.h5"]
+    rom, off = offline(args, d, opts="runs/sphere_block3d.opts", extra=opts[2:] + ["-dual_select_size", "6", "-dual_select_seed", "11"])
+    ds = off["dual_select"]
+    rows = ds["candidates"]
+    Rs = [r["R"] for r in rows]
+    print("  %d held-out parameters, candidates R %s; chosen R %d (N %d) of %d: lambda %.3e (all: %.3e)"
+          % (ds["heldout"], Rs, ds["R"], ds["N"], ds["R_stored"], ds["max_rel_err_lambda"], ds["max_rel_err_lambda_all"]))
+    check(ds["enabled"] and ds["heldout"] == 6 and Rs == sorted(set(Rs)) and Rs[-1] == ds["R_stored"] == off["rom"]["R"] and Rs[0] == -(-ds["R_stored"] // 2),
+          "16 candidates from ceil(R / 2) to R = %d, sorted and distinct (%d)" % (ds["R_stored"], len(Rs)))
+    # the rule, recomputed: the smallest R whose lambda error is within 10 % of the best and whose u and force errors (max
+    # and mean) are within 10 % of those with every dual vector
+    best, a = min(r["max_rel_err_lambda"] for r in rows), rows[-1]
+    adm = [r["R"] for r in rows if not r["failed"] and r["max_rel_err_lambda"] <= 1.1 * best
+           and all(r[k + q] <= 1.1 * a[k + q] for k in ("max_rel_err_", "mean_rel_err_") for q in ("u", "force"))]
+    want = min(adm) if adm else a["R"]
+    check(ds["R"] == want and off["rom"]["R_in_use"] == want, "the chosen R %d = the rule's on the table (%d)" % (ds["R"], want))
+    with h5py.File(rom, "r") as f:
+        stored = list(f["online/dual_select"][:]) if "online/dual_select" in f else None
+    check(stored == ([want] if want < a["R"] else None), "the ROM file stores it as /online/dual_select: %s" % stored)
+    # validate at the same held-out parameters (the FOM solved there again): the default is the chosen R, and its errors
+    # and those of -validate_sweep_R are the table's; on 1 rank the same
+    row = {r["R"]: r for r in rows}
+    for np_ in (2, 1):
+        run(args, np_, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-test_type", "random", "-test_size", "6", "-test_seed", "11",
+                                    "-validate_repeat", "1", "-validate_sweep_R", "%d,%d" % (Rs[0], a["R"]), "-report", "%s/val%d.json" % (d, np_)])
+        v = report("%s/val%d.json" % (d, np_))
+        dev = max(abs(x[k] - row[x["R"]][k]) / row[x["R"]][k] for x in [dict(v["test"], R=v["rom"]["R"])] + v["sweep_R"]
+                  for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force"))
+        check(v["rom"]["R"] == want and v["rom"]["N"] == ds["N"] and [x["R"] for x in v["sweep_R"]] == [Rs[0], a["R"]] and dev <= 1e-6,
+              "validate on %d rank(s): R %d, N %d by default; its errors and -validate_sweep_R's = the offline table's to %.1e (<= 1e-6)" % (np_, v["rom"]["R"], v["rom"]["N"], dev))
+    # online: the chosen R by default, every stored one with -rom_R; no error estimate from the unused dual vectors
+    run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", d + "/on.json"])
+    run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-rom_R", str(a["R"]), "-rom_error_estimate", "false", "-report", d + "/on_all.json"])
+    on, on_all = report(d + "/on.json"), report(d + "/on_all.json")
+    check(on["rom"]["R"] == want and on_all["rom"]["R"] == a["R"], "online: R %d by default, %d with -rom_R" % (on["rom"]["R"], on_all["rom"]["R"]))
+    check(not on["error_estimate"]["available"] and "held-out" in on["error_estimate"]["why"], "online: no estimate from the dual vectors beyond the choice (%s)" % on["error_estimate"]["why"][:60])
+    # the held-out FOM solutions from a snapshot file (checkpointed: the finest level's use): the same table
+    run(args, 2, "offline", ["-options_file", "runs/sphere_block3d.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "6", "-train_seed", "11",
+                             "-snapshots_subcomm", "1", "-snapshots", d + "/held.h5", "-report", d + "/held.json"])
+    # (the file takes precedence over a -dual_select_size, e.g. of the scene's options file)
+    run(args, 2, "offline", opts + ["-snapshots_restart", "-rom", d + "/rom2.h5", "-dual_select_size", "4", "-dual_select_snapshots", d + "/held.h5", "-report", d + "/off2.json"])
+    ds2 = report(d + "/off2.json")["dual_select"]
+    dev = max(abs(x[k] - y[k]) / y[k] for x, y in zip(ds2["candidates"], rows) for k in ("max_rel_err_u", "max_rel_err_lambda", "max_rel_err_force"))
+    check(ds2["snapshots"] == d + "/held.h5" and ds2["heldout"] == 6 and ds2["R"] == ds["R"] and [x["R"] for x in ds2["candidates"]] == Rs and dev <= 1e-6,
+          "-dual_select_snapshots: the same choice (R %d) and table to %.1e (<= 1e-6)" % (ds2["R"], dev))
+    # bad input: before the snapshots, or at the end naming the option
+    for extra, words, what in ((["-dual_select_size", "6", "-dual_select_slack", "-1"], ["-dual_select_slack", "-1"], "negative slack"),
+                               (["-dual_select_snapshots", d + "/nosuch.h5"], ["-dual_select_snapshots", "nosuch.h5"], "missing held-out file"),
+                               (["-dual_select_size", "6", "-estimate"], ["-estimate", "-dual_select_size"], "with -estimate"),
+                               (["-dual_select_size", "6", "-dual_select_R", "10,0"], ["-dual_select_R", "0"], "a candidate of 0 dual vectors")):
+        expect_error(args, opts + ["-snapshots_restart", "-rom", d + "/bad.h5"] + extra, words, "offline " + what, stage="offline", np_=2)
+    check(not os.path.exists(d + "/bad.h5"), "refused before the snapshots: no ROM file written")
+    run(args, 2, "offline", ["-options_file", "runs/sphere_block3d.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "1",
+                             "-body_E", "2000,1000", "-snapshots", d + "/other.h5"])
+    expect_error(args, opts + ["-snapshots_restart", "-rom", d + "/bad.h5", "-dual_select_snapshots", d + "/other.h5"], ["-dual_select_snapshots", "other.h5", "another configuration"],
+                 "offline with held-out solutions of another configuration", stage="offline", np_=2)
+    expect_error(args, ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-test_type", "random", "-test_size", "1", "-validate_sweep_R", "0"], ["-validate_sweep_R", "0"],
+                 "validate -validate_sweep_R 0", stage="validate")
+    # the stored choice: out of range refused naming the dataset; absent (a file of before 2026-11-27): every dual vector
+    shutil.copy(rom, d + "/t.h5")
+    with h5py.File(d + "/t.h5", "r+") as f:
+        if "online/dual_select" in f:
+            del f["online/dual_select"]
+        f["online/dual_select"] = [float(a["R"] + 1)]
+    expect_error(args, ["-rom", d + "/t.h5", "-mu", "0.93,0.043"], ["/online/dual_select", "t.h5"], "a stored R above the file's dual vectors")
+    with h5py.File(d + "/t.h5", "r+") as f:
+        del f["online/dual_select"]
+    run(args, 1, "online", ["-rom", d + "/t.h5", "-mu", "0.93,0.043", "-report", d + "/on_old.json"])
+    check(report(d + "/on_old.json")["rom"]["R"] == a["R"], "a ROM file without /online/dual_select uses every dual vector")
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def residual(args):
     """validate -validate_residual (docs/error_estimate.md): the residual indicator of every reduced solution on the mesh
     and its effectivity against the energy error, on 1 and 2 ranks."""
@@ -797,7 +875,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

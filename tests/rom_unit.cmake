@@ -40,3 +40,7 @@ rbc_add_mpi_test(NAME test_greedy_indicator RANKS 1 2 TIMEOUT 120 COMMAND $<TARG
 #                          brute-force search
 rbc_test_exe(test_error_estimate)
 rbc_add_mpi_test(NAME test_error_estimate RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_error_estimate> LABELS rom)
+#   test_dual_selection    the offline choice of the answer's dual vectors on held-out solutions (ChooseDualSize,
+#                          DualSelectionCandidates) on hand-made tables, the finest 3D level's among them
+rbc_test_exe(test_dual_selection)
+rbc_add_mpi_test(NAME test_dual_selection RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dual_selection> LABELS rom)

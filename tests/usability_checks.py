@@ -148,7 +148,7 @@ def help_(args):
                 "-train_size", "-report", "-pod_inner", "-pod_tol", "-pod_supremizers", "-pod_supremizers_infsup", "-dual_type", "-dual_tol",
                 "-dual_mass_weighted", "-rom_hyper", "-ecsw_tol", "-ecsw_fit", "-ecsw_fit_force", "-eim_quadrature_subdivisions", "-eim_patch_rings",
                 "-eim_select", "-eim_select_slack", "-eim_kappa_tol", "-rom_kacanov_max_it", "-offline_basis_output", "-snapshots_sensitivities",
-                "-dual_sensitivity_step", "-ecsw_distribute_states"):
+                "-dual_sensitivity_step", "-ecsw_distribute_states", "-dual_select_size", "-dual_select_snapshots", "-dual_select_slack", "-dual_select_R"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "offline -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "offline with the shipped scene: no rbcontact warning (unused option)")
     p = run(args, 1, ["online", "-rom", rom, "-help"])
@@ -157,7 +157,7 @@ def help_(args):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "online -help lists %s" % opt)
     p = run(args, 1, ["validate", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "1", "-validate_repeat", "1", "-help"])
     for opt in ("-rom", "-report", "-validate_repeat", "-validate_sweep", "-validate_sweep_fractions", "-validate_sweep_output", "-test_type", "-test_size",
-                "-rom_hyper", "-test_snapshots"):
+                "-rom_hyper", "-test_snapshots", "-validate_sweep_R"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "validate -help lists %s" % opt)
     p = run(args, 1, ["dualbasis", "-snapshots", d + "/rom.snapshots.h5", "-help"])
     for opt in ("-snapshots", "-report", "-dual_out", "-dual_type", "-dual_tol"):

@@ -99,8 +99,8 @@ public:
   // -rom_error_estimate <bool> (default true: every solve estimates its error when the file allows it).
   PetscErrorCode SetFromOptions();
   // Uses the leading n POD modes (and the supremizers of the leading r dual vectors), r dual vectors,
-  // mk and mg EIM terms (-1: NDefault/RDefault, i.e. all without an enrichment, for n and r; MkDefault/MgDefault
-  // for mk and mg). Rebuilds the active operators.
+  // mk and mg EIM terms (-1: NDefault/RDefault, i.e. all without an enrichment, for n and r, and RSelected for r
+  // where the file has one; MkDefault/MgDefault for mk and mg). Rebuilds the active operators.
   PetscErrorCode Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg);
   // The reduced solution at mu (inside the box). Never throws on a numerical failure: converged =
   // false and message set (the stages turn that into an error); PETSc errors only for bad input.
@@ -117,6 +117,7 @@ public:
   // Sizes in use, and of the file.
   PetscInt N() const { return (PetscInt)cols_.size(); }
   PetscInt R() const { return r_; }
+  bool SizesGiven() const { return sizesGiven_; } // the last Truncate named n or r (false: the file's defaults)
   PetscInt Mk() const { return mk_; }
   PetscInt Mg() const { return mg_; }
   PetscInt Mc() const { return (PetscInt)cPoint.size(); }
@@ -155,6 +156,9 @@ public:
   PetscReal              estimateFloor[3] = {0, 0, 0};   // estimate = scale * raw + floor (error_estimate.hpp)
   PetscBool              errorEstimate = PETSC_TRUE;     // -rom_error_estimate
   bool HasEnrichment() const { return (NDefault >= 0 && NDefault < Npod) || (RDefault >= 0 && RDefault < Rfull); }
+  PetscInt               RSelected = -1;                  // dual vectors of the answer chosen offline on held-out FOM solutions
+                                                         // (/online/dual_select, dual_selection.hpp; -1: none): used unless -rom_R,
+                                                         // the rest of the stored ones unused (no estimate's enrichment)
   std::vector<PetscInt>  kPoint, kMode, gPoint;      // EIM points: patch point (and mode for kappa)
   std::vector<PetscReal> kB, kC, gB, gC;             // B (M x M, column-major); C_j: Mk x Nfull x Rfull, Mg x Rfull
   std::vector<PetscReal> kConstant, gConstant;       // exact terms when constant: Nfull x Rfull, Rfull
@@ -225,6 +229,7 @@ private:
   std::vector<PetscInt>  cols_;
   std::vector<PetscReal> aAct_;                       // Aq of the active columns (QA x Na x Na, column-major; Truncate)
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;
+  bool                   sizesGiven_ = false; // the last Truncate named n or r (not the file's defaults)
   ContactPatch           active_;                     // patch with the active basis columns
   std::vector<PetscInt>  evalPoints_, kPos_, gPos_;   // unique patch points evaluated, positions
   PetscInt               nkEval_ = 0;                 // evalPoints_[0, nkEval_) carry kappa points

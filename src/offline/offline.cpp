@@ -3,6 +3,7 @@
 // finished round written to the snapshot file before the next starts: a killed job resumes) and the
 // bases and ROM steps (offline_bases.cpp, offline_greedy.cpp, offline_rom.cpp).
 #include "rbcontact/offline.hpp"
+#include "rbcontact/dual_selection.hpp"
 #include "rbcontact/offline_bases.hpp"
 #include "rbcontact/offline_greedy.hpp"
 #include "rbcontact/offline_rom.hpp"
@@ -173,6 +174,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
     PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
+    DualSelectionOptions dso;
+    PetscCall(DualSelectionFromOptions(world, &dso));
     PetscCheck(slack >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_select_slack %g must be >= 0", (double)slack);
     PetscBool held = PETSC_FALSE;
     PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &held));

@@ -8,6 +8,7 @@
 #include "rbcontact/supremizers.hpp"
 #include "rbcontact/offline_rom.hpp"
 #include "rbcontact/estimate_calibration.hpp"
+#include "rbcontact/dual_selection.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
@@ -441,6 +442,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(w.Write(world, bpath));
     PetscCall(wr.Write(world, romPath));
     if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
+    PetscCall(SelectDualSize(world, fom.scene, romPath, &wr, rep)); // -dual_select_*: the answer's R on held-out solutions
     unsigned long long big[2] = {0, 0};
     std::string        bigName;
     if (wrank == 0) {

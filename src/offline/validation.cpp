@@ -48,6 +48,12 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCall(PetscOptionsBool("-validate_sweep", "also the speed-against-error sweep over truncated sizes", "", sweep, &sweep, NULL));
   PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
   PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
+  {
+    PetscInt  rbuf[256], nr = 256;
+    PetscBool rset = PETSC_FALSE;
+    PetscCall(PetscOptionsIntArray("-validate_sweep_R", "also the errors with these numbers of dual vectors (all POD modes; untimed)", "", rbuf, &nr, &rset));
+    if (rset) s->rValues.assign(rbuf, rbuf + nr);
+  }
   PetscCall(PetscOptionsBool("-validate_residual", "also the residual of each reduced solution on the mesh (the greedy indicator) and its effectivity against the energy error", "", residual, &residual, NULL));
   {
     char      path[PETSC_MAX_PATH_LEN] = "";
@@ -60,6 +66,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCheck(s->repeat >= 1 && s->repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", s->repeat);
   if (fset) s->fractions.assign(fbuf, fbuf + nf);
   for (PetscReal f : s->fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
+  for (PetscInt r : s->rValues) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
   s->sweep       = sweep;
   s->sweepOutput = sweepOut;
   if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".json", "-validate_sweep_output"));
@@ -71,22 +78,22 @@ static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
 namespace {
 // The FOM test solutions of -test_snapshots (a snapshot file of offline -offline_stop snapshots, every one solved),
 // checked against the scene as configured now and against the test set (its points, to 1e-14).
-PetscErrorCode ReadTestSnapshots(MPI_Comm comm, const std::string &path, const SceneSpec &scene, ElasticFOM &fom, const CanonicalOrder &order, const ContactMap &cmap, const ParameterSet &test, std::vector<Snapshot> *snaps)
+PetscErrorCode ReadTestSnapshots(MPI_Comm comm, const std::string &path, const char *opt, const SceneSpec &scene, ElasticFOM &fom, const CanonicalOrder &order, const ContactMap &cmap, const ParameterSet &test, std::vector<Snapshot> *snaps)
 {
   SnapshotHeader h;
   PetscFunctionBeginUser;
   PetscCall(SnapshotFile::ReadHeader(path, &h));
   const char *file = path.c_str();
-  PetscCheck(h.sceneHash == Fnv1a(SceneFingerprint(scene, fom.map)), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s was solved for another configuration of the scene (file: scene '%s'; now '%s'): the options must be those of the ROM", file, h.scene.c_str(), scene.name.c_str());
-  PetscCheck(h.ndofs == order.NumDofs() && h.nmult == cmap.NumMultipliers(), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s has %" PetscInt_FMT " dofs and %" PetscInt_FMT " multipliers, the mesh now %" PetscInt_FMT " and %" PetscInt_FMT, file, h.ndofs, h.nmult, order.NumDofs(), cmap.NumMultipliers());
+  PetscCheck(h.sceneHash == Fnv1a(SceneFingerprint(scene, fom.map)), comm, PETSC_ERR_USER_INPUT, "%s %s was solved for another configuration of the scene (file: scene '%s'; now '%s'): the options must be those of the ROM", opt, file, h.scene.c_str(), scene.name.c_str());
+  PetscCheck(h.ndofs == order.NumDofs() && h.nmult == cmap.NumMultipliers(), comm, PETSC_ERR_USER_INPUT, "%s %s has %" PetscInt_FMT " dofs and %" PetscInt_FMT " multipliers, the mesh now %" PetscInt_FMT " and %" PetscInt_FMT, opt, file, h.ndofs, h.nmult, order.NumDofs(), cmap.NumMultipliers());
   bool same = h.trainingPoints.size() == test.points.size();
   for (size_t j = 0; same && j < test.points.size(); ++j) {
     same = h.trainingPoints[j].size() == test.points[j].size();
     for (size_t i = 0; same && i < test.points[j].size(); ++i) same = std::abs(h.trainingPoints[j][i] - test.points[j][i]) <= 1e-14 * std::max<PetscReal>(1, std::abs(test.points[j][i]));
   }
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "validate: the parameters of -test_snapshots %s (%zu) are not the test set (%zu)", file, h.trainingPoints.size(), test.points.size());
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "%s %s: its parameters (%zu) are not the test set (%zu)", opt, file, h.trainingPoints.size(), test.points.size());
   PetscCall(SnapshotFile::ReadAll(path, snaps));
-  PetscCheck(snaps->size() == test.points.size(), comm, PETSC_ERR_USER_INPUT, "validate: -test_snapshots %s holds %zu of its %zu solutions: finish it with offline -offline_stop snapshots -snapshots_restart -snapshots %s (and the options that wrote it)", file, snaps->size(), test.points.size(), file);
+  PetscCheck(snaps->size() == test.points.size(), comm, PETSC_ERR_USER_INPUT, "%s %s holds %zu of its %zu solutions: finish it with offline -offline_stop snapshots -snapshots_restart -snapshots %s (and the options that wrote it)", opt, file, snaps->size(), test.points.size(), file);
   PetscFunctionReturn(0);
 }
 
@@ -322,7 +329,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   std::vector<std::shared_ptr<ContactSystem>> sysAt(nt);
   std::vector<Snapshot>    stored;
   PetscCheck(nt >= 1, comm, PETSC_ERR_ARG_SIZ, "validate: the test set is empty");
-  if (!settings.testSnapshots.empty()) PetscCall(ReadTestSnapshots(comm, settings.testSnapshots, scene, fom, order, cmap, test, &stored));
+  if (!settings.testSnapshots.empty()) PetscCall(ReadTestSnapshots(comm, settings.testSnapshots, settings.testSnapshotsOption.c_str(), scene, fom, order, cmap, test, &stored));
   for (PetscInt j = 0; j < nt; ++j) {
     F[j].mu = test.points[j];
     ContactSystem  readSys;
@@ -574,13 +581,47 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   ReportSizes(model, &ro);
   ro["ndofs"] = (long long)order.NumDofs();
 
+  // the errors with fewer dual vectors (and their supremizers), every POD mode of the answer: what the offline
+  // stage chooses R on (dual_selection.hpp); the estimate off, as in the sweep below
+  // (the sweeps end on the model's own truncation: its sizes if given, else the file's defaults)
+  const PetscInt Npod = (PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; });
+  const PetscInt R0 = model.R(), Mk0 = model.Mk(), Mg0 = model.Mg();
+  auto restoreSizes = [&, given = model.SizesGiven()]() { return given ? model.Truncate(Npod, R0, Mk0, Mg0) : model.Truncate(-1, -1, Mk0, Mg0); };
+  if (!settings.rValues.empty()) {
+    const PetscBool est0 = model.errorEstimate;
+    JsonValue      &rows = rep.root["sweep_R"];
+    model.errorEstimate  = PETSC_FALSE;
+    for (PetscInt r : settings.rValues) {
+      PetscCheck(r >= 1 && r <= model.Rfull, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors, the ROM file %s stores %" PetscInt_FMT, r, romPath, model.Rfull);
+      PetscCall(model.Truncate(Npod, r, Mk0, Mg0));
+      Errors Es;
+      PetscCall(evaluate(model, false, &Es, nullptr, nullptr, nullptr));
+      auto mx   = [&](const std::vector<double> &v) { return v.empty() || Es.failed ? NAN : *std::max_element(v.begin(), v.end()); };
+      auto mean = [&](const std::vector<double> &v) { return v.empty() || Es.failed ? NAN : std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+      const DualSizeRow dr{r, model.N(), mx(Es.u), mx(Es.lambda), mx(Es.force), mean(Es.u), mean(Es.lambda), mean(Es.force), Es.failed > 0};
+      JsonValue         row;
+      row["R"]                   = (long long)r;
+      row["N"]                   = (long long)dr.N;
+      row["max_rel_err_u"]       = dr.u;
+      row["max_rel_err_lambda"]  = dr.lambda;
+      row["max_rel_err_force"]   = dr.force;
+      row["mean_rel_err_u"]      = dr.meanU;
+      row["mean_rel_err_lambda"] = dr.meanLambda;
+      row["mean_rel_err_force"]  = dr.meanForce;
+      row["failed"]              = (long long)Es.failed;
+      if (Es.failed) row["first_failure"] = Es.firstFailure;
+      rows.Push(row);
+      if (settings.rRows) settings.rRows->push_back(dr);
+    }
+    model.errorEstimate = est0;
+    PetscCall(restoreSizes());
+  }
+
   // speed against error over truncations of the same ROM
   if (sweep) {
     JsonValue         &rows = rep.root["sweep"];
     std::ostringstream csv;
     csv << "N,R,Mk,Mg,online_median_s,max_rel_err_u,max_rel_err_lambda,max_rel_err_force,failed\n";
-    const PetscInt Npod = (PetscInt)std::count_if(model.Columns().begin(), model.Columns().end(), [&](PetscInt c) { return c < model.Npod; });
-    const PetscInt R0 = model.R(), Mk0 = model.Mk(), Mg0 = model.Mg();
     const PetscBool est0 = model.errorEstimate;
     model.errorEstimate  = PETSC_FALSE; // the sweep times the solves alone (the estimate's cost: online_time_s)
     for (PetscReal fr : fractions) {
@@ -606,7 +647,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       csv << model.N() << "," << r << "," << mk << "," << mg << "," << Median(meds) << "," << row["max_rel_err_u"].AsNumber() << "," << row["max_rel_err_lambda"].AsNumber() << "," << row["max_rel_err_force"].AsNumber() << "," << Es.failed << "\n";
       rows.Push(row);
     }
-    PetscCall(model.Truncate(Npod, R0, Mk0, Mg0));
+    PetscCall(restoreSizes());
     model.errorEstimate = est0;
     csv << "# FOM median " << fomMedian << " s\n";
     JsonValue table;

@@ -238,6 +238,7 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
   // the arithmetic of the cubature's dof sum the model was validated with (-rom_ecsw_precision: 64 or 32 bits)
   w->Dataset("/online/ecsw_precision", {1}, {m.ecswSingle ? 32.0 : 64.0});
   if (m.MkDefault >= 0 || m.MgDefault >= 0) w->Dataset("/online/eim_default", {2}, {(double)m.MkDefault, (double)m.MgDefault});
+  if (m.RSelected >= 1) w->Dataset("/online/dual_select", {1}, {(double)m.RSelected}); // the answer's R chosen on held-out solutions
   if (m.HasEnrichment()) { // the answer's sizes, the rest is the error estimate's enrichment (docs/error_estimate.md)
     w->Dataset("/online/estimate/default_sizes", {2}, {(double)m.NDefault, (double)m.RDefault});
     w->Dataset("/online/estimate/calibration", {2, 3}, {m.estimateScale[0], m.estimateScale[1], m.estimateScale[2], m.estimateFloor[0], m.estimateFloor[1], m.estimateFloor[2]});
@@ -368,6 +369,15 @@ PetscErrorCode ReducedModel::Open(const std::string &path)
       MgDefault = (PetscInt)d[1];
     }
   }
+  RSelected = -1;
+  { // optional (files of before 2026-11-27 have none): the answer's dual vectors chosen on held-out FOM solutions
+    bool found;
+    PetscCall(RomReadOptional(path, "/online/dual_select", &d, &found));
+    if (found) {
+      PetscCheck(d.size() == 1 && d[0] >= 1 && d[0] <= Rfull && d[0] == std::floor(d[0]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/dual_select must hold one number of dual vectors within [1, %" PetscInt_FMT "]", path.c_str(), Rfull);
+      RSelected = (PetscInt)d[0];
+    }
+  }
   NDefault = RDefault = -1;
   massGram.clear();
   for (int k = 0; k < 3; ++k) {
@@ -464,8 +474,9 @@ PetscErrorCode ReducedModel::SetFromOptions()
 PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg)
 {
   PetscFunctionBeginUser;
+  sizesGiven_ = n >= 0 || r >= 0;
   if (n < 0) n = NDefault >= 1 ? std::min(NDefault, Npod) : Npod;
-  if (r < 0) r = RDefault >= 1 ? std::min(RDefault, Rfull) : Rfull;
+  if (r < 0) r = RDefault >= 1 ? std::min(RDefault, Rfull) : RSelected >= 1 ? std::min(RSelected, Rfull) : Rfull;
   if (mk < 0) mk = MkDefault >= 0 ? std::min(MkDefault, MkFull) : MkFull;
   if (mg < 0) mg = MgDefault >= 0 ? std::min(MgDefault, MgFull) : MgFull;
   PetscCheck(n >= 1 && n <= Npod, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_N %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "] (POD modes in %s)", n, Npod, file.c_str());
@@ -977,6 +988,10 @@ PetscErrorCode ReducedModel::EstimateError(const std::vector<PetscReal> &mu, Red
   }
   if (Na >= Nf && r >= Rf) {
     e.why = "no enrichment: the model uses every basis function of the ROM file (rebuild it with offline -estimate, or use fewer with -rom_N/-rom_R)";
+    PetscFunctionReturn(0);
+  }
+  if (!HasEnrichment() && !sizesGiven_) { // the file's default sizes: the dual vectors beyond the held-out choice
+    e.why = "no enrichment: the ROM file's dual vectors beyond the R chosen on held-out solutions (offline -dual_select_*) are not an error estimate's enrichment (rebuild with offline -estimate, or use fewer with -rom_N/-rom_R)";
     PetscFunctionReturn(0);
   }
   if (wnMode_ == ContactMode::EIM) {

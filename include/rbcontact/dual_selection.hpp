@@ -1,0 +1,58 @@
+// rbcontact/dual_selection.hpp: the number of dual vectors the online stage uses by default, chosen by the offline
+// stage on FOM solutions at held-out parameters (docs/dual_basis.md "R chosen on held-out solutions"). The dual
+// greedy stops on its error over the training multipliers; with a cubature its last vectors can cost time and make
+// lambda worse between training parameters (measured at the finest 3D level: lambda 1.85e-2 with all 162, 1.48e-2
+// with 110, on six held-out FOM solutions). The ROM just written is validated at the held-out parameters for a list
+// of R (validation.hpp, -validate_sweep_R: every POD mode, the supremizers of the leading R dual vectors); the
+// choice goes into the file as /online/dual_select, which the online stage uses unless -rom_R. The file keeps every
+// dual vector (-rom_R reaches them all).
+#pragma once
+#include <string>
+#include <vector>
+#include <petscsys.h>
+#include "rbcontact/report.hpp"
+#include "rbcontact/rom_file.hpp"
+#include "rbcontact/scene.hpp"
+#include "rbcontact/validation.hpp"
+
+namespace rbc {
+
+struct DualSelectionOptions {
+  PetscInt              size = 0;           // -dual_select_size: random held-out parameters solved by the FOM here (0: off)
+  PetscInt              seed = 11;          // -dual_select_seed
+  std::string           snapshots;          // -dual_select_snapshots: the held-out FOM solutions from this snapshot file
+                                            // (offline -offline_stop snapshots: checkpointed; its parameters are the set;
+                                            // it takes precedence over -dual_select_size, e.g. of a scene's options file)
+  PetscReal             slack = 0.1;        // -dual_select_slack
+  PetscReal             minFraction = 0.5;  // -dual_select_min_fraction: the smallest candidate, as a fraction of R
+  PetscInt              count = 16;         // -dual_select_count: candidates from there to R, evenly spaced
+  std::vector<PetscInt> candidates;         // -dual_select_R: the candidates themselves (R is always added)
+  bool Enabled() const { return size > 0 || !snapshots.empty(); }
+};
+
+// Reads and checks the options (prefix dual_select_); the offline stage calls it before its snapshots (hours on a
+// real scene) and again at the end. Errors: ranges, a missing or unreadable snapshot file, -estimate (whose
+// enrichment is the dual vectors beyond the answer's).
+PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o);
+
+// The candidates for a file of R dual vectors: -dual_select_R (those above R left out: R is the dual greedy's, not
+// known when the options are given) or count values evenly spaced from ceil(minFraction R) to R; sorted, distinct,
+// R included.
+std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, PetscInt R);
+
+// The rule (rows: DualSizeRow, validation.hpp): admissible are the rows that did not fail whose max lambda error is
+// within (1 + slack) of the best row's and whose u and force errors, max and mean, are within (1 + slack) of those
+// with every dual vector (the row of the largest R); the admissible row of the smallest R is chosen, the largest R
+// when none is. Returns the chosen row's index.
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack);
+
+// With the options enabled: validates the ROM at romPath (w: its writer, holding the model) on the held-out FOM
+// solutions for every candidate, chooses R (ChooseDualSize), writes /online/dual_select (the file rewritten
+// atomically). Report keys: dual_select {enabled, heldout, seed or snapshots, slack, candidates [rows R, N,
+// max_rel_err_u, max_rel_err_lambda, max_rel_err_force, mean_rel_err_u, mean_rel_err_lambda, mean_rel_err_force,
+// failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the
+// chosen row), max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use
+// become the chosen sizes; time_s.dual_select its seconds. Collective on world.
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep);
+
+} // namespace rbc

@@ -1,0 +1,157 @@
+// src/offline/dual_selection.cpp: SelectDualSize and its rule (rbcontact/dual_selection.hpp).
+#include "rbcontact/dual_selection.hpp"
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include "rbcontact/snapshot_file.hpp"
+#include "rbcontact/training_set.hpp"
+
+namespace rbc {
+
+PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
+{
+  char      path[PETSC_MAX_PATH_LEN] = "";
+  PetscInt  rbuf[256], nr = 256;
+  PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, "dual_select_", "The answer's dual vectors chosen on held-out FOM solutions (offline)", "SelectDualSize");
+  PetscCall(PetscOptionsInt("-size", "random held-out parameters, solved by the FOM at the end of the offline stage (0: no choice; -dual_select_snapshots takes precedence)", "", o->size, &o->size, NULL));
+  PetscCall(PetscOptionsInt("-seed", "seed of those parameters", "", o->seed, &o->seed, NULL));
+  PetscCall(PetscOptionsString("-snapshots", "the held-out FOM solutions from this snapshot file (offline -offline_stop snapshots: checkpointed)", "", path, path, sizeof path, &pset));
+  PetscCall(PetscOptionsReal("-slack", "the smallest R whose held-out lambda error is within this relative slack of the best (u, force within it of all R's)", "", o->slack, &o->slack, NULL));
+  PetscCall(PetscOptionsReal("-min_fraction", "the smallest candidate R as a fraction of the dual vectors stored", "", o->minFraction, &o->minFraction, NULL));
+  PetscCall(PetscOptionsInt("-count", "candidates from there to all, evenly spaced", "", o->count, &o->count, NULL));
+  PetscCall(PetscOptionsIntArray("-R", "the candidates themselves (all dual vectors always added)", "", rbuf, &nr, &rset));
+  PetscOptionsEnd();
+  if (pset) o->snapshots = path;
+  if (rset) o->candidates.assign(rbuf, rbuf + nr);
+  PetscCheck(o->size >= 0 && o->size <= 10000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_size %" PetscInt_FMT " out of range [0, 1e4]", o->size);
+  PetscCheck(o->slack >= 0 && o->slack <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_slack %g out of range [0, 10]", (double)o->slack);
+  PetscCheck(o->minFraction > 0 && o->minFraction <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_min_fraction %g is not in (0, 1]", (double)o->minFraction);
+  PetscCheck(o->count >= 1 && o->count <= 1000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_count %" PetscInt_FMT " out of range [1, 1000]", o->count);
+  for (PetscInt r : o->candidates) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
+  if (!o->snapshots.empty()) {
+    std::error_code ec;
+    PetscCheck(std::filesystem::is_regular_file(o->snapshots, ec), comm, PETSC_ERR_FILE_OPEN, "-dual_select_snapshots %s: no such file (write it with offline -offline_stop snapshots -train_type random -snapshots %s)", o->snapshots.c_str(), o->snapshots.c_str());
+    SnapshotHeader h;
+    PetscCall(SnapshotFile::ReadHeader(o->snapshots, &h));
+    PetscCheck(!h.trainingPoints.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "-dual_select_snapshots %s holds no parameters", o->snapshots.c_str());
+  }
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-estimate", &estimate, NULL));
+  PetscCheck(!(o->Enabled() && estimate), comm, PETSC_ERR_ARG_INCOMP, "-dual_select_%s chooses the answer's R among all stored dual vectors; it does not combine with -estimate, whose enrichment is the dual vectors beyond the answer's", o->snapshots.empty() ? "size" : "snapshots");
+  PetscFunctionReturn(0);
+}
+
+std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, PetscInt R)
+{
+  std::vector<PetscInt> c;
+  if (!o.candidates.empty()) {
+    for (PetscInt r : o.candidates)
+      if (r <= R) c.push_back(r); // the dual greedy's R is not known before the offline stage: larger ones are R
+  } else {
+    const PetscInt lo = std::max<PetscInt>(1, (PetscInt)std::ceil(o.minFraction * R - 1e-9));
+    for (PetscInt k = 0; k < o.count; ++k) c.push_back(o.count == 1 ? R : lo + (PetscInt)std::lround((double)(R - lo) * k / (o.count - 1)));
+  }
+  c.push_back(R);
+  std::sort(c.begin(), c.end());
+  c.erase(std::unique(c.begin(), c.end()), c.end());
+  return c;
+}
+
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack)
+{
+  size_t all = 0;
+  for (size_t k = 1; k < rows.size(); ++k)
+    if (rows[k].R > rows[all].R) all = k;
+  double best = INFINITY;
+  for (const auto &r : rows)
+    if (!r.failed) best = std::min(best, r.lambda);
+  const DualSizeRow &a      = rows[all];
+  size_t             chosen = rows.size(); // none yet
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const DualSizeRow &r = rows[k];
+    // u and force no worse than with every dual vector, at the worst parameter and on average (a max over a few
+    // held-out parameters is set by one of them and hides a change at the others)
+    const bool guard      = a.failed || (r.u <= (1 + slack) * a.u && r.force <= (1 + slack) * a.force && r.meanU <= (1 + slack) * a.meanU && r.meanForce <= (1 + slack) * a.meanForce);
+    const bool admissible = !r.failed && r.lambda <= (1 + slack) * best && guard;
+    if (admissible && (chosen == rows.size() || r.R < rows[chosen].R)) chosen = k;
+  }
+  return chosen == rows.size() ? all : chosen;
+}
+
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep)
+{
+  DualSelectionOptions o;
+
+  PetscFunctionBeginUser;
+  PetscCall(DualSelectionFromOptions(world, &o));
+  JsonValue &d = rep->root["dual_select"];
+  d["enabled"] = o.Enabled();
+  if (!o.Enabled()) PetscFunctionReturn(0);
+  PetscLogDouble t0, t1;
+  PetscCall(PetscTime(&t0));
+  std::vector<unsigned long long> dims;
+  std::vector<double>             gram;
+  PetscCall(RomReadDataset(romPath, "/online/dual_gram", &dims, &gram));
+  const PetscInt R = (PetscInt)dims[0];
+
+  ParameterSet held;
+  for (const auto &p : scene.params) held.names.push_back(p.name);
+  ValidationSettings vs;
+  if (o.snapshots.empty()) held.points = RandomSample(scene.params, o.size, (unsigned long long)o.seed);
+  else {
+    SnapshotHeader h;
+    PetscCall(SnapshotFile::ReadHeader(o.snapshots, &h));
+    held.points            = h.trainingPoints;
+    vs.testSnapshots       = o.snapshots;
+    vs.testSnapshotsOption = "offline: -dual_select_snapshots";
+  }
+  vs.repeat  = 1;
+  vs.print   = false;
+  vs.rValues = DualSelectionCandidates(o, R);
+  std::vector<DualSizeRow> rows;
+  vs.rRows = &rows;
+  Report vr;
+  PetscCall(RunValidation(world, scene, romPath, held, vs, &vr));
+
+  JsonValue &cand = d["candidates"];
+  for (const auto &r : rows) {
+    JsonValue j;
+    j["R"]                  = (long long)r.R;
+    j["N"]                  = (long long)r.N;
+    j["max_rel_err_u"]      = r.u;
+    j["max_rel_err_lambda"] = r.lambda;
+    j["max_rel_err_force"]  = r.force;
+    j["mean_rel_err_u"]      = r.meanU;
+    j["mean_rel_err_lambda"] = r.meanLambda;
+    j["mean_rel_err_force"]  = r.meanForce;
+    j["failed"]             = r.failed;
+    cand.Push(j);
+  }
+  const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack)], &a = rows.back();
+  if (c.R < R) w->Dataset("/online/dual_select", {1}, {(double)c.R}); // R itself: no dataset, the file's default
+  PetscCall(w->Write(world, romPath));
+  d["heldout"] = (long long)held.points.size();
+  if (o.snapshots.empty()) d["seed"] = (long long)o.seed;
+  else d["snapshots"] = o.snapshots;
+  d["slack"]                      = (double)o.slack;
+  d["R"]                          = (long long)c.R;
+  d["N"]                          = (long long)c.N;
+  d["R_stored"]                   = (long long)R;
+  d["max_rel_err_u"]              = c.u;
+  d["max_rel_err_lambda"]         = c.lambda;
+  d["max_rel_err_force"]          = c.force;
+  d["max_rel_err_u_all"]          = a.u;
+  d["max_rel_err_lambda_all"]     = a.lambda;
+  d["max_rel_err_force_all"]      = a.force;
+  d["fom_median_s"]               = vr.root["fom_time_s"]["median"].AsNumber();
+  PetscCall(PetscTime(&t1));
+  rep->root["time_s"]["dual_select"] = (double)(t1 - t0); // the held-out FOM solves (none from a file) and the validations
+  rep->root["rom"]["R_in_use"]    = (long long)c.R;
+  rep->root["rom"]["N_in_use"]    = (long long)c.N;
+  PetscCall(PetscPrintf(world, "rbcontact offline: R chosen on %zu held-out FOM solutions: %" PetscInt_FMT " of %" PetscInt_FMT " dual vectors (N %" PetscInt_FMT "), max rel err lambda %.3e u %.3e force %.3e (all %" PetscInt_FMT ": %.3e, %.3e, %.3e)\n", held.points.size(), c.R, R, c.N, c.lambda, c.u, c.force, R, a.lambda, a.u, a.force));
+  PetscFunctionReturn(0);
+}
+
+} // namespace rbc

@@ -1,0 +1,80 @@
+// tests/test_dual_selection.cpp: the offline choice of the answer's dual vectors (dual_selection.hpp) on hand-made
+// tables: ChooseDualSize's rule (lambda within the slack of the best, u and force (max and mean) within it of every dual vector's,
+// the smallest such R; failed rows never; none admissible: every dual vector) and DualSelectionCandidates (evenly
+// spaced from ceil(f R) to R, a given list with R added and larger values left out).
+#include "rbcontact/dual_selection.hpp"
+#include "test_check.hpp"
+
+using rbc::DualSizeRow;
+using rbctest::Check;
+
+static DualSizeRow Row(PetscInt R, double u, double l, double f, bool failed = false)
+{
+  DualSizeRow r;
+  r.R = R;
+  r.N = R + 10;
+  r.u = u;
+  r.lambda = l;
+  r.force = f;
+  r.meanU = u / 2; // the means half the maxima unless a case sets them
+  r.meanLambda = l / 2;
+  r.meanForce = f / 2;
+  r.failed = failed;
+  return r;
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  MPI_Comm c = PETSC_COMM_WORLD;
+  { // the finest 3D level's held-out table (docs/rom3d.md): 110 best on lambda, u and force no worse
+    std::vector<DualSizeRow> t{Row(110, 1.616e-4, 1.483e-2, 1.409e-4), Row(130, 1.655e-4, 1.654e-2, 1.471e-4), Row(162, 1.647e-4, 1.846e-2, 1.605e-4)};
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1)].R == 110, "finest table: R 110", (double)t[rbc::ChooseDualSize(t, 0.1)].R, 110));
+    // with a 20 % slack 130 is within it of the best lambda (1.654 <= 1.2 x 1.483) but 110 is still smaller
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.2)].R == 110, "slack 0.2: still the smallest admissible, R 110", (double)t[rbc::ChooseDualSize(t, 0.2)].R, 110));
+  }
+  { // the smallest R within the slack of the best lambda, not the best itself
+    std::vector<DualSizeRow> t{Row(10, 1e-4, 3e-2, 1e-4), Row(20, 1e-4, 1.05e-2, 1e-4), Row(30, 1e-4, 1.0e-2, 1e-4), Row(40, 1e-4, 1.2e-2, 1e-4)};
+    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    PetscCall(Check(c, t[k].R == 20, "lambda 1.05e-2 within 10 % of the best 1.0e-2: R 20, not 30", (double)t[k].R, 20));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.0)].R == 30, "slack 0: the best, R 30", (double)t[rbc::ChooseDualSize(t, 0.0)].R, 30));
+  }
+  { // a smaller R whose u or force error grows beyond the slack of every dual vector's is not admissible; nor a failed row
+    std::vector<DualSizeRow> t{Row(10, 1e-4, 1.0e-2, 5e-4, true), Row(15, 3e-4, 1.0e-2, 1e-4), Row(20, 1e-4, 1.0e-2, 2e-4), Row(25, 1.05e-4, 1.0e-2, 1.05e-4), Row(30, 1e-4, 1.2e-2, 1e-4)};
+    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    PetscCall(Check(c, t[k].R == 25, "failed row, u x3 and force x2 refused: R 25", (double)t[k].R, 25));
+  }
+  { // the same max errors, but u worse on average at the smaller R (a max over few parameters is set by one of them)
+    std::vector<DualSizeRow> t{Row(20, 1e-4, 1.0e-2, 1e-4), Row(25, 1e-4, 1.0e-2, 1e-4), Row(30, 1e-4, 1.0e-2, 1e-4)};
+    t[0].meanU = 0.8e-4; // 1.6x every dual vector's mean (0.5e-4): refused
+    t[1].meanForce = 0.54e-4; // 1.08x: within the slack
+    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    PetscCall(Check(c, t[k].R == 25, "mean u 1.6x refused, mean force 1.08x admitted: R 25", (double)t[k].R, 25));
+  }
+  { // nothing admissible (the best lambda's u is worse, every dual vector's lambda is not within the slack): all of them
+    std::vector<DualSizeRow> t{Row(20, 5e-4, 1.0e-2, 1e-4), Row(30, 1e-4, 2.0e-2, 1e-4)};
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1)].R == 30, "none admissible: every dual vector, R 30", (double)t[rbc::ChooseDualSize(t, 0.1)].R, 30));
+  }
+  { // candidates
+    rbc::DualSelectionOptions o;
+    std::vector<PetscInt>     v = rbc::DualSelectionCandidates(o, 162);
+    bool ok = v.size() == 16 && v.front() == 81 && v.back() == 162;
+    for (size_t k = 1; k < v.size(); ++k) ok = ok && v[k] > v[k - 1];
+    PetscCall(Check(c, ok, "default: 16 distinct candidates from 81 to 162", (double)v.size(), 16));
+    v = rbc::DualSelectionCandidates(o, 10); // fewer values than the count: distinct
+    ok = v.size() == 6 && v.front() == 5 && v.back() == 10;
+    PetscCall(Check(c, ok, "R 10: the 6 values 5..10", (double)v.size(), 6));
+    o.candidates = {120, 80, 500, 80};
+    v  = rbc::DualSelectionCandidates(o, 110);
+    ok = v == std::vector<PetscInt>{80, 110};
+    PetscCall(Check(c, ok, "-dual_select_R 120,80,500,80 with R 110: 80, 110", (double)v.size(), 2));
+    o.candidates.clear();
+    o.count = 1;
+    v = rbc::DualSelectionCandidates(o, 7);
+    PetscCall(Check(c, v == std::vector<PetscInt>{7}, "-dual_select_count 1: R alone", (double)v.size(), 1));
+  }
+  PetscCall(PetscPrintf(c, "%s\n", rbctest::failures ? "FAILED" : "all checks passed"));
+  const int f = rbctest::failures;
+  PetscCall(PetscFinalize());
+  return f ? 1 : 0;
+}
