@@ -115,20 +115,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   Report vr;
   PetscCall(RunValidation(world, scene, romPath, held, vs, &vr));
 
-  JsonValue &cand = d["candidates"];
-  for (const auto &r : rows) {
-    JsonValue j;
-    j["R"]                  = (long long)r.R;
-    j["N"]                  = (long long)r.N;
-    j["max_rel_err_u"]      = r.u;
-    j["max_rel_err_lambda"] = r.lambda;
-    j["max_rel_err_force"]  = r.force;
-    j["mean_rel_err_u"]      = r.meanU;
-    j["mean_rel_err_lambda"] = r.meanLambda;
-    j["mean_rel_err_force"]  = r.meanForce;
-    j["failed"]             = r.failed;
-    cand.Push(j);
-  }
+  d["candidates"] = vr.root["sweep_R"]; // validate's rows (-validate_sweep_R), one per candidate
   const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack)], &a = rows.back();
   if (c.R < R) w->Dataset("/online/dual_select", {1}, {(double)c.R}); // R itself: no dataset, the file's default
   PetscCall(w->Write(world, romPath));
