@@ -443,7 +443,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
-  PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's)", "", r, &r, NULL));
+  PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's: the offline stage's held-out choice, /online/dual_select, else all but the estimate's enrichment)", "", r, &r, NULL));
   PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
   PetscCall(PetscOptionsInt("-Mk", "EIM terms of kappa used (default: the offline selection)", "", mk, &mk, NULL));
   PetscCall(PetscOptionsInt("-Mg", "EIM terms of the gap used (default: the offline selection)", "", mg, &mg, NULL));
