@@ -227,6 +227,7 @@ private:
   ContactMode            wnMode_ = ContactMode::EIM;  // the mode of that evaluation (EIM: none)
   ContactMode            mode_ = ContactMode::EIM;
   std::vector<PetscInt>  cols_;
+  std::vector<PetscReal> kapAct_;                     // exact mode: kappa's active columns when they are not the leading ones
   std::vector<PetscReal> aAct_;                       // Aq of the active columns (QA x Na x Na, column-major; Truncate)
   PetscInt               r_ = 0, mk_ = 0, mg_ = 0;
   bool                   sizesGiven_ = false; // the last Truncate named n or r (not the file's defaults)
