@@ -47,12 +47,12 @@ std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, Pet
 size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack);
 
 // With the options enabled: validates the ROM at romPath (w: its writer, holding the model) on the held-out FOM
-// solutions for every candidate, chooses R (ChooseDualSize), writes /online/dual_select (the file rewritten
-// atomically). Report keys: dual_select {enabled, heldout, seed or snapshots, slack, candidates [rows R, N,
-// max_rel_err_u, max_rel_err_lambda, max_rel_err_force, mean_rel_err_u, mean_rel_err_lambda, mean_rel_err_force,
-// failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the
-// chosen row), max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use
-// become the chosen sizes; time_s.dual_select its seconds. Collective on world.
+// solutions for every candidate, chooses R (ChooseDualSize) and, when R is below the stored count, writes
+// /online/dual_select (the file rewritten atomically). Report keys: dual_select {enabled, heldout, seed or
+// snapshots, slack, candidates [validate's sweep_R rows: R, N, max_rel_err_{u,lambda,force},
+// mean_rel_err_{u,lambda,force}, failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the chosen row),
+// max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use become the
+// chosen sizes; time_s.dual_select its seconds. Collective on world.
 PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep);
 
 } // namespace rbc

@@ -117,26 +117,28 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
 
   d["candidates"] = vr.root["sweep_R"]; // validate's rows (-validate_sweep_R), one per candidate
   const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack)], &a = rows.back();
-  if (c.R < R) w->Dataset("/online/dual_select", {1}, {(double)c.R}); // R itself: no dataset, the file's default
-  PetscCall(w->Write(world, romPath));
+  if (c.R < R) { // R itself: no dataset (the file's default), the file as written
+    w->Dataset("/online/dual_select", {1}, {(double)c.R});
+    PetscCall(w->Write(world, romPath));
+  }
   d["heldout"] = (long long)held.points.size();
   if (o.snapshots.empty()) d["seed"] = (long long)o.seed;
   else d["snapshots"] = o.snapshots;
-  d["slack"]                      = (double)o.slack;
-  d["R"]                          = (long long)c.R;
-  d["N"]                          = (long long)c.N;
-  d["R_stored"]                   = (long long)R;
-  d["max_rel_err_u"]              = c.u;
-  d["max_rel_err_lambda"]         = c.lambda;
-  d["max_rel_err_force"]          = c.force;
-  d["max_rel_err_u_all"]          = a.u;
-  d["max_rel_err_lambda_all"]     = a.lambda;
-  d["max_rel_err_force_all"]      = a.force;
-  d["fom_median_s"]               = vr.root["fom_time_s"]["median"].AsNumber();
+  d["slack"]                         = (double)o.slack;
+  d["R"]                             = (long long)c.R;
+  d["N"]                             = (long long)c.N;
+  d["R_stored"]                      = (long long)R;
+  d["max_rel_err_u"]                 = c.u;
+  d["max_rel_err_lambda"]            = c.lambda;
+  d["max_rel_err_force"]             = c.force;
+  d["max_rel_err_u_all"]             = a.u;
+  d["max_rel_err_lambda_all"]        = a.lambda;
+  d["max_rel_err_force_all"]         = a.force;
+  d["fom_median_s"]                  = vr.root["fom_time_s"]["median"].AsNumber();
   PetscCall(PetscTime(&t1));
   rep->root["time_s"]["dual_select"] = (double)(t1 - t0); // the held-out FOM solves (none from a file) and the validations
-  rep->root["rom"]["R_in_use"]    = (long long)c.R;
-  rep->root["rom"]["N_in_use"]    = (long long)c.N;
+  rep->root["rom"]["R_in_use"]       = (long long)c.R;
+  rep->root["rom"]["N_in_use"]       = (long long)c.N;
   PetscCall(PetscPrintf(world, "rbcontact offline: R chosen on %zu held-out FOM solutions: %" PetscInt_FMT " of %" PetscInt_FMT " dual vectors (N %" PetscInt_FMT "), max rel err lambda %.3e u %.3e force %.3e (all %" PetscInt_FMT ": %.3e, %.3e, %.3e)\n", held.points.size(), c.R, R, c.N, c.lambda, c.u, c.force, R, a.lambda, a.u, a.force));
   PetscFunctionReturn(0);
 }
