@@ -92,9 +92,10 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   PetscLogDouble t0, t1;
   PetscCall(PetscTime(&t0));
   std::vector<unsigned long long> dims;
-  std::vector<double>             gram;
-  PetscCall(RomReadDataset(romPath, "/online/dual_gram", &dims, &gram));
-  const PetscInt R = (PetscInt)dims[0];
+  std::vector<double>             sizes; // {dim, N, N_pod, n_supremizers, R, 0} (docs/rom_file.md)
+  PetscCall(RomReadDataset(romPath, "/online/sizes", &dims, &sizes));
+  PetscCheck(sizes.size() == 6, world, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/sizes holds %zu values, expected 6", romPath.c_str(), sizes.size());
+  const PetscInt R = (PetscInt)sizes[4];
 
   ParameterSet held;
   for (const auto &p : scene.params) held.names.push_back(p.name);

@@ -291,6 +291,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   }
   PetscCall(model.Open(romPath));
   PetscCall(model.SetFromOptions());
+  for (PetscInt r : settings.rValues) // before the FOM solves (hours on a fine mesh)
+    PetscCheck(r >= 1 && r <= model.Rfull, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors, the ROM file %s stores %" PetscInt_FMT, r, romPath, model.Rfull);
   PetscCall(RomReadAttr(romPath, "scene", &romScene));
   PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), romPath, romScene.c_str(), romScene.c_str());
   for (const auto &mu : test.points) PetscCall(model.par.CheckBox(comm, mu));
@@ -592,7 +594,6 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     JsonValue      &rows = rep.root["sweep_R"];
     model.errorEstimate  = PETSC_FALSE;
     for (PetscInt r : settings.rValues) {
-      PetscCheck(r >= 1 && r <= model.Rfull, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors, the ROM file %s stores %" PetscInt_FMT, r, romPath, model.Rfull);
       PetscCall(model.Truncate(Npod, r, Mk0, Mg0));
       Errors Es;
       PetscCall(evaluate(model, false, &Es, nullptr, nullptr, nullptr));
