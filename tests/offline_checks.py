@@ -16,6 +16,9 @@
   sensitivities  -snapshots_sensitivities on half_disks: du/dmu against central differences of FOM solutions,
               the dense, saddle and CG solves, 1 and 2 ranks, the POD and dual basis enriched (on a 3 x 3 grid: the best
               approximation of u, the ROM's u and lambda errors smaller), a file without them and a bad step refused.
+  initial_guess  -snapshots_initial_guess nearest (half_disks on the dense dual path, with and without sensitivities;
+              sphere_block3d on the saddle path with GAMG): the snapshots of the zero start to the Kacanov tolerance, in
+              fewer Kacanov iterations, on 1 rank and on 2 (two groups, each from its own); a bad value refused.
 """
 import argparse
 import atexit
@@ -464,9 +467,37 @@ def sensitivities(args):
     check(p.returncode != 0 and "-dual_sensitivity_step 2" in p.stdout, "-dual_sensitivity_step 2 is refused, naming the option")
 
 
+def initial_guess(args):
+    d = workdir("rbc_off_")
+    # the Kacanov loop stops at a relative change of 1e-8 (u and lambda, -kacanov_rtol_*): two starts of the same
+    # contraction land within about that of each other; 1e-7 leaves a factor 10 (measured: 6e-14 on half_disks, whose
+    # Newton steps converge quadratically, 1e-9 on the 3D saddle path)
+    cases = (("half_disks + sensitivities", "runs/half_disks.opts", ["-train_size", "4", "-snapshots_sensitivities"]),
+             ("half_disks", "runs/half_disks.opts", ["-train_size", "4"]),
+             ("sphere_block3d, saddle + GAMG, + sensitivities", "runs/sphere_block3d.opts",
+              ["-train_size", "3", "-snapshots_sensitivities", "-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg"]))
+    for i, (what, opts, extra) in enumerate(cases):
+        its = {}
+        for tag, np_, guess in (("zero", 1, "zero"), ("nearest", 1, "nearest"), ("nearest_np2", 2, "nearest")):
+            f = "%s/c%d_%s" % (d, i, tag)
+            run(args, np_, opts, extra + ["-snapshots", f + ".h5", "-snapshots_initial_guess", guess, "-report", f + ".json"])
+            r = report(f + ".json")
+            check(r["initial_guess"] == guess and r["fom_solves"] == r["ntrain"], "%s, %s on %d rank(s): report initial_guess %s, %d solves"
+                  % (what, guess, np_, r["initial_guess"], r["fom_solves"]))
+            its[tag] = arrays(f + ".h5")
+        z = its["zero"]
+        for tag in ("nearest", "nearest_np2"):
+            compare(z, its[tag], 1e-7, "%s, %s against the zero start" % (what, tag))
+            a, b = int(np.sum(z["kacanov_iterations"])), int(np.sum(its[tag]["kacanov_iterations"]))
+            check(b < a, "%s, %s: %d Kacanov iterations over the grid < %d from zero" % (what, tag, b, a))
+    p = run(args, 1, "runs/half_disks.opts", ["-train_size", "2", "-snapshots", d + "/bad.h5", "-snapshots_initial_guess", "previous"], expect_ok=False)
+    check(p.returncode != 0 and "-snapshots_initial_guess previous" in p.stdout and not os.path.exists(d + "/bad.h5"),
+          "-snapshots_initial_guess previous is refused, naming the option, before any snapshot file")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -73,6 +73,12 @@ public:
   // Solves the contact problem of fom (assembled and factored). On return fom.u is the displacement,
   // lambda (R, distributed like the rows of K) the multipliers, sys the constraint at the last iterate.
   PetscErrorCode Solve(ElasticFOM &fom, ContactMap &map);
+  // The next Solve starts from u (free dofs, fom.u's layout: its first geometry is the contact map at u with the
+  // parameter's own Dirichlet values) and lambda (the dual QP's warm start and active set) instead of the
+  // reference configuration; its first iterate's changes are measured from them, and the initial overlap is
+  // still measured at the reference configuration (one more contact assembly). Both copied, used by the next
+  // Solve only (offline -snapshots_initial_guess nearest: a nearby parameter's solution). Collective.
+  PetscErrorCode SetInitialGuess(Vec u, Vec lambda);
   // Before fom.AssembleAndFactor: when the dual matrix will be dense, hands the contact dofs to the FOM
   // so that one factorization serves the solves and the compliance (ElasticFOM::SetSchurDofs). Collective.
   PetscErrorCode ShareFactor(ElasticFOM &fom, const ContactMap &map) const;
@@ -116,6 +122,7 @@ public:
 private:
   PetscErrorCode ComputeKKT(ElasticFOM &fom);
   PetscErrorCode MeasureInitialOverlap(MPI_Comm comm);
+  Vec             uInit_ = nullptr, lamInit_ = nullptr; // SetInitialGuess's, until the next Solve
   DualQPSolver    qp_;
   DualShellSolver shell_;
   SaddleActiveSetSolver saddle_;

@@ -67,6 +67,9 @@ public:
   // A has new values (a new parameter): the next step factors afresh (the set is kept as a start).
   // The first step of a parameter starts its Krylov solve from zero (no guess from another parameter).
   void NewOperator() { factored_ = false; guess_ = false; }
+  // The set to start the next warm Solve from: the rows where lambda (distributed like K's rows) is positive
+  // (KacanovSolver::SetInitialGuess: the multipliers of a nearby parameter).
+  PetscErrorCode SetActiveSet(Vec lambda);
 
   PetscInt  maxIt   = 100;
   PetscReal setTol  = 1e-10;

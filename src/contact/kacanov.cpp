@@ -14,7 +14,24 @@ namespace rbc {
 
 static PetscLogEvent KAC_Assemble = 0, KAC_Schur = 0, KAC_QP = 0;
 
-KacanovSolver::~KacanovSolver() { (void)VecDestroy(&lambda); }
+KacanovSolver::~KacanovSolver()
+{
+  (void)VecDestroy(&lambda);
+  (void)VecDestroy(&uInit_);
+  (void)VecDestroy(&lamInit_);
+}
+
+PetscErrorCode KacanovSolver::SetInitialGuess(Vec u, Vec lam)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDestroy(&uInit_));
+  PetscCall(VecDestroy(&lamInit_));
+  PetscCall(VecDuplicate(u, &uInit_));
+  PetscCall(VecCopy(u, uInit_));
+  PetscCall(VecDuplicate(lam, &lamInit_));
+  PetscCall(VecCopy(lam, lamInit_));
+  PetscFunctionReturn(0);
+}
 
 // The contact QP's TAO had the prefix fom_ until 2026-11-25, shared with the elastic KSP/PC (so that
 // -fom_ksp_type cg -fom_pc_type gamg reached TAO's inner KSP on the dense dual matrix). Its prefix is fom_qp_ now;
@@ -365,6 +382,43 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(VecRestoreArray(usurf, &us));
     PetscFunctionReturn(0);
   };
+  // SetInitialGuess: the overlap measured at the reference configuration (as without a guess), then the first
+  // geometry at the guess, the multipliers and the QP's start from it, the first changes measured from both
+  const bool guessed = uInit_ != nullptr;
+  if (guessed) {
+    PetscInt nu, ng, nl, nr;
+    PetscCall(PetscTime(&t0));
+    PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
+    PetscCall(map.Assemble(fom.elas, uloc, &sys));
+    PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
+    PetscCall(MeasureInitialOverlap(comm));
+    if (!lambda) {
+      PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
+      PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
+    }
+    PetscCall(VecGetSize(uInit_, &ng));
+    PetscCall(VecGetSize(fom.u, &nu));
+    PetscCall(VecGetSize(lamInit_, &nl));
+    PetscCall(VecGetSize(lambda, &nr));
+    PetscCheck(ng == nu && nl == nr, comm, PETSC_ERR_ARG_SIZ, "KacanovSolver: initial guess of %" PetscInt_FMT " dofs and %" PetscInt_FMT " multipliers for a problem of %" PetscInt_FMT " and %" PetscInt_FMT, ng, nl, nu, nr);
+    PetscCall(VecCopy(lamInit_, lambda));
+    PetscCall(VecDuplicate(lambda, &lamPrev));
+    PetscCall(VecCopy(lambda, lamPrev));
+    if (distributed) {
+      PetscCall(VecCopy(uInit_, uprev));
+      PetscCall(fom.elas.GlobalToLocalWithBC(uInit_, uloc));
+      if (saddle) PetscCall(saddle_.SetActiveSet(lambda));
+    } else {
+      PetscCall(GatherAt(uInit_, D, &uDprev));
+      PetscCall(setSurface(uDprev));
+      PetscCall(fom.elas.GlobalToLocalWithBC(usurf, uloc));
+      PetscCall(GatherVec(lambda, &lamWarm));
+    }
+    PetscCall(VecDestroy(&uInit_));
+    PetscCall(VecDestroy(&lamInit_));
+    PetscCall(PetscTime(&t1));
+    fom.times.contact += t1 - t0;
+  }
   if (loop.monitor) {
     if (distributed) PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, %" PetscInt_FMT " contact dofs (-1: not counted), dual matrix %s (-fom_dual_matrix %s, -fom_dual_dense_max %" PetscInt_FMT ", -fom_dual_dense_max_dofs %" PetscInt_FMT ")\n", R0, contactDofs, mode.c_str(), dualMatrixOption.c_str(), dualDenseMax, dualDenseMaxDofs));
     else PetscCall(PetscPrintf(comm, "  Kacanov: R = %" PetscInt_FMT " multipliers, dual matrix dense, %d contact dofs, compliance by %s in %.3f s\n", R0, (int)nD, compliance.method.c_str(), (double)compliance.seconds));
@@ -378,7 +432,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
-    if (k == 1) PetscCall(MeasureInitialOverlap(comm));
+    if (k == 1 && !guessed) PetscCall(MeasureInitialOverlap(comm));
     const PetscBool warm = lambda ? PETSC_TRUE : PETSC_FALSE;
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));

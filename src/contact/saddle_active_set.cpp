@@ -342,6 +342,20 @@ PetscErrorCode SaddleActiveSetSolver::GetSolution(Vec u, Vec lambda) const
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode SaddleActiveSetSolver::SetActiveSet(Vec lambda)
+{
+  const PetscScalar *la;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(lambda, &n));
+  PetscCall(VecGetArrayRead(lambda, &la));
+  active_.assign(n, 0);
+  for (PetscInt i = 0; i < n; ++i) active_[i] = PetscRealPart(la[i]) > 0;
+  PetscCall(VecRestoreArrayRead(lambda, &la));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SaddleActiveSetSolver::SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda)
 {
   KSPConvergedReason reason;

@@ -15,6 +15,7 @@
 #include "rbcontact/fom.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
+#include "rbcontact/snapshot_continuation.hpp"
 #include "rbcontact/snapshot_file.hpp"
 #include "rbcontact/snapshot_sensitivity.hpp"
 #include "rbcontact/training_set.hpp"
@@ -29,13 +30,14 @@ static PetscLogEvent OFF_Snapshots = 0, OFF_SnapshotSolve = 0, OFF_SnapshotIO = 
 
 PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
 {
-  char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64];
+  char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64], guess[64];
   PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE, sens = s->sensitivities ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(romPath, s->rom.c_str(), sizeof romPath));
   PetscCall(PetscStrncpy(trainType, s->trainType.c_str(), sizeof trainType));
   PetscCall(PetscStrncpy(viewPath, s->basisView.c_str(), sizeof viewPath));
+  PetscCall(PetscStrncpy(guess, s->initialGuess.c_str(), sizeof guess));
   if (s->stop == OfflineStop::Snapshots) PetscCall(PetscStrncpy(stop, "snapshots", sizeof stop));
   if (s->stop == OfflineStop::Bases) PetscCall(PetscStrncpy(stop, "bases", sizeof stop));
   // the companion files' defaults follow -rom, so -help lists them after it
@@ -72,8 +74,10 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
       PetscCall(PetscFree(from[i]));
     }
   }
+  PetscCall(PetscOptionsString("-snapshots_initial_guess", "a contact snapshot's solve starts from: zero (the reference configuration) or nearest (its group's nearest snapshot solved earlier in this run, extrapolated by its sensitivities if stored; docs/offline.md)", "", guess, guess, sizeof guess, NULL));
   PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));
   PetscOptionsEnd();
+  PetscCheck(!strcmp(guess, "zero") || !strcmp(guess, "nearest"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-snapshots_initial_guess %s: unknown (zero or nearest)", guess);
   PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
   s->stop      = !strcmp(stop, "rom") ? OfflineStop::Rom : !strcmp(stop, "bases") ? OfflineStop::Bases : OfflineStop::Snapshots;
   s->rom       = romPath;
@@ -84,6 +88,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   s->sensitivities = sens;
   s->trainType = trainType;
   s->basisView = viewPath;
+  s->initialGuess = guess;
   PetscFunctionReturn(0); // the files are checked by RunOffline, before any work
 }
 
@@ -274,6 +279,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     // Solves the training points list (indices into train.points) in rounds of k, one per group of ranks;
     // every finished round is written before the next starts.
     PetscInt solvedNow = 0;
+    // -snapshots_initial_guess nearest: this group's solutions of this run, the next solve's start
+    const bool           nearest = s.initialGuess == "nearest";
+    std::vector<PetscReal> ranges;
+    for (const auto &p : scene.params) ranges.push_back(p.max - p.min);
+    SnapshotContinuation continuation(ranges);
     auto solveList = [&](const std::vector<PetscInt> &list) -> PetscErrorCode {
       const PetscInt rounds = ((PetscInt)list.size() + k - 1) / k;
       for (PetscInt r = 0; r < rounds; ++r) {
@@ -291,6 +301,14 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           std::vector<PetscReal> u, lam, gap;
           if (scene.contact) {
             cmap.SetGeometry(&fom.map, mu);
+            if (nearest) { // -snapshots_initial_guess nearest
+              Vec       ug, lg;
+              PetscReal dist;
+              PetscCall(continuation.Predict(mu, &ug, &lg, &dist));
+              if (ug) PetscCall(kac.SetInitialGuess(ug, lg));
+              PetscCall(VecDestroy(&ug));
+              PetscCall(VecDestroy(&lg));
+            }
             PetscCall(kac.Solve(fom, cmap));
             PetscCall(PetscTime(&s1)); // the snapshot's seconds: the FOM solve's (validate -test_snapshots reports them)
             if (!multOrderBuilt) {
@@ -306,9 +324,9 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
           PetscCall(order.DofsToCanonical(fom.u, &u));
           PetscCall(PetscLogEventEnd(OFF_SnapshotSolve, 0, 0, 0, 0));
           std::vector<std::vector<PetscReal>> dus, dls;
+          std::vector<Vec>                    dv, dl;
           if (sensOn) { // after the solve's time: the snapshot's seconds stay the FOM's
-            std::vector<Vec> dv, dl;
-            SensitivityInfo  si;
+            SensitivityInfo si;
             PetscCall(ParameterSensitivities(fom, cmap, kac, &dv, &dl, &si));
             for (PetscInt i = 0; i < np; ++i) {
               dus.emplace_back();
@@ -318,13 +336,16 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
               const PetscReal w = scene.params[i].max - scene.params[i].min; // the derivative over the whole range
               for (auto &x : dus.back()) x *= w;
               for (auto &x : dls.back()) x *= w;
-              PetscCall(VecDestroy(&dv[i]));
-              PetscCall(VecDestroy(&dl[i]));
             }
             sensSeconds += si.seconds;
             sensIts    = std::max(sensIts, si.cgIterations);
             sensActive = std::max(sensActive, si.active);
             sensMethod = si.method;
+          }
+          if (nearest && scene.contact) PetscCall(continuation.Add(mu, fom.u, kac.lambda, dv, dl));
+          for (size_t i = 0; i < dv.size(); ++i) {
+            PetscCall(VecDestroy(&dv[i]));
+            PetscCall(VecDestroy(&dl[i]));
           }
           if (grank == 0) {
             size_t o = 1;
@@ -429,6 +450,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     rep.root["fom_solves"]  = (long long)allIts.size();
     rep.root["resumed"]     = (long long)(done.size() - (size_t)imported); // in the file before this run
     rep.root["imported"]    = (long long)imported;       // copied by -snapshots_from
+    rep.root["initial_guess"] = s.initialGuess;          // -snapshots_initial_guess
     rep.root["ndofs"]       = (long long)ndofs;
     rep.root["ncontact"]    = (long long)R;
     JsonValue &ki           = rep.root["kacanov_iterations"];
