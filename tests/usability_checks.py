@@ -148,7 +148,8 @@ def help_(args):
                 "-train_size", "-report", "-pod_inner", "-pod_tol", "-pod_supremizers", "-pod_supremizers_infsup", "-dual_type", "-dual_tol",
                 "-dual_mass_weighted", "-rom_hyper", "-ecsw_tol", "-ecsw_fit", "-ecsw_fit_force", "-eim_quadrature_subdivisions", "-eim_patch_rings",
                 "-eim_select", "-eim_select_slack", "-eim_kappa_tol", "-rom_kacanov_max_it", "-offline_basis_output", "-snapshots_sensitivities",
-                "-dual_sensitivity_step", "-ecsw_distribute_states", "-dual_select_size", "-dual_select_snapshots", "-dual_select_slack", "-dual_select_R"):
+                "-dual_sensitivity_step", "-ecsw_distribute_states", "-dual_select_size", "-dual_select_snapshots", "-dual_select_slack", "-dual_select_R",
+                "-snapshots_initial_guess"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "offline -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "offline with the shipped scene: no rbcontact warning (unused option)")
     p = run(args, 1, ["online", "-rom", rom, "-help"])
