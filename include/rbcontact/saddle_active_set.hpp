@@ -16,7 +16,9 @@
 // Options (prefix fom_saddle_): -pdas_max_it (100), -pdas_tol (1e-10), -pdas_inner, -pdas_monitor,
 // -pdas_rtol_loose (1e-4: the solves of a cold start while the set changes; its last set is solved again exactly),
 // -reuse_max_changes (10), -previous_guess (on: each step's Krylov solve starts from the last step's solution of
-// this parameter, the inactive rows zeroed; the stopping test stays rtol |b|), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
+// this parameter, the inactive rows zeroed; the stopping test stays rtol |b|), -rtol_forcing c (0: off; else the
+// last solve of a Kacanov iterate to c times the iterate's change, within [-ksp_rtol, -pdas_rtol_loose]: Solve's
+// change argument), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
 // fieldsplit with GAMG on the u block and LU on the selfp Schur complement), -ksp_* / -pc_* of the solver
 // (the u and lambda blocks are the fields "u" and "lambda" of a PCFIELDSPLIT).
 #pragma once
@@ -33,6 +35,7 @@ struct SaddleInfo {
   PetscInt  krylov         = 0; // GMRES iterations of all steps
   PetscInt  changed        = 0; // rows whose status changed after the last step (0: the set is the solution's)
   PetscInt  nactive        = 0; // size of the set of the last step
+  PetscBool exact          = PETSC_TRUE; // the last step solved to -fom_saddle_ksp_rtol (not to a forcing tolerance)
   PetscReal seconds        = 0; // wall time of the Solve
   std::string kspType, pcType;  // the solver that ran (-fom_saddle_solver's preset or the user's)
 };
@@ -50,8 +53,11 @@ public:
   // last call (the previous Kacanov iterate or parameter), else from the empty set (the unconstrained u
   // decides the first set). converge (or -pdas_inner, or no kept set): step until the set does not change;
   // else one step (info->changed > 0: the set moved, the QP at this K, g is not solved yet).
+  // change: the Kacanov loop's last relative change of u (1 on its first iterate; 0: solve exactly); with
+  // -rtol_forcing c > 0 the last step is solved to c * change (within [-ksp_rtol, -pdas_rtol_loose]) instead of
+  // -ksp_rtol (info->exact false), an inexact Kacanov iterate whose error stays below the change it measures.
   // Out: u, lambda of the last step's set (lambda = 0 off it).
-  PetscErrorCode Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info);
+  PetscErrorCode Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info, PetscReal change = 0);
   // One solve with the set and the matrix of the last step, no set update:
   //   [A  K_P'] [u     ]   [f  ]
   //   [K_P  0 ] [lambda] = [g_P],  P the set, lambda = 0 off it
@@ -74,6 +80,7 @@ public:
   PetscInt  maxIt   = 100;
   PetscReal setTol  = 1e-10;
   PetscReal looseRtol = 1e-4; // -pdas_rtol_loose
+  PetscReal forcing   = 0;    // -rtol_forcing: the last solve of a Kacanov iterate to forcing x its change (0: to -ksp_rtol)
   PetscBool inner   = PETSC_FALSE; // -pdas_inner: to convergence on every Kacanov iterate
   PetscBool monitor = PETSC_FALSE;
   PetscInt  reuseMaxChanges = 10; // -reuse_max_changes

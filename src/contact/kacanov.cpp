@@ -443,7 +443,10 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
       // the QP on the saddle point: to convergence of the active set on the first iterate, then one
       // active-set step per iterate (the set and the geometry converge together; docs/contact.md)
       PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
-      PetscCall(saddle_.Solve(fom.A, fom.f, sys.K, sys.g, warm, k == 1 ? PETSC_TRUE : PETSC_FALSE, fom.u, lambda, &lastSaddle));
+      // -fom_saddle_rtol_forcing: the saddle point to a tolerance tied to the last change of u (1 on the first
+      // iterate), exactly once that change is within 100x of -kacanov_rtol_primal
+      const PetscReal change = k == 1 ? 1.0 : duPrev > 100 * loop.rtolPrimal ? duPrev : 0.0;
+      PetscCall(saddle_.Solve(fom.A, fom.f, sys.K, sys.g, warm, k == 1 ? PETSC_TRUE : PETSC_FALSE, fom.u, lambda, &lastSaddle, change));
       PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
       nact = lastSaddle.nactive;
       history.dualSteps.push_back(lastSaddle.steps);
@@ -581,6 +584,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     bool done = false;
     PetscCall(loop.Record(comm, k, du, dl, nact, sys.R, detail, &done));
     if (saddle && lastSaddle.changed) done = false; // the set moved: this K, g's QP is not solved yet
+    if (saddle && !lastSaddle.exact) done = false;  // solved to a forcing tolerance: the next iterate solves exactly
     if (!lamPrev) PetscCall(VecDuplicate(lambda, &lamPrev));
     PetscCall(VecCopy(lambda, lamPrev));
     if (distributed) PetscCall(VecCopy(fom.u, uprev));

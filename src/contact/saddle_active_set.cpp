@@ -46,6 +46,7 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     solver = types[t];
   }
   PetscCall(PetscOptionsReal("-pdas_rtol_loose", "Relative tolerance of the solves while the set still changes on a cold start (the last set is solved to -fom_saddle_ksp_rtol)", "docs/contact.md", looseRtol, &looseRtol, NULL));
+  PetscCall(PetscOptionsReal("-rtol_forcing", "Solve a Kacanov iterate's saddle point to this times the loop's last relative change of u, within [-fom_saddle_ksp_rtol, -fom_saddle_pdas_rtol_loose]; the loop stops only after an exact one (0: every iterate exactly; docs/fom_speed.md)", "docs/fom_speed.md", forcing, &forcing, NULL));
   PetscCall(PetscOptionsBool("-previous_guess", "Start each step's Krylov solve from the last step's solution of the parameter (the stopping test stays rtol |b|)", "docs/contact.md", previousGuess, &previousGuess, NULL));
   PetscCall(PetscOptionsInt("-reuse_max_changes", "Solve with the last factorization (GMRES) while at most this many rows changed status since it (-1: factor every step)", "docs/contact.md", reuseMaxChanges, &reuseMaxChanges, NULL));
   PetscOptionsEnd();
@@ -488,7 +489,7 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info)
+PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBool warm, PetscBool converge, Vec u, Vec lambda, SaddleInfo *info, PetscReal change)
 {
   MPI_Comm              comm = PetscObjectComm((PetscObject)A);
   PetscLogDouble        t0, t1;
@@ -518,10 +519,15 @@ PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBoo
   }
   std::vector<std::vector<char>> seen; // the sets of this call's steps (a set that comes back on every rank is a cycle)
   bool loose = toEnd && canReuse_ && looseRtol > exactRtol_; // loose solves while the set changes, then the last set exactly
+  // -rtol_forcing: the last set to forcing x the Kacanov change instead of exactly (never looser than the loose solves)
+  const PetscReal last = forcing > 0 && change > 0 ? std::max(exactRtol_, std::min(forcing * change, std::max(looseRtol, exactRtol_))) : exactRtol_;
+  PetscReal used = exactRtol_; // the tolerance of the last step
   for (;;) {
     seen.push_back(active_);
-    PetscCall(Step(A, f, K, g, loose ? looseRtol : exactRtol_, u, lambda, info));
-    if (!info->changed && loose) { // the set settled under loose solves: the same set once more, exactly
+    used = loose ? looseRtol : last;
+    PetscCall(Step(A, f, K, g, used, u, lambda, info));
+    if (!info->changed && loose && last >= looseRtol) break; // settled under loose solves, as loose as the last one may be
+    if (!info->changed && loose) { // the set settled under loose solves: the same set once more, to the last tolerance
       loose = false;
       seen.clear();
       continue;
@@ -535,6 +541,7 @@ PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBoo
   }
   PetscCall(PetscTime(&t1));
   info->seconds = t1 - t0;
+  info->exact   = used <= exactRtol_ ? PETSC_TRUE : PETSC_FALSE;
   {
     KSPType kt;
     PCType  pt;
