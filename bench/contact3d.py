@@ -208,8 +208,8 @@ def rom3d(args, extra):
         select = [] if tag == "scene" else ["-dual_select_size", "6"]
         # the training solves start from their nearest solved neighbour (docs/offline.md "Initial guesses") and, on the
         # saddle path (finest), solve each Kacanov iterate's saddle point to 1e-3 of its change (docs/fom_speed.md "Inexact
-        # Kacanov iterates"); the test and held-out sets' FOM solves run the default FOM (their seconds are the FOM time
-        # the speedup divides)
+        # Kacanov iterates"); the test set's FOM solves run the default FOM (their seconds are the FOM time the speedup
+        # divides)
         near = ["-snapshots_initial_guess", "nearest", "-fom_saddle_rtol_forcing", "1e-3"]
         steps = [("offline", ["-rom", out + "/rom.h5", "-snapshots", out + "/snap.h5", "-report", out + "/off.json"] + select + near),
                  ("validate", ["-rom", out + "/rom.h5", "-report", out + "/val.json"])]
@@ -218,13 +218,15 @@ def rom3d(args, extra):
         snapjson = out + "/snap%s.json" % sfx
         if args.rom_workdir:  # every step resumable: the snapshots of training and test set checkpointed, a finished step kept
             test, train = out + "/test.h5", out + "/snap%s.h5" % sfx
+            # the order: what the offline stage needs (training, held-out, refinement), the offline stage (the longest
+            # step: start it as early as possible), then the test set's FOM solves (whose stored seconds the speedup
+            # divides: run them on a quiet machine) and validate
             steps = [("offline", ["-offline_stop", "snapshots", "-snapshots", out + "/snap.h5", "-snapshots_restart", "-snapshots_monitor",
                                   "-report", out + "/snap.json"] + near),
-                     ("offline:test", ["-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
-                                  "-snapshots_subcomm", "1", "-snapshots", test, "-snapshots_restart", "-snapshots_monitor", "-report", out + "/test.json"]),
-                     # the held-out FOM solutions the offline stage chooses R on (seed 11, not the test set's 7), checkpointed
+                     # the held-out FOM solutions the offline stage chooses R on (seed 11, not the test set's 7), checkpointed;
+                     # their seconds are not read: the training solves' options
                      ("offline:test", ["-offline_stop", "snapshots", "-train_type", "random", "-train_size", "6", "-train_seed", "11",
-                                  "-snapshots_subcomm", "1", "-snapshots", out + "/held6.h5", "-snapshots_restart", "-snapshots_monitor", "-report", out + "/held6.json"])]
+                                  "-snapshots_subcomm", "1", "-snapshots", out + "/held6.h5", "-snapshots_restart", "-snapshots_monitor", "-report", out + "/held6.json"] + near)]
             trainset = []
             if refine:  # the grid's worst cells' centres added, the grid's snapshots copied (docs/greedy_training.md)
                 tfile = out + "/train%s.txt" % sfx
@@ -234,10 +236,12 @@ def rom3d(args, extra):
                           ("offline", trainset + ["-offline_stop", "snapshots", "-snapshots", train, "-snapshots_from", out + "/snap.h5",
                                                   "-snapshots_restart", "-snapshots_monitor", "-report", snapjson] + near)]
             select = [] if tag == "scene" else ["-dual_select_snapshots", out + "/held6.h5"]
-            steps += [("offline", trainset + ["-rom", out + "/rom%s.h5" % sfx, "-snapshots", train, "-snapshots_restart", "-report", out + "/off%s.json" % sfx] + select),
+            build = ("offline", trainset + ["-rom", out + "/rom%s.h5" % sfx, "-snapshots", train, "-snapshots_restart", "-report", out + "/off%s.json" % sfx] + select)
+            if not (os.path.exists(out + "/off%s.json" % sfx) and os.path.exists(out + "/rom%s.h5" % sfx)):
+                steps.append(build)  # else the ROM of an earlier run (delete off*.json to rebuild it)
+            steps += [("offline:test", ["-offline_stop", "snapshots", "-train_type", "random", "-train_size", "20", "-train_seed", "7",
+                                        "-snapshots_subcomm", "1", "-snapshots", test, "-snapshots_restart", "-snapshots_monitor", "-report", out + "/test.json"]),
                       ("validate", ["-rom", out + "/rom%s.h5" % sfx, "-test_snapshots", test, "-report", out + "/val%s.json" % sfx])]
-            if os.path.exists(out + "/off%s.json" % sfx) and os.path.exists(out + "/rom%s.h5" % sfx):
-                steps = steps[:-2] + steps[-1:]  # the ROM of an earlier run (delete off*.json to rebuild it)
         for stage, more in steps:
             opts = base
             if stage == "offline:test":  # the test and held-out sets' FOM solutions: no sensitivities
