@@ -17,9 +17,11 @@ Tables:
      Mc, max relative errors u, lambda, force (targets 1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median,
      speedup (target 1e4 at the finest level). --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of
      ~10 s). With --rom-workdir DIR every step is kept in DIR/<mesh> and resumed by the next run (the finest level needs
-     it: 36 + 20 FOM solves of 6-8 min): training snapshots, the test set's FOM solutions (offline -offline_stop
-     snapshots, read by validate -test_snapshots: the FOM median is theirs), the ROM, validate; each command and its
-     output go to DIR/<mesh>/bench.log. --rom-refine K (meshes trained with sensitivity snapshots, with --rom-workdir):
+     it: 44 + 6 + 20 FOM solves of 40-90 s), in this order: the training snapshots (from their nearest solved
+     neighbour, with inexact Kacanov iterates: -snapshots_initial_guess nearest -fom_saddle_rtol_forcing 1e-3), the
+     held-out ones, the ROM, the test set's FOM solutions (offline -offline_stop snapshots with the default FOM, read
+     by validate -test_snapshots: the FOM median is theirs), validate; each command and its output go to
+     DIR/<mesh>/bench.log. --rom-refine K (meshes trained with sensitivity snapshots, with --rom-workdir):
      after the grid's snapshots, share/refine_training.py adds the centres of the K grid cells whose multipliers the
      corners' sensitivities predict worst, offline -snapshots_from copies the grid's snapshots and solves those K, and
      the ROM is built on the refined set (files *_refineK.*, the grid's own kept; docs/greedy_training.md).
