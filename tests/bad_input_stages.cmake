@@ -41,6 +41,7 @@ rbc_bad_stage(output_dir_online "-rom_reconstruct /nonexistent_rbc/f.h5: cannot 
 rbc_bad_stage(output_dir_validate "-report /nonexistent_rbc/v.json: cannot write there" validate -options_file runs/ring_on_block.opts -rom nosuch.h5 -report /nonexistent_rbc/v.json)
 rbc_bad_stage(output_dir_dualbasis "-dual_out /nonexistent_rbc/w.h5: cannot write there" dualbasis -snapshots nosuch.h5:/lambda -dual_out /nonexistent_rbc/w.h5)
 # a gmsh 2.2 file whose entity tag equals another physical group's tag (PETSc 3.18 would mislabel it)
+rbc_bad_stage(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be in [[]0, 1[)]" fom -options_file runs/ring_on_block.opts -fom_dual_matrix saddle -fom_saddle_rtol_forcing -1)
 rbc_bad_stage(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of physical group 'master'[)] has the tag of physical group 'pin_core'" fom -options_file runs/hard_cases/pin_in_hole.opts -mesh_file @PIN_MSH22@)
 # the same refusals on 2 ranks (every rank stops with the message, no hang)
 function(rbc_bad_stage_np2 name regex)

@@ -70,6 +70,8 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
   }
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
   PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
+  PetscCheck(looseRtol > 0 && looseRtol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_rtol_loose %g must be in (0, 1)", prefix_.c_str(), (double)looseRtol);
+  PetscCheck(forcing >= 0 && forcing < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%srtol_forcing %g must be in [0, 1) (0: every Kacanov iterate solved exactly)", prefix_.c_str(), (double)forcing);
   PetscFunctionReturn(0);
 }
 
