@@ -646,11 +646,12 @@ def dual_select(args):
           % (ds["heldout"], Rs, ds["R"], ds["N"], ds["R_stored"], ds["max_rel_err_lambda"], ds["max_rel_err_lambda_all"]))
     check(ds["enabled"] and ds["heldout"] == 6 and Rs == sorted(set(Rs)) and Rs[-1] == ds["R_stored"] == off["rom"]["R"] and Rs[0] == -(-ds["R_stored"] // 2),
           "16 candidates from ceil(R / 2) to R = %d, sorted and distinct (%d)" % (ds["R_stored"], len(Rs)))
-    # the rule, recomputed: the smallest R whose lambda error is within 10 % of the best and whose u and force errors (max
-    # and mean) are within 10 % of those with every dual vector
+    # the rule, recomputed: the smallest R whose lambda error is within the slack (default 0) of the best and whose u and
+    # force errors (max and mean) are within the guard (default 10 %) of those with every dual vector
+    check(ds["slack"] == 0 and ds["guard"] == 0.1, "the defaults: slack %g (0), guard %g (0.1)" % (ds["slack"], ds["guard"]))
     best, a = min(r["max_rel_err_lambda"] for r in rows), rows[-1]
-    adm = [r["R"] for r in rows if not r["failed"] and r["max_rel_err_lambda"] <= 1.1 * best
-           and all(r[k + q] <= 1.1 * a[k + q] for k in ("max_rel_err_", "mean_rel_err_") for q in ("u", "force"))]
+    adm = [r["R"] for r in rows if not r["failed"] and r["max_rel_err_lambda"] <= (1 + ds["slack"]) * best
+           and all(r[k + q] <= (1 + ds["guard"]) * a[k + q] for k in ("max_rel_err_", "mean_rel_err_") for q in ("u", "force"))]
     want = min(adm) if adm else a["R"]
     check(ds["R"] == want and off["rom"]["R_in_use"] == want, "the chosen R %d = the rule's on the table (%d)" % (ds["R"], want))
     with h5py.File(rom, "r") as f:
@@ -684,6 +685,7 @@ def dual_select(args):
           "-dual_select_snapshots: the same choice (R %d) and table to %.1e (<= 1e-6)" % (ds2["R"], dev))
     # bad input: before the snapshots, or at the end naming the option
     for extra, words, what in ((["-dual_select_size", "6", "-dual_select_slack", "-1"], ["-dual_select_slack", "-1"], "negative slack"),
+                               (["-dual_select_size", "6", "-dual_select_guard", "11"], ["-dual_select_guard", "11"], "guard out of range"),
                                (["-dual_select_snapshots", d + "/nosuch.h5"], ["-dual_select_snapshots", "nosuch.h5"], "missing held-out file"),
                                (["-dual_select_size", "6", "-estimate"], ["-estimate", "-dual_select_size"], "with -estimate"),
                                (["-dual_select_size", "6", "-dual_select_R", "10,0"], ["-dual_select_R", "0"], "a candidate of 0 dual vectors")):

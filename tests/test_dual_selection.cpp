@@ -1,6 +1,6 @@
 // tests/test_dual_selection.cpp: the offline choice of the answer's dual vectors (dual_selection.hpp) on hand-made
-// tables: ChooseDualSize's rule (lambda within the slack of the best, u and force (max and mean) within it of every dual vector's,
-// the smallest such R; failed rows never; none admissible: every dual vector) and DualSelectionCandidates (evenly
+// tables: ChooseDualSize's rule (lambda within the slack of the best, u and force (max and mean) within the guard of every
+// dual vector's, the smallest such R; the defaults: the best lambda; failed rows never; none admissible: every dual vector) and DualSelectionCandidates (evenly
 // spaced from ceil(f R) to R, a given list with R added and larger values left out).
 #include "rbcontact/dual_selection.hpp"
 #include "test_check.hpp"
@@ -29,31 +29,48 @@ int main(int argc, char **argv)
   MPI_Comm c = PETSC_COMM_WORLD;
   { // the finest 3D level's held-out table (docs/rom3d.md): 110 best on lambda, u and force no worse
     std::vector<DualSizeRow> t{Row(110, 1.616e-4, 1.483e-2, 1.409e-4), Row(130, 1.655e-4, 1.654e-2, 1.471e-4), Row(162, 1.647e-4, 1.846e-2, 1.605e-4)};
-    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1)].R == 110, "finest table: R 110", (double)t[rbc::ChooseDualSize(t, 0.1)].R, 110));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1, 0.1)].R == 110, "finest table: R 110", (double)t[rbc::ChooseDualSize(t, 0.1, 0.1)].R, 110));
     // with a 20 % slack 130 is within it of the best lambda (1.654 <= 1.2 x 1.483) but 110 is still smaller
-    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.2)].R == 110, "slack 0.2: still the smallest admissible, R 110", (double)t[rbc::ChooseDualSize(t, 0.2)].R, 110));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.2, 0.1)].R == 110, "slack 0.2: still the smallest admissible, R 110", (double)t[rbc::ChooseDualSize(t, 0.2, 0.1)].R, 110));
+  }
+  { // the finest level's held-out table of 2026-11-28 (docs/dual_basis.md): flat in lambda within 10 % from R 81 to 124, so
+    // a 10 % slack walks to the candidates' floor (R 81: lambda 2.55e-2 and 2.11e-2 on two test sets), the defaults
+    // take the best (R 108: 1.74e-2, 1.58e-2). Maxima and means of the offline report.
+    std::vector<DualSizeRow> t{Row(81, 1.6445e-4, 1.6102e-2, 1.5240e-4), Row(92, 1.6514e-4, 1.5852e-2, 1.5053e-4), Row(108, 1.6122e-4, 1.4982e-2, 1.4173e-4),
+                               Row(124, 1.6493e-4, 1.5947e-2, 1.4984e-4), Row(162, 1.6480e-4, 1.8561e-2, 1.6194e-4)};
+    const double meanU[] = {1.3298e-4, 1.3022e-4, 1.2807e-4, 1.2645e-4, 1.2383e-4}, meanF[] = {8.054e-5, 7.732e-5, 7.683e-5, 7.341e-5, 8.278e-5};
+    for (size_t k = 0; k < t.size(); ++k) {
+      t[k].meanU     = meanU[k];
+      t[k].meanForce = meanF[k];
+    }
+    const rbc::DualSelectionOptions o;
+    PetscCall(Check(c, o.slack == 0 && o.guard == 0.1, "defaults: -dual_select_slack 0, -dual_select_guard 0.1", (double)o.slack, 0));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, o.slack, o.guard)].R == 108, "finest table 2026-11-28, defaults: the best lambda, R 108", (double)t[rbc::ChooseDualSize(t, o.slack, o.guard)].R, 108));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1, 0.1)].R == 81, "slack 0.1: the floor, R 81", (double)t[rbc::ChooseDualSize(t, 0.1, 0.1)].R, 81));
+    // the guard alone: with 0 the mean u of 108 (1.034x every vector's) is refused, and no smaller R has the best lambda
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.0, 0.0)].R == 162, "guard 0: every dual vector, R 162", (double)t[rbc::ChooseDualSize(t, 0.0, 0.0)].R, 162));
   }
   { // the smallest R within the slack of the best lambda, not the best itself
     std::vector<DualSizeRow> t{Row(10, 1e-4, 3e-2, 1e-4), Row(20, 1e-4, 1.05e-2, 1e-4), Row(30, 1e-4, 1.0e-2, 1e-4), Row(40, 1e-4, 1.2e-2, 1e-4)};
-    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    const size_t k = rbc::ChooseDualSize(t, 0.1, 0.1);
     PetscCall(Check(c, t[k].R == 20, "lambda 1.05e-2 within 10 % of the best 1.0e-2: R 20, not 30", (double)t[k].R, 20));
-    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.0)].R == 30, "slack 0: the best, R 30", (double)t[rbc::ChooseDualSize(t, 0.0)].R, 30));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.0, 0.1)].R == 30, "slack 0: the best, R 30", (double)t[rbc::ChooseDualSize(t, 0.0, 0.1)].R, 30));
   }
   { // a smaller R whose u or force error grows beyond the slack of every dual vector's is not admissible; nor a failed row
     std::vector<DualSizeRow> t{Row(10, 1e-4, 1.0e-2, 5e-4, true), Row(15, 3e-4, 1.0e-2, 1e-4), Row(20, 1e-4, 1.0e-2, 2e-4), Row(25, 1.05e-4, 1.0e-2, 1.05e-4), Row(30, 1e-4, 1.2e-2, 1e-4)};
-    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    const size_t k = rbc::ChooseDualSize(t, 0.1, 0.1);
     PetscCall(Check(c, t[k].R == 25, "failed row, u x3 and force x2 refused: R 25", (double)t[k].R, 25));
   }
   { // the same max errors, but u worse on average at the smaller R (a max over few parameters is set by one of them)
     std::vector<DualSizeRow> t{Row(20, 1e-4, 1.0e-2, 1e-4), Row(25, 1e-4, 1.0e-2, 1e-4), Row(30, 1e-4, 1.0e-2, 1e-4)};
     t[0].meanU = 0.8e-4; // 1.6x every dual vector's mean (0.5e-4): refused
     t[1].meanForce = 0.54e-4; // 1.08x: within the slack
-    const size_t k = rbc::ChooseDualSize(t, 0.1);
+    const size_t k = rbc::ChooseDualSize(t, 0.1, 0.1);
     PetscCall(Check(c, t[k].R == 25, "mean u 1.6x refused, mean force 1.08x admitted: R 25", (double)t[k].R, 25));
   }
   { // nothing admissible (the best lambda's u is worse, every dual vector's lambda is not within the slack): all of them
     std::vector<DualSizeRow> t{Row(20, 5e-4, 1.0e-2, 1e-4), Row(30, 1e-4, 2.0e-2, 1e-4)};
-    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1)].R == 30, "none admissible: every dual vector, R 30", (double)t[rbc::ChooseDualSize(t, 0.1)].R, 30));
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1, 0.1)].R == 30, "none admissible: every dual vector, R 30", (double)t[rbc::ChooseDualSize(t, 0.1, 0.1)].R, 30));
   }
   { // candidates
     rbc::DualSelectionOptions o;

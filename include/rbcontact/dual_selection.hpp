@@ -23,7 +23,9 @@ struct DualSelectionOptions {
   std::string           snapshots;          // -dual_select_snapshots: the held-out FOM solutions from this snapshot file
                                             // (offline -offline_stop snapshots: checkpointed; its parameters are the set;
                                             // it takes precedence over -dual_select_size, e.g. of a scene's options file)
-  PetscReal             slack = 0.1;        // -dual_select_slack
+  PetscReal             slack = 0;          // -dual_select_slack: lambda within it of the best held-out row (0: the best;
+                                            // 0.1 until 2026-11-28, docs/dual_basis.md)
+  PetscReal             guard = 0.1;        // -dual_select_guard: u and force within it of every dual vector's
   PetscReal             minFraction = 0.5;  // -dual_select_min_fraction: the smallest candidate, as a fraction of R
   PetscInt              count = 16;         // -dual_select_count: candidates from there to R, evenly spaced
   std::vector<PetscInt> candidates;         // -dual_select_R: the candidates themselves (R is always added)
@@ -41,15 +43,15 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o);
 std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, PetscInt R);
 
 // The rule (rows: DualSizeRow, validation.hpp): admissible are the rows that did not fail whose max lambda error is
-// within (1 + slack) of the best row's and whose u and force errors, max and mean, are within (1 + slack) of those
-// with every dual vector (the row of the largest R); the admissible row of the smallest R is chosen, the largest R
-// when none is. Returns the chosen row's index.
-size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack);
+// within (1 + slack) of the best row's and whose u and force errors, max and mean, are within (1 + guardSlack) of
+// those with every dual vector (the row of the largest R); the admissible row of the smallest R is chosen, the
+// largest R when none is. Returns the chosen row's index.
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack);
 
 // With the options enabled: validates the ROM at romPath (w: its writer, holding the model) on the held-out FOM
 // solutions for every candidate, chooses R (ChooseDualSize) and, when R is below the stored count, writes
 // /online/dual_select (the file rewritten atomically). Report keys: dual_select {enabled, heldout, seed or
-// snapshots, slack, candidates [validate's sweep_R rows: R, N, max_rel_err_{u,lambda,force},
+// snapshots, slack, guard, candidates [validate's sweep_R rows: R, N, max_rel_err_{u,lambda,force},
 // mean_rel_err_{u,lambda,force}, failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the chosen row),
 // max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use become the
 // chosen sizes; time_s.dual_select its seconds. Collective on world.

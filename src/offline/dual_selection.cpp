@@ -19,7 +19,8 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCall(PetscOptionsInt("-size", "random held-out parameters, solved by the FOM at the end of the offline stage (0: no choice; -dual_select_snapshots takes precedence)", "", o->size, &o->size, NULL));
   PetscCall(PetscOptionsInt("-seed", "seed of those parameters", "", o->seed, &o->seed, NULL));
   PetscCall(PetscOptionsString("-snapshots", "the held-out FOM solutions from this snapshot file (offline -offline_stop snapshots: checkpointed)", "", path, path, sizeof path, &pset));
-  PetscCall(PetscOptionsReal("-slack", "the smallest R whose held-out lambda error is within this relative slack of the best (u, force within it of all R's)", "", o->slack, &o->slack, NULL));
+  PetscCall(PetscOptionsReal("-slack", "the smallest R whose held-out lambda error is within this relative slack of the best (0: the best)", "", o->slack, &o->slack, NULL));
+  PetscCall(PetscOptionsReal("-guard", "an R is admissible only if its held-out u and force errors (max and mean) are within this relative slack of every dual vector's", "", o->guard, &o->guard, NULL));
   PetscCall(PetscOptionsReal("-min_fraction", "the smallest candidate R as a fraction of the dual vectors stored", "", o->minFraction, &o->minFraction, NULL));
   PetscCall(PetscOptionsInt("-count", "candidates from there to all, evenly spaced", "", o->count, &o->count, NULL));
   PetscCall(PetscOptionsIntArray("-R", "the candidates themselves (all dual vectors always added)", "", rbuf, &nr, &rset));
@@ -28,6 +29,7 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   if (rset) o->candidates.assign(rbuf, rbuf + nr);
   PetscCheck(o->size >= 0 && o->size <= 10000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_size %" PetscInt_FMT " out of range [0, 1e4]", o->size);
   PetscCheck(o->slack >= 0 && o->slack <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_slack %g out of range [0, 10]", (double)o->slack);
+  PetscCheck(o->guard >= 0 && o->guard <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_guard %g out of range [0, 10]", (double)o->guard);
   PetscCheck(o->minFraction > 0 && o->minFraction <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_min_fraction %g is not in (0, 1]", (double)o->minFraction);
   PetscCheck(o->count >= 1 && o->count <= 1000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_count %" PetscInt_FMT " out of range [1, 1000]", o->count);
   for (PetscInt r : o->candidates) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
@@ -59,7 +61,7 @@ std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, Pet
   return c;
 }
 
-size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack)
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack)
 {
   size_t all = 0;
   for (size_t k = 1; k < rows.size(); ++k)
@@ -73,7 +75,8 @@ size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack)
     const DualSizeRow &r = rows[k];
     // u and force no worse than with every dual vector, at the worst parameter and on average (a max over a few
     // held-out parameters is set by one of them and hides a change at the others)
-    const bool guard      = a.failed || (r.u <= (1 + slack) * a.u && r.force <= (1 + slack) * a.force && r.meanU <= (1 + slack) * a.meanU && r.meanForce <= (1 + slack) * a.meanForce);
+    const PetscReal g     = 1 + guardSlack;
+    const bool      guard = a.failed || (r.u <= g * a.u && r.force <= g * a.force && r.meanU <= g * a.meanU && r.meanForce <= g * a.meanForce);
     const bool admissible = !r.failed && r.lambda <= (1 + slack) * best && guard;
     if (admissible && (chosen == rows.size() || r.R < rows[chosen].R)) chosen = k;
   }
@@ -117,7 +120,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   PetscCall(RunValidation(world, scene, romPath, held, vs, &vr));
 
   d["candidates"] = vr.root["sweep_R"]; // validate's rows (-validate_sweep_R), one per candidate
-  const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack)], &a = rows.back();
+  const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack, o.guard)], &a = rows.back();
   if (c.R < R) { // R itself: no dataset (the file's default), the file as written
     w->Dataset("/online/dual_select", {1}, {(double)c.R});
     PetscCall(w->Write(world, romPath));
@@ -126,6 +129,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   if (o.snapshots.empty()) d["seed"] = (long long)o.seed;
   else d["snapshots"] = o.snapshots;
   d["slack"]                         = (double)o.slack;
+  d["guard"]                         = (double)o.guard;
   d["R"]                             = (long long)c.R;
   d["N"]                             = (long long)c.N;
   d["R_stored"]                      = (long long)R;
