@@ -191,6 +191,15 @@ def pipeline(args):
     check(same_pts and dw <= 1e-5 and dr2 <= 1e-12 and dek <= 1e-6 * max(cw["train_err_K"]),
           "states split over the ranks = whole on every rank: %d points, weights to %.1e (<= 1e-5), residual %.6e vs %.6e (squares to %.1e <= 1e-12), per-state errors to %.1e"
           % (cg["M"], dw, cg["residual"], cw["residual"], dr2, dek))
+    # the groups' fits dealt to the ranks (-ecsw_share_groups, the default) against every rank fitting every group: the
+    # same Gram matrices on every rank, so the same points and weights bit for bit (a wrong owner or broadcast would not)
+    os.makedirs(d + "/groups_every")
+    _, offe = offline(args, d + "/groups_every", extra=["-ecsw_group_points", "100", "-ecsw_share_groups", "0", "-snapshots", d + "/groups/rom.snapshots.h5", "-snapshots_restart"])
+    ce = offe["ecsw"]
+    with h5py.File(romg, "r") as f, h5py.File(d + "/groups_every/rom.h5", "r") as g:
+        same_every = all(np.array_equal(np.array(f[k]), np.array(g[k])) for k in ("online/ecsw/points", "online/ecsw/Pw"))
+    check(cg["groups"] >= 3 and same_every and ce["group_residuals"] == cg["group_residuals"] and ce["weights"] == cg["weights"],
+          "%d groups on 2 ranks, each fitted by one rank = every rank fitting every group: the same points, weights and group residuals (bit for bit)" % cg["groups"])
     # the same offline stage on 1 rank: the same ROM
     d2 = d + "/np1"
     os.makedirs(d2)

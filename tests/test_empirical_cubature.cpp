@@ -553,7 +553,7 @@ int main(int argc, char **argv)
     oh.groupPoints     = 20;
     CubatureResult    rc;
     CubatureHierarchy hi;
-    PetscCall(HierarchicalCubature(Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &rc, &hi));
+    PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &rc, &hi));
     std::vector<PetscReal> xc(Q, 0.0);
     bool                   pos = !rc.points.empty(), groupsOk = hi.groups == 4 && hi.groupResiduals.size() == 4 && hi.groupTol > 0 && hi.groupTol <= oh.tol;
     for (size_t j = 0; j < rc.points.size(); ++j) {
@@ -568,7 +568,7 @@ int main(int argc, char **argv)
     Check(std::abs(recc - rc.residual) <= 1e-6 * opt.tol + 1e-3 * rc.residual, "hierarchical: residual recomputed against the exact terms over all 80 points (|diff|)", std::abs(recc - rc.residual), 1e-3 * rc.residual);
     CubatureResult r1;
     oh.groupPoints = 80; // one group: the plain fit
-    PetscCall(HierarchicalCubature(Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &r1, &hi));
+    PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &r1, &hi));
     Check(hi.groups == 1 && r1.points == res.points && r1.weights == res.weights, "hierarchical with one group = the plain fit (groups)", (double)hi.groups, 1);
   }
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, failures ? "test_empirical_cubature FAILED (%d failure(s))\n" : "test_empirical_cubature passed\n", failures));

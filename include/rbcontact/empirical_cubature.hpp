@@ -35,6 +35,9 @@ struct CubatureOptions {
   PetscInt  groupPoints = 8000; // -ecsw_group_points: more quadrature points than this: the hierarchical fit
                                 // (HierarchicalCubature); the Gram memory stays about 2.25 x 8 bytes x (this or the union)^2
   bool      monitor   = false; // print "  cubature M = k  rel residual = r" per added point
+  bool      shareGroups = true; // -ecsw_share_groups: the hierarchical fit's groups fitted each by one rank of the
+                                // communicator (in turn), their points then broadcast; false: every rank fits every
+                                // group (the same points and weights, bit for bit; for the test that says so)
   bool      incremental = false; // the Cholesky factor of H(S, S) updated as points enter (O(k^2) a step) instead of
                                  // refactored (O(k^3)); the hierarchical fit's groups and union use it, the one-Gram
                                  // fit keeps the refactoring (its points and weights as before, bit for bit)
@@ -168,6 +171,12 @@ struct CubatureHierarchy {
 // terms within opt.tol (triangle inequality); then the fit of the whole terms (every point's) among the union of the
 // groups' points, which therefore reaches opt.tol. The reported residual is against the exact terms of every point.
 // Errors: a group not reaching tol_g (PETSC_ERR_NOT_CONVERGED, naming -ecsw_max_points and -ecsw_group_points).
-PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info = nullptr);
+// Parallel: collective on comm; gram is called by every rank for every group in the same order (it may sum over comm),
+// and must give every rank the same matrix. With opt.shareGroups the groups' fits (independent once their matrices are
+// formed) are dealt to the ranks in turn, group g to rank g mod size, each rank fitting while the others fit theirs, and
+// the points broadcast: the result is the same bit for bit as every rank fitting every group, in about 1/size of the
+// fits' time (memory: a rank keeps its group's matrix while the next ones of its batch are formed, at most twice one).
+// PETSC_COMM_SELF: the serial fit.
+PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info = nullptr);
 
 } // namespace rbc

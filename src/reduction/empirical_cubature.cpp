@@ -9,6 +9,8 @@
 
 namespace rbc {
 
+static PetscLogEvent CUB_Gram = 0, CUB_Fit = 0; // -log_view: the cubature's Gram systems and its fits
+
 PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, CubatureOptions *opt)
 {
   PetscBool flg = PETSC_FALSE;
@@ -33,6 +35,9 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   flg = opt->monitor ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-monitor", "print the residual per added point", "", flg, &flg, NULL));
   opt->monitor = flg;
+  flg = opt->shareGroups ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-share_groups", "with groups (-group_points): each group fitted by one rank, in turn, its points broadcast (false: every rank fits every group; the same result)", "", flg, &flg, NULL));
+  opt->shareGroups = flg;
   PetscOptionsEnd();
   PetscCheck(opt->tol > 0 && opt->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%stol %g must lie in (0, 1)", pre, (double)opt->tol);
   PetscCheck(opt->maxPoints >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%smax_points %" PetscInt_FMT " must be >= 1", pre, opt->maxPoints);
@@ -723,15 +728,31 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info)
+PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info)
 {
   std::vector<PetscReal> H;
   CubatureHierarchy      hi;
+  PetscMPIInt            rank, size;
 
   PetscFunctionBeginUser;
+  if (!CUB_Gram) {
+    PetscCall(PetscLogEventRegister("RBCCubatureGram", PETSC_SMALLEST_CLASSID, &CUB_Gram));
+    PetscCall(PetscLogEventRegister("RBCCubatureFit", PETSC_SMALLEST_CLASSID, &CUB_Fit));
+  }
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  auto formGram = [&](CubatureCandidates *c) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    PetscCall(PetscLogEventBegin(CUB_Gram, 0, 0, 0, 0));
+    gram(c, &H);
+    PetscCall(PetscLogEventEnd(CUB_Gram, 0, 0, 0, 0));
+    PetscFunctionReturn(0);
+  };
   if (opt.groupPoints <= 0 || Q <= opt.groupPoints) { // one Gram matrix of every point
-    gram(nullptr, &H);
+    PetscCall(formGram(nullptr));
+    PetscCall(PetscLogEventBegin(CUB_Fit, 0, 0, 0, 0));
     PetscCall(EmpiricalCubature(H, Q, opt, res));
+    PetscCall(PetscLogEventEnd(CUB_Fit, 0, 0, 0, 0));
     hi.groups = 1;
     hi.candidates = Q;
     if (info) *info = hi;
@@ -748,7 +769,7 @@ PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, cons
   c.targetOnly = true;
   for (PetscInt g = 0; g < K; ++g) {
     group(g, &c);
-    gram(&c, &H);
+    PetscCall(formGram(&c));
     sumRoot += std::sqrt(std::max<PetscReal>(c.cOwn, 0));
     cAll = c.c;
   }
@@ -759,24 +780,68 @@ PetscErrorCode HierarchicalCubature(PetscInt Q, const CubatureOptions &opt, cons
   og.monitor         = false;
   og.groupPoints     = 0;
   og.incremental     = true; // thousands of points per group: O(k^2) steps
-  PetscCheck(og.tol > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
-  std::vector<PetscInt> U;
-  for (PetscInt g = 0; g < K; ++g) {
+  PetscCheck(og.tol > 0, comm, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
+  // the groups in batches of `share` (the ranks, or 1): every rank forms each group's Gram matrix (gram may be
+  // collective), group b + j is fitted by rank j, which keeps that matrix; then the batch's points are broadcast
+  const PetscMPIInt      share = opt.shareGroups ? size : 1;
+  std::vector<PetscInt>  U;
+  std::vector<PetscReal> Hmine;
+  hi.groupResiduals.assign(K, 0);
+  for (PetscInt b = 0; b < K; b += share) {
+    const PetscInt nb = std::min<PetscInt>(share, K - b);
+    PetscInt       mine = -1; // this rank's group of the batch
+    for (PetscInt j = 0; j < nb; ++j) {
+      group(b + j, &c);
+      PetscCall(formGram(&c));
+      if (share == 1 || j == rank) {
+        mine = b + j;
+        Hmine.swap(H);
+      }
+    }
+    H.clear();
+    H.shrink_to_fit();
     CubatureResult rg;
-    group(g, &c);
-    gram(&c, &H);
-    PetscCall(EmpiricalCubature(H, (PetscInt)c.points.size(), og, &rg)); // the group's own terms
-    PetscCheck(rg.residual <= og.tol, PETSC_COMM_SELF, PETSC_ERR_NOT_CONVERGED, "empirical cubature: group %" PetscInt_FMT " of %" PetscInt_FMT " reaches %g > its tolerance %g with %zu points (-ecsw_max_points %" PetscInt_FMT "; larger -ecsw_group_points: fewer groups)", g, K, (double)rg.residual, (double)og.tol, rg.points.size(), opt.maxPoints);
-    for (PetscInt p : rg.points) U.push_back(c.points[p]);
-    hi.groupResiduals.push_back(rg.residual);
+    PetscInt       failed = 0;
+    if (mine >= 0) { // the fit on this rank's own group; an error here is made collective below (no rank left waiting)
+      group(mine, &c);
+      PetscCall(PetscLogEventBegin(CUB_Fit, 0, 0, 0, 0));
+      failed = EmpiricalCubature(Hmine, (PetscInt)c.points.size(), og, &rg) ? 1 : 0; // the group's own terms
+      PetscCall(PetscLogEventEnd(CUB_Fit, 0, 0, 0, 0));
+      for (auto &p : rg.points) p = c.points[p];
+    }
+    Hmine.clear();
+    Hmine.shrink_to_fit();
+    if (share > 1) PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &failed, 1, MPIU_INT, MPI_MAX, comm));
+    PetscCheck(!failed, comm, PETSC_ERR_LIB, "empirical cubature: the fit of a group of points %" PetscInt_FMT "..%" PetscInt_FMT " of %" PetscInt_FMT " failed (its error above)", b, b + nb - 1, K);
+    for (PetscInt j = 0; j < nb; ++j) { // group b + j's points and residual, from the rank that fitted it
+      const PetscInt         g = b + j;
+      std::vector<PetscInt>  pts;
+      PetscReal              resid = 0;
+      if (g == mine) {
+        pts   = rg.points;
+        resid = rg.residual;
+      }
+      if (share > 1) {
+        PetscInt n = (PetscInt)pts.size();
+        PetscCallMPI(MPI_Bcast(&n, 1, MPIU_INT, (PetscMPIInt)j, comm));
+        pts.resize(n);
+        if (n) PetscCallMPI(MPI_Bcast(pts.data(), (PetscMPIInt)n, MPIU_INT, (PetscMPIInt)j, comm));
+        PetscCallMPI(MPI_Bcast(&resid, 1, MPIU_REAL, (PetscMPIInt)j, comm));
+      }
+      PetscCheck(resid <= og.tol, comm, PETSC_ERR_NOT_CONVERGED, "empirical cubature: group %" PetscInt_FMT " of %" PetscInt_FMT " reaches %g > its tolerance %g with %zu points (-ecsw_max_points %" PetscInt_FMT "; larger -ecsw_group_points: fewer groups)", g, K, (double)resid, (double)og.tol, pts.size(), opt.maxPoints);
+      U.insert(U.end(), pts.begin(), pts.end());
+      hi.groupResiduals[g] = resid;
+    }
   }
   // final fit: the union of the groups' points, against every point's terms
   std::sort(U.begin(), U.end());
   c.points = U;
-  gram(&c, &H);
+  PetscCall(formGram(&c));
   CubatureOptions of = opt;
   of.incremental     = true;
+  PetscCall(PetscLogEventBegin(CUB_Fit, 0, 0, 0, 0));
   PetscCall(EmpiricalCubature(H, Q, of, res, &c));
+  PetscCall(PetscLogEventEnd(CUB_Fit, 0, 0, 0, 0));
   hi.groups     = K;
   hi.candidates = (PetscInt)U.size();
   hi.groupTol   = og.tol;
