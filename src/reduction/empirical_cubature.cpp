@@ -801,18 +801,18 @@ PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOpt
     H.clear();
     H.shrink_to_fit();
     CubatureResult rg;
-    PetscInt       failed = 0;
+    PetscInt       failed = -1; // the group whose fit failed (its error printed by its rank), else -1
     if (mine >= 0) { // the fit on this rank's own group; an error here is made collective below (no rank left waiting)
       group(mine, &c);
       PetscCall(PetscLogEventBegin(CUB_Fit, 0, 0, 0, 0));
-      failed = EmpiricalCubature(Hmine, (PetscInt)c.points.size(), og, &rg) ? 1 : 0; // the group's own terms
+      if (EmpiricalCubature(Hmine, (PetscInt)c.points.size(), og, &rg)) failed = mine; // the group's own terms
       PetscCall(PetscLogEventEnd(CUB_Fit, 0, 0, 0, 0));
       for (auto &p : rg.points) p = c.points[p];
     }
     Hmine.clear();
     Hmine.shrink_to_fit();
     if (share > 1) PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &failed, 1, MPIU_INT, MPI_MAX, comm));
-    PetscCheck(!failed, comm, PETSC_ERR_LIB, "empirical cubature: the fit of a group of points %" PetscInt_FMT "..%" PetscInt_FMT " of %" PetscInt_FMT " failed (its error above)", b, b + nb - 1, K);
+    PetscCheck(failed < 0, comm, PETSC_ERR_LIB, "empirical cubature: the fit of group %" PetscInt_FMT " of %" PetscInt_FMT " failed (its error above, from rank %" PetscInt_FMT ")", failed, K, failed % share);
     for (PetscInt j = 0; j < nb; ++j) { // group b + j's points and residual, from the rank that fitted it
       const PetscInt         g = b + j;
       std::vector<PetscInt>  pts;
