@@ -171,12 +171,13 @@ struct CubatureHierarchy {
 // terms within opt.tol (triangle inequality); then the fit of the whole terms (every point's) among the union of the
 // groups' points, which therefore reaches opt.tol. The reported residual is against the exact terms of every point.
 // Errors: a group not reaching tol_g (PETSC_ERR_NOT_CONVERGED, naming -ecsw_max_points and -ecsw_group_points).
-// Parallel: collective on comm; gram is called by every rank for every group in the same order (it may sum over comm),
+// Parallel: collective on comm; with collectiveGram, gram is called by every rank for every group in the same order (it may sum over comm),
 // and must give every rank the same matrix. With opt.shareGroups the groups' fits (independent once their matrices are
 // formed) are dealt to the ranks in turn, group g to rank g mod size, each rank fitting while the others fit theirs, and
 // the points broadcast: the result is the same bit for bit as every rank fitting every group, in about 1/size of the
 // fits' time (memory: a rank keeps its group's matrix while the next ones of its batch are formed, at most twice one).
-// PETSC_COMM_SELF: the serial fit.
-PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info = nullptr);
+// PETSC_COMM_SELF: the serial fit. collectiveGram false: gram is local (every rank holds every state), and with
+// opt.shareGroups a rank forms only the Gram matrices of the groups it fits (the first pass's targets still all).
+PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info = nullptr, bool collectiveGram = true);
 
 } // namespace rbc

@@ -575,7 +575,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
           PetscCallAbort(world, SumOnEveryRank(world, &c->cOwn, 1));
         }
       };
-    PetscCall(HierarchicalCubature(world, Q, co, gram, &cr, &hier)); // gram: collective when distributed, else the same on every rank
+    PetscCall(HierarchicalCubature(world, Q, co, gram, &cr, &hier, distribute)); // gram: collective when distributed, else local
     PetscCheck(cr.residual <= co.tol, world, PETSC_ERR_NOT_CONVERGED, "offline: the empirical cubature reaches a relative residual %g > -ecsw_tol %g with %zu points (-ecsw_max_points %" PetscInt_FMT "): raise -ecsw_max_points or -ecsw_tol", (double)cr.residual, (double)co.tol, cr.points.size(), co.maxPoints);
     rm.cPoint.clear();
     rm.cPw.assign((size_t)R * cr.points.size(), 0.0);

@@ -728,7 +728,7 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info)
+PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOptions &opt, const CubatureGramFunction &gram, CubatureResult *res, CubatureHierarchy *info, bool collectiveGram)
 {
   std::vector<PetscReal> H;
   CubatureHierarchy      hi;
@@ -781,8 +781,9 @@ PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOpt
   og.groupPoints     = 0;
   og.incremental     = true; // thousands of points per group: O(k^2) steps
   PetscCheck(og.tol > 0, comm, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
-  // the groups in batches of `share` (the ranks, or 1): every rank forms each group's Gram matrix (gram may be
-  // collective), group b + j is fitted by rank j, which keeps that matrix; then the batch's points are broadcast
+  // the groups in batches of `share` (the ranks, or 1): every rank forms each group's Gram matrix when gram is
+  // collective (else only its own), group b + j is fitted by rank j, which keeps that matrix; then the batch's points
+  // are broadcast
   const PetscMPIInt      share = opt.shareGroups ? size : 1;
   std::vector<PetscInt>  U;
   std::vector<PetscReal> Hmine;
@@ -791,6 +792,7 @@ PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOpt
     const PetscInt nb = std::min<PetscInt>(share, K - b);
     PetscInt       mine = -1; // this rank's group of the batch
     for (PetscInt j = 0; j < nb; ++j) {
+      if (!collectiveGram && share > 1 && j != rank) continue; // a local gram: only this rank's group is formed here
       group(b + j, &c);
       PetscCall(formGram(&c));
       if (share == 1 || j == rank) {
