@@ -55,3 +55,4 @@ rbc_bad_stage_np2(output_dir_fom "-report /nonexistent_rbc/r.json: cannot write 
 rbc_bad_stage_np2(mumps_parallel_ordering "INFOG[(]1[)] = -38: a parallel ordering [(]-fom_mat_mumps_icntl_28 2[)]" fom -options_file runs/ring_on_block.opts -mesh_partitioner metis -fom_mat_mumps_icntl_28 2 -fom_mat_mumps_icntl_29 2)
 rbc_bad_stage_np2(output_dir_offline "-rom /nonexistent_rbc/rom.h5: cannot write there" offline -options_file runs/ring_on_block.opts -rom /nonexistent_rbc/rom.h5)
 rbc_bad_stage_np2(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of physical group 'master'[)] has the tag of physical group 'pin_core'" fom -options_file runs/hard_cases/pin_in_hole.opts -mesh_file @PIN_MSH22@)
+rbc_bad_stage_np2(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be in" fom -options_file runs/ring_on_block.opts -fom_dual_matrix saddle -fom_saddle_rtol_forcing -1)
