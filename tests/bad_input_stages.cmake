@@ -39,6 +39,7 @@ rbc_bad_stage(output_is_dir_fom "-fom_output /tmp: cannot write there: it is a d
 rbc_bad_stage(output_dir_offline "-rom /nonexistent_rbc/rom.h5: cannot write there" offline -options_file runs/ring_on_block.opts -rom /nonexistent_rbc/rom.h5)
 rbc_bad_stage(output_dir_online "-rom_reconstruct /nonexistent_rbc/f.h5: cannot write there" online -rom nosuch.h5 -rom_reconstruct /nonexistent_rbc/f.h5)
 rbc_bad_stage(output_dir_validate "-report /nonexistent_rbc/v.json: cannot write there" validate -options_file runs/ring_on_block.opts -rom nosuch.h5 -report /nonexistent_rbc/v.json)
+rbc_bad_stage(validate_threads "-validate_threads: 0 threads is not in [[]1, 256[]]" validate -options_file runs/ring_on_block.opts -rom nosuch.h5 -validate_threads 1,0)
 rbc_bad_stage(output_dir_dualbasis "-dual_out /nonexistent_rbc/w.h5: cannot write there" dualbasis -snapshots nosuch.h5:/lambda -dual_out /nonexistent_rbc/w.h5)
 # a gmsh 2.2 file whose entity tag equals another physical group's tag (PETSc 3.18 would mislabel it)
 rbc_bad_stage(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be in [[]0, 1[)]" fom -options_file runs/ring_on_block.opts -fom_dual_matrix saddle -fom_saddle_rtol_forcing -1)

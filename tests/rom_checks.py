@@ -505,7 +505,7 @@ def sphere_block3d(args):
     vals = {}
     for np_ in (1, 2):
         run(args, np_, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-test_type", "grid", "-test_size", "3",
-                                    "-validate_repeat", "3", "-report", "%s/val%d.json" % (d, np_)])
+                                    "-validate_repeat", "3", "-report", "%s/val%d.json" % (d, np_)] + (["-validate_threads", "1,2"] if np_ == 2 else []))
         vals[np_] = report("%s/val%d.json" % (d, np_))["test"]
     t = vals[2]
     print("  at the 9 training parameters: max rel err u %.2e lambda %.2e force %.2e (online force %.2e)"
@@ -521,6 +521,11 @@ def sphere_block3d(args):
     ot = report("%s/val2.json" % d)["online_time_s"]
     check(ot["timed_on"] == "rank 0, the other ranks waiting" and len(ot["per_parameter_median"]) == 9 and min(ot["per_parameter_median"]) > 0,
           "validate on 2 ranks times on rank 0 alone: %s, %d medians > 0" % (ot["timed_on"], len(ot["per_parameter_median"])))
+    # -validate_threads 1,2 (docs/online.md "Threads"): the same solves timed on 1 and 2 threads, each row with its own
+    # medians and speedup; the main timing is the model's -rom_threads (1)
+    bt = ot.get("by_threads", [])
+    check(ot.get("threads") == 1 and [b["threads"] for b in bt] == [1, 2] and all(len(b["per_parameter_median"]) == 9 and min(b["per_parameter_median"]) > 0 and b["speedup_median"] > 0 for b in bt),
+          "validate -validate_threads 1,2: rows %s, each with 9 medians > 0" % [b["threads"] for b in bt])
     # -fom_saddle_solver gamg (memory linear in the dofs, the finest 3D level): the supremizers' A^{-1} is CG + GAMG
     # as well, not a MUMPS factor of A (which outgrew the machine there); the same supremizers to the CG tolerance
     sup = {}
@@ -556,19 +561,26 @@ def sphere_block3d(args):
     hs = {}
     for tag, extra in (("pd", ["-rom_ecsw_sum", "points", "-rom_ecsw_precision", "double"]), ("ps", ["-rom_ecsw_sum", "points", "-rom_gemm", "blas"]),
                        ("psb", ["-rom_ecsw_sum", "points", "-rom_gemm", "builtin"]), ("psa", ["-rom_ecsw_sum", "points"]),
-                       ("ds", ["-rom_ecsw_sum", "dofs"]), ("dsb", ["-rom_ecsw_sum", "dofs", "-rom_gemm", "builtin"])):
+                       ("ds", ["-rom_ecsw_sum", "dofs"]), ("dsb", ["-rom_ecsw_sum", "dofs", "-rom_gemm", "builtin"]),
+                       # -rom_threads (docs/online.md "Threads"): the points split over the threads, each part's sum in
+                       # float added in double: the same solution to the float sums' noise
+                       ("psa2", ["-rom_ecsw_sum", "points", "-rom_threads", "2"]), ("psb3", ["-rom_ecsw_sum", "points", "-rom_gemm", "builtin", "-rom_threads", "3"]),
+                       ("ds2", ["-rom_ecsw_sum", "dofs", "-rom_threads", "2"])):
         run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-report", "%s/sp_%s.json" % (d, tag)] + extra)
         hs[tag] = report("%s/sp_%s.json" % (d, tag))
     names = [hs[t]["rom"]["ecsw_sum"] + "/" + hs[t]["rom"]["ecsw_precision"] + "/" + hs[t]["rom"]["gemm"] for t in ("pd", "ps", "psb", "psa", "ds", "dsb")]
     check(names == ["points/double/blas", "points/single/blas", "points/single/builtin", "points/single/" + ("fused" if avx512 else "blas"),
                     "dofs/single/blas", "dofs/single/builtin"],
           "the reports name the sum, its precision and its gemm (AVX-512F: %s): %s" % (avx512, names))
-    for t in ("ps", "psb", "psa", "ds", "dsb"):
+    thr = [hs[t]["rom"].get("threads") for t in ("psa", "psa2", "psb3", "ds2")]
+    check(thr == [1, 2, 3, 2], "the reports name the threads (-rom_threads; default 1): %s" % thr)
+    for t in ("ps", "psb", "psa", "ds", "dsb", "psa2", "psb3", "ds2"):
         dv = np.linalg.norm(np.array(hs[t]["u_hat"]) - hs["pd"]["u_hat"]) / np.linalg.norm(hs["pd"]["u_hat"])
         df = abs(hs[t]["outputs"]["contact_force"] - hs["pd"]["outputs"]["contact_force"]) / hs["pd"]["outputs"]["contact_force"]
         print("  %s against the points' sum in double: |du|/|u| %.1e, force %.1e" % (t, dv, df))
         check(dv <= 1e-5 and df <= 1e-5, "%s: the same reduced solution as the points' sum in double to %.1e (u), %.1e (force) <= 1e-5" % (t, dv, df))
     expect_error(args, ["-rom", rom, "-mu", "0.93,0.043", "-rom_gemm", "mkl"], ["mkl", "-rom_gemm"], "unknown -rom_gemm")
+    expect_error(args, ["-rom", rom, "-mu", "0.93,0.043", "-rom_threads", "0"], ["-rom_threads", "must be in"], "-rom_threads 0")
     # -rom_gemm fused without AVX-512F (RBC_KERNELS_PORTABLE=1 hides the CPU's vector units): a clear error, and auto
     # falls back to the BLAS
     env = dict(os.environ, RBC_KERNELS_PORTABLE="1")

@@ -88,6 +88,7 @@ public:
   // -fom_dual_matrix saddle, after a Solve: the saddle point of the last Kacanov iterate's K and converged active set
   // with the right-hand side (f, g) (SaddleActiveSetSolver::SolveFixedSet; the parameter sensitivities).
   PetscErrorCode SolveSaddleFixedSet(Vec f, Vec g, Vec u, Vec lam) { return saddle_.SolveFixedSet(f, g, u, lam); }
+  PetscReal      SaddleForcing() const { return saddle_.forcing; } // -fom_saddle_rtol_forcing in use
   Vec            lambda = nullptr;
   ContactSystem  sys;
   KacanovHistory history;

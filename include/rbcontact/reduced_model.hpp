@@ -16,6 +16,7 @@
 #include "rbcontact/affine_decomposition.hpp"
 #include "rbcontact/kacanov_loop.hpp"
 #include "rbcontact/eim.hpp"
+#include "rbcontact/fork_join.hpp"
 #include "rbcontact/reduced_contact.hpp"
 #include "rbcontact/reduced_qp.hpp"
 #include "rbcontact/report.hpp"
@@ -211,6 +212,10 @@ public:
   // The name of the sum in effect (report key rom.gemm): fused, blas or builtin
   const char *GemmName() const { return FusedPointSum() ? "fused" : gemmBlas ? "blas" : "builtin"; }
   bool      recordIterates = false;
+  // -rom_threads n (default 1): the cubature's contact terms on n threads (the patch's displacement, the points'
+  // closest-point scans and kernels, and the points' sum split into n parts of the points; docs/online.md "Threads").
+  // The same answer to the float sums' rounding (the parts' sums added in double).
+  PetscInt  threads = 1;
   ReducedQP qp;
 
 private:
@@ -252,6 +257,8 @@ private:
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
+  ForkJoinHolder         pool_;   // -rom_threads > 1: the workers (a copy of the model starts its own)
+  std::vector<std::vector<PetscReal>> cKt_; // the points' sum of each thread but the first (rp x Na each)
 };
 
 // The stored basis columns of a model of sizes (n, r): the leading n POD modes, then the supremizers of the

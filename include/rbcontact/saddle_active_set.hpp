@@ -16,7 +16,7 @@
 // Options (prefix fom_saddle_): -pdas_max_it (100), -pdas_tol (1e-10), -pdas_inner, -pdas_monitor,
 // -pdas_rtol_loose (1e-4: the solves of a cold start while the set changes; its last set is solved again exactly),
 // -reuse_max_changes (10), -previous_guess (on: each step's Krylov solve starts from the last step's solution of
-// this parameter, the inactive rows zeroed; the stopping test stays rtol |b|), -rtol_forcing c (0: off; else the
+// this parameter, the inactive rows zeroed; the stopping test stays rtol |b|), -rtol_forcing c (1e-3; 0: off, every iterate exactly; else the
 // last solve of a Kacanov iterate to c times the iterate's change, within [-ksp_rtol, -pdas_rtol_loose]: Solve's
 // change argument), -solver direct|gamg (presets: GMRES on a MUMPS LDL^T factor; FGMRES + Schur
 // fieldsplit with GAMG on the u block and LU on the selfp Schur complement), -ksp_* / -pc_* of the solver
@@ -80,7 +80,7 @@ public:
   PetscInt  maxIt   = 100;
   PetscReal setTol  = 1e-10;
   PetscReal looseRtol = 1e-4; // -pdas_rtol_loose
-  PetscReal forcing   = 0;    // -rtol_forcing: the last solve of a Kacanov iterate to forcing x its change (0: to -ksp_rtol)
+  PetscReal forcing   = 1e-3; // -rtol_forcing: the last solve of a Kacanov iterate to forcing x its change (0: to -ksp_rtol; default since 2026-11-28, docs/fom_speed.md)
   PetscBool inner   = PETSC_FALSE; // -pdas_inner: to convergence on every Kacanov iterate
   PetscBool monitor = PETSC_FALSE;
   PetscInt  reuseMaxChanges = 10; // -reuse_max_changes

@@ -30,6 +30,8 @@ struct ValidationSettings {
   std::vector<PetscInt>  rValues;                             // -validate_sweep_R: errors of the model with these numbers of dual
                                                               // vectors (and their supremizers), all POD modes in use (untimed)
   std::vector<DualSizeRow> *rRows = nullptr;                  // when not null: those errors, one row per rValues entry
+  std::vector<PetscInt>  threadValues;                        // -validate_threads: also timed with these -rom_threads
+                                                              // (online_time_s.by_threads [{threads, median, per_parameter_median, speedup_median}])
   bool                   residual = false;                    // -validate_residual: the residual indicator and its effectivity
   bool                   print    = true;                     // the summary line (off for offline -estimate's calibration run)
   std::string            testSnapshots;                       // -test_snapshots: the FOM test solutions from a snapshot file
@@ -46,7 +48,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 // The ROM at romPath (built for scene as configured now: checked) against the FOM at every point of test.
 // Report keys: stage, scene, rom_file, nranks, test and test_exact (= test_no_eim) {n, max_rel_err_u,
 // mean_rel_err_u, max_rel_err_lambda, mean_rel_err_lambda, max_rel_err_force, rel_err_*, max_rel_err_force_online,
-// failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat, timed_on}, fom_time_s {median, all},
+// failed}, test.mu, online_time_s {median, max, per_parameter_median, repeat, timed_on, threads, by_threads}, fom_time_s {median, all},
 // speedup_median, rom_kacanov_iterations, rom {N, R, Mk, Mg, Mc, hyper, ecsw_sum, ndofs}, test_snapshots (the file or
 // ""; with it, the FOM solutions and fom_time_s come from the file: docs/online.md "Validation"); with the sweep
 // also sweep [rows] and sweep_files; with -validate_sweep_R also sweep_R [rows {R, N, max_rel_err_u,

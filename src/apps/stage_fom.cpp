@@ -78,6 +78,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
       sd["steps"]          = (long long)ns;
       sd["factorizations"] = (long long)nf; // numeric factorizations, or preconditioner set-ups with an iterative solver
       sd["krylov"]         = (long long)nk;
+      sd["rtol_forcing"]   = (double)kacanov.SaddleForcing(); // -fom_saddle_rtol_forcing (0: every iterate exactly)
     }
     if (kacanov.contactDofs >= 0) rep.root["contact_dofs"] = (long long)kacanov.contactDofs; // the dofs of the slave and master facets (the rows of the dense G)
     { // the master facets each rank held (-contact_master_search all|near, docs/contact.md "Parallel")

@@ -46,7 +46,7 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     solver = types[t];
   }
   PetscCall(PetscOptionsReal("-pdas_rtol_loose", "Relative tolerance of the solves while the set still changes on a cold start (the last set is solved to -fom_saddle_ksp_rtol)", "docs/contact.md", looseRtol, &looseRtol, NULL));
-  PetscCall(PetscOptionsReal("-rtol_forcing", "Solve a Kacanov iterate's saddle point to this times the loop's last relative change of u, within [-fom_saddle_ksp_rtol, -fom_saddle_pdas_rtol_loose]; the loop stops only after an exact one (0: every iterate exactly; docs/fom_speed.md)", "docs/fom_speed.md", forcing, &forcing, NULL));
+  PetscCall(PetscOptionsReal("-rtol_forcing", "Solve a Kacanov iterate's saddle point to this times the loop's last relative change of u, within [-fom_saddle_ksp_rtol, -fom_saddle_pdas_rtol_loose]; the loop stops only after an exact one (0: every iterate exactly; default 1e-3; docs/fom_speed.md)", "docs/fom_speed.md", forcing, &forcing, NULL));
   PetscCall(PetscOptionsBool("-previous_guess", "Start each step's Krylov solve from the last step's solution of the parameter (the stopping test stays rtol |b|)", "docs/contact.md", previousGuess, &previousGuess, NULL));
   PetscCall(PetscOptionsInt("-reuse_max_changes", "Solve with the last factorization (GMRES) while at most this many rows changed status since it (-1: factor every step)", "docs/contact.md", reuseMaxChanges, &reuseMaxChanges, NULL));
   PetscOptionsEnd();

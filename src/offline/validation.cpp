@@ -17,6 +17,8 @@
 #include "rbcontact/snapshot_contact.hpp"
 #include "rbcontact/mesh.hpp"
 #include <petscblaslapack.h>
+#include <chrono>
+#include <thread>
 #include <algorithm>
 #include <numeric>
 #include <cmath>
@@ -54,6 +56,12 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
     PetscCall(PetscOptionsIntArray("-validate_sweep_R", "also the errors with these numbers of dual vectors (all POD modes; untimed)", "", rbuf, &nr, &rset));
     if (rset) s->rValues.assign(rbuf, rbuf + nr);
   }
+  {
+    PetscInt  tbuf[64], ntb = 64;
+    PetscBool tset = PETSC_FALSE;
+    PetscCall(PetscOptionsIntArray("-validate_threads", "also time the online solves with these numbers of threads (-rom_threads; report online_time_s.by_threads)", "", tbuf, &ntb, &tset));
+    if (tset) s->threadValues.assign(tbuf, tbuf + ntb);
+  }
   PetscCall(PetscOptionsBool("-validate_residual", "also the residual of each reduced solution on the mesh (the greedy indicator) and its effectivity against the energy error", "", residual, &residual, NULL));
   {
     char      path[PETSC_MAX_PATH_LEN] = "";
@@ -66,6 +74,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCheck(s->repeat >= 1 && s->repeat <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_repeat %" PetscInt_FMT " out of range [1, 1e6]", s->repeat);
   if (fset) s->fractions.assign(fbuf, fbuf + nf);
   for (PetscReal f : s->fractions) PetscCheck(f > 0 && f <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_fractions: %g is not in (0, 1]", (double)f);
+  for (PetscInt t : s->threadValues) PetscCheck(t >= 1 && t <= 256, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_threads: %" PetscInt_FMT " threads is not in [1, 256]", t);
   for (PetscInt r : s->rValues) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
   s->sweep       = sweep;
   s->sweepOutput = sweepOut;
@@ -401,7 +410,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   // mediansNoEstimate (may be null): the same timing with -rom_error_estimate false, when the model estimates
   PetscMPIInt rank;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols, std::vector<double> *mediansNoEstimate = nullptr) -> PetscErrorCode {
+  auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols, std::vector<double> *mediansNoEstimate = nullptr, std::vector<std::vector<double>> *mediansByThreads = nullptr) -> PetscErrorCode {
     PetscFunctionBeginUser;
     for (PetscInt j = 0; j < nt; ++j) {
       ReducedSolution sol;
@@ -424,7 +433,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
           }
           med = Median(ts);
         }
-        if (!settings.timeAllRanks) PetscCallMPI(MPI_Bcast(&med, 1, MPI_DOUBLE, 0, comm));
+        if (!settings.timeAllRanks) { // the other ranks wait asleep, not spinning in MPI (a core for -rom_threads)
+          MPI_Request req;
+          int         done = 0;
+          PetscCallMPI(MPI_Ibcast(&med, 1, MPI_DOUBLE, 0, comm, &req));
+          for (;;) {
+            PetscCallMPI(MPI_Test(&req, &done, MPI_STATUS_IGNORE));
+            if (done) break;
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+          }
+        }
         meds->push_back(med);
         PetscFunctionReturn(0);
       };
@@ -435,6 +453,14 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         m.errorEstimate = on;
       }
       if (timed) PetscCall(timeSolves(medians));
+      if (timed && mediansByThreads) { // -validate_threads: the same solves with other numbers of threads
+        const PetscInt t0 = m.threads;
+        for (size_t k = 0; k < settings.threadValues.size(); ++k) {
+          m.threads = settings.threadValues[k];
+          PetscCall(timeSolves(&(*mediansByThreads)[k]));
+        }
+        m.threads = t0;
+      }
       PetscCall(PetscLogEventEnd(VAL_ROM, 0, 0, 0, 0));
       if (!sol.converged) {
         if (!E->failed) E->firstFailure = sol.message;
@@ -474,10 +500,11 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   };
   Errors                E, E0;
   std::vector<double>   medians, mediansNoEstimate;
+  std::vector<std::vector<double>> mediansByThreads(settings.threadValues.size());
   std::vector<PetscInt> romIts;
   std::vector<ReducedSolution> sols;
   exact.errorEstimate = PETSC_FALSE;
-  PetscCall(evaluate(model, true, &E, &medians, &romIts, settings.residual ? &sols : nullptr, &mediansNoEstimate));
+  PetscCall(evaluate(model, true, &E, &medians, &romIts, settings.residual ? &sols : nullptr, &mediansNoEstimate, &mediansByThreads));
   PetscCall(evaluate(exact, false, &E0, nullptr, nullptr, nullptr));
   // the residual indicator of each reduced solution (the greedy's, on the mesh: docs/error_estimate.md) against its
   // energy error: the effectivity an online estimate built on this residual would start from
@@ -568,6 +595,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   if (!mediansNoEstimate.empty()) { // the solve alone, without the error estimate (same parameters, same repeats)
     rep.root["online_time_s"]["median_without_estimate"] = Median(mediansNoEstimate);
     rep.root["online_time_s"]["estimate_cost_ratio"]     = Median(mediansNoEstimate) > 0 ? onlineMedian / Median(mediansNoEstimate) : 0.0;
+  }
+  rep.root["online_time_s"]["threads"] = (long long)model.threads; // -rom_threads of the timing above
+  for (size_t k = 0; k < settings.threadValues.size(); ++k) { // -validate_threads: the same solves on other numbers of threads
+    JsonValue    row;
+    const double med = Median(mediansByThreads[k]);
+    row["threads"]              = (long long)settings.threadValues[k];
+    row["median"]               = med;
+    row["per_parameter_median"] = mediansByThreads[k];
+    row["speedup_median"]       = med > 0 ? Median(fomTimes) / med : 0.0;
+    rep.root["online_time_s"]["by_threads"].Push(row);
   }
   rep.root["test_snapshots"]          = settings.testSnapshots; // "" : the FOM solved here; else fom_time_s as stored
   rep.root["fom_time_s"]["median"]    = fomMedian;

@@ -5,6 +5,7 @@
 #include "dense_kernels.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
+#include <functional>
 #include <numeric>
 #include <cmath>
 #include <cstring>
@@ -13,6 +14,9 @@
 namespace rbc {
 
 static PetscLogEvent ROM_Solve = 0, ROM_Contact = 0, ROM_QP = 0, ROM_Estimate = 0;
+// the cubature's contact terms by phase (-log_view; docs/online.md "Threads"): the patch's displacement and master
+// geometry, the points' scans and kernels, the points' sum
+static PetscLogEvent ROM_CubDisp = 0, ROM_CubPoints = 0, ROM_CubSum = 0;
 
 static PetscErrorCode RegisterEvents()
 {
@@ -22,6 +26,9 @@ static PetscErrorCode RegisterEvents()
     PetscCall(PetscLogEventRegister("RBCOnlineContact", DM_CLASSID, &ROM_Contact));
     PetscCall(PetscLogEventRegister("RBCOnlineQP", DM_CLASSID, &ROM_QP));
     PetscCall(PetscLogEventRegister("RBCOnlineEstimate", DM_CLASSID, &ROM_Estimate));
+    PetscCall(PetscLogEventRegister("RBCOnlineCubDisp", DM_CLASSID, &ROM_CubDisp));
+    PetscCall(PetscLogEventRegister("RBCOnlineCubPoints", DM_CLASSID, &ROM_CubPoints));
+    PetscCall(PetscLogEventRegister("RBCOnlineCubSum", DM_CLASSID, &ROM_CubSum));
   }
   PetscFunctionReturn(0);
 }
@@ -199,6 +206,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["gemm"]           = m.GemmName();
+  (*r)["threads"]        = (long long)m.threads; // -rom_threads
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
   (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
@@ -443,6 +451,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
     }
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
+  PetscCall(PetscOptionsInt("-threads", "threads of the cubature's contact terms (the patch displacement, the points' scans and kernels, the points' sum; docs/online.md \"Threads\")", "", threads, &threads, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's: the offline stage's held-out choice, /online/dual_select, else all but the estimate's enrichment)", "", r, &r, NULL));
   PetscCall(PetscOptionsBool("-error_estimate", "estimate the error of every solve in the enriched spaces of the file (docs/error_estimate.md)", "", errorEstimate, &errorEstimate, NULL));
@@ -451,6 +460,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscOptionsEnd();
   PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCheck(threads >= 1 && threads <= 256, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_threads %" PetscInt_FMT " must be in [1, 256]", threads);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
   PetscCall(qpEst_.SetFromOptions("rom_"));
@@ -747,22 +757,49 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       patch.SetGeometry(&par.map, mu);
       geomMu_ = mu;
     }
+    // -rom_threads: the regions below split over the points (or the patch's rows) on nth threads
+    const int nth  = (int)threads;
+    ForkJoin *pool = nth > 1 ? &pool_.Get(nth) : nullptr;
+    auto      run  = [&](const std::function<void(int)> &f) { pool ? pool->Run(f) : f(0); };
+    // (ContactTerms returns a count, not an error code: the events' calls abort on an error)
+    PetscCallAbort(PETSC_COMM_SELF, RegisterEvents()); // (callers other than Solve: the offline stage's)
+    auto event = [](PetscLogEvent e, bool begin) { PetscCallAbort(PETSC_COMM_SELF, begin ? PetscLogEventBegin(e, 0, 0, 0, 0) : PetscLogEventEnd(e, 0, 0, 0, 0)); };
+    event(ROM_CubDisp, true);
     if (cSingle_ && !cDofs_) { // U = uD + theta(:, cols) v from theta's float copy (half the bytes of the double theta)
-      const PetscInt       ldf = PaddedRows(Na, 8);
+      const PetscInt       ldf = PaddedRows(Na, 8), rows = patch.nnode * patch.dim;
       thread_local std::vector<float>     vf;
       thread_local std::vector<PetscReal> U;
       vf.assign(ldf, 0.0f);
       for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)v[i];
-      U.resize((size_t)patch.nnode * patch.dim);
-      RowDotsSingle(patch.nnode * patch.dim, ldf, cThetaFs_.data(), vf.data(), patch.uD.data(), U.data());
+      U.resize((size_t)rows);
+      // (pointers: a thread_local named inside the lambda would be the worker's own)
+      const float *vfp = vf.data();
+      PetscReal   *Up  = U.data();
+      run([&](int t) {
+        PetscInt a, b;
+        ForkJoin::Part(rows, t, nth, &a, &b);
+        if (b > a) RowDotsSingle(b - a, ldf, cThetaFs_.data() + (size_t)a * ldf, vfp, patch.uD.data() + a, Up + a);
+      });
       patch.SetNodal(U);
     } else patch.SetReduced(vfull.data());
+    event(ROM_CubDisp, false);
     const PetscInt rp = PaddedRows(r);
     SetGemmBlas(gemmBlas); // this model's choice for the sums below (-rom_gemm)
     wn_.resize((size_t)M * patch.dim);
     wnMode_ = ContactMode::Cubature;
-    out = cDofs_ || cSingle_ ? patch.EvaluateCoefficients(cPoint.data(), M, cNt_.data(), cRow_.data(), cCoef_.data(), gam_.data(), wn_.data())
-                             : patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    event(ROM_CubPoints, true);
+    if (cDofs_ || cSingle_) { // the points' closest-point scans and kernels, nth parts of the points
+      std::vector<PetscInt> outs(nth, 0);
+      run([&](int t) {
+        PetscInt a, b;
+        ForkJoin::Part(M, t, nth, &a, &b);
+        const size_t mt = ContactPatch::MaxTerms, d = patch.dim;
+        if (b > a) outs[t] = patch.EvaluateCoefficients(cPoint.data() + a, b - a, cNt_.data() + a, cRow_.data() + a * mt, cCoef_.data() + a * mt, gam_.data() + a, wn_.data() + a * d);
+      });
+      for (PetscInt o : outs) out += o;
+    } else out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
+    event(ROM_CubPoints, false);
+    event(ROM_CubSum, true);
     kapStale_ = cSingle_ && !cDofs_; // kappa's double rows not formed (EstimateError forms them from the terms)
     if (cSingle_) {
       const PetscInt rps = PaddedRows(r, 8), nd = cNd_;
@@ -772,18 +809,34 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
         SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
       } else { // the points' sum: kappa's used columns combined in float from theta's (cThetaFs_), then one sum
+        // nth parts of the points, each summed into its own K (the first into cK_), then added in double
         const PetscInt ldf = PaddedRows(Na, 8);
-        PointSumSingle(FusedPointSum(), M, rps, Na, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cThetaFs_.data(), ldf, cPwTs_.data(), cXs_.data(), cK_.data());
+        const size_t   mt  = ContactPatch::MaxTerms;
+        if ((int)cKt_.size() < nth - 1) cKt_.resize(nth - 1);
+        for (int t = 1; t < nth; ++t) cKt_[t - 1].resize((size_t)rps * Na);
+        const bool blas = gemmBlas;
+        run([&](int t) {
+          PetscInt a, b;
+          ForkJoin::Part(M, t, nth, &a, &b);
+          SetGemmBlas(blas); // per thread
+          PetscReal *Kt = t ? cKt_[t - 1].data() : cK_.data();
+          if (b > a) PointSumSingle(FusedPointSum(), b - a, rps, Na, cNt_.data() + a, mt, cRow_.data() + a * mt, cCoef_.data() + a * mt, cThetaFs_.data(), ldf, cPwTs_.data() + (size_t)a * rps, cXs_.data() + (size_t)a * ldf, Kt);
+          else std::fill(Kt, Kt + (size_t)rps * Na, 0.0);
+        });
+        for (int t = 1; t < nth; ++t)
+          for (size_t e = 0; e < (size_t)rps * Na; ++e) cK_[e] += cKt_[t - 1][e];
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
       cX_.resize(rp);
       SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
       std::copy(cX_.begin(), cX_.begin() + r, g);
+      event(ROM_CubSum, false);
       return out;
     }
     CubatureSum(rp, cPwT_, cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
     for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
+    event(ROM_CubSum, false);
     return out;
   }
   wnMode_ = ContactMode::EIM; // the EIM interpolates K^ and g^, not the normals: no resultant force
