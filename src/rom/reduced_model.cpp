@@ -5,6 +5,7 @@
 #include "dense_kernels.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <numeric>
 #include <cmath>
@@ -789,14 +790,14 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     wnMode_ = ContactMode::Cubature;
     event(ROM_CubPoints, true);
     if (cDofs_ || cSingle_) { // the points' closest-point scans and kernels, nth parts of the points
-      std::vector<PetscInt> outs(nth, 0);
+      std::atomic<PetscInt> outs{0}; // (no allocation on the default, serial path)
       run([&](int t) {
         PetscInt a, b;
         ForkJoin::Part(M, t, nth, &a, &b);
         const size_t mt = ContactPatch::MaxTerms, d = patch.dim;
-        if (b > a) outs[t] = patch.EvaluateCoefficients(cPoint.data() + a, b - a, cNt_.data() + a, cRow_.data() + a * mt, cCoef_.data() + a * mt, gam_.data() + a, wn_.data() + a * d);
+        if (b > a) outs += patch.EvaluateCoefficients(cPoint.data() + a, b - a, cNt_.data() + a, cRow_.data() + a * mt, cCoef_.data() + a * mt, gam_.data() + a, wn_.data() + a * d);
       });
-      for (PetscInt o : outs) out += o;
+      out += outs.load();
     } else out = patch.Evaluate(cPoint.data(), M, kap_.data(), gam_.data(), nullptr, wn_.data());
     event(ROM_CubPoints, false);
     event(ROM_CubSum, true);
