@@ -526,6 +526,14 @@ def sphere_block3d(args):
     bt = ot.get("by_threads", [])
     check(ot.get("threads") == 1 and [b["threads"] for b in bt] == [1, 2] and all(len(b["per_parameter_median"]) == 9 and min(b["per_parameter_median"]) > 0 and b["speedup_median"] > 0 for b in bt),
           "validate -validate_threads 1,2: rows %s, each with 9 medians > 0" % [b["threads"] for b in bt])
+    # mpirun binds each rank to a core by default, so rank 0's threads would share its one core: validate times them on
+    # the cores of all its node's ranks (those that wait asleep), and says how many (docs/online.md "Threads"). The
+    # union measured here independently, from the ranks' affinity masks under the same mpirun
+    p = subprocess.run(["mpirun", "-n", "2", sys.executable, "-c", "import os; print(sorted(os.sched_getaffinity(0)))"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    masks = [json.loads(l) for l in p.stdout.splitlines() if l.startswith("[")]
+    union = set().union(*masks) if len(masks) == 2 else set()
+    check(len(masks) == 2 and ot.get("threads_cpus") == len(union),
+          "validate's threads ran on the node's %s CPUs (report online_time_s.threads_cpus %s; the ranks' masks %s)" % (len(union), ot.get("threads_cpus"), masks))
     # -fom_saddle_solver gamg (memory linear in the dofs, the finest 3D level): the supremizers' A^{-1} is CG + GAMG
     # as well, not a MUMPS factor of A (which outgrew the machine there); the same supremizers to the CG tolerance
     sup = {}
@@ -574,6 +582,13 @@ def sphere_block3d(args):
           "the reports name the sum, its precision and its gemm (AVX-512F: %s): %s" % (avx512, names))
     thr = [hs[t]["rom"].get("threads") for t in ("psa", "psa2", "psb3", "ds2")]
     check(thr == [1, 2, 3, 2], "the reports name the threads (-rom_threads; default 1): %s" % thr)
+    # the CPUs those threads may use: the process's affinity mask under `mpirun -n 1` (bound to one core by default),
+    # measured here independently; fewer CPUs than threads: the solve warns that they share them
+    p = subprocess.run(["mpirun", "-n", "1", sys.executable, "-c", "import os; print(len(os.sched_getaffinity(0)))"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    ncpu = int(p.stdout.split()[-1])
+    check(hs["psb3"]["rom"].get("threads_cpus") == ncpu, "rom.threads_cpus %s = the CPUs mpirun -n 1 allows (%d)" % (hs["psb3"]["rom"].get("threads_cpus"), ncpu))
+    w = run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.043", "-rom_ecsw_sum", "points", "-rom_threads", "3"])
+    check(("WARNING: -rom_threads 3" in w.stdout) == (ncpu < 3), "-rom_threads 3 on %d CPU(s): warns that the threads share them iff 3 > %d" % (ncpu, ncpu))
     for t in ("ps", "psb", "psa", "ds", "dsb", "psa2", "psb3", "ds2"):
         dv = np.linalg.norm(np.array(hs[t]["u_hat"]) - hs["pd"]["u_hat"]) / np.linalg.norm(hs["pd"]["u_hat"])
         df = abs(hs[t]["outputs"]["contact_force"] - hs["pd"]["outputs"]["contact_force"]) / hs["pd"]["outputs"]["contact_force"]

@@ -44,3 +44,7 @@ rbc_add_mpi_test(NAME test_error_estimate RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FI
 #                          DualSelectionCandidates) on hand-made tables, the finest 3D level's among them
 rbc_test_exe(test_dual_selection)
 rbc_add_mpi_test(NAME test_dual_selection RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_dual_selection> LABELS rom)
+#   test_fork_join         the thread pool of -rom_threads (ForkJoin): every part once on its own thread over many
+#                          regions, late workers, Part's ranges, and the CPUs (the caller's mask, the workers' SetCpus)
+rbc_test_exe(test_fork_join)
+rbc_add_mpi_test(NAME test_fork_join RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_fork_join> LABELS rom)

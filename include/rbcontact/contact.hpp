@@ -56,6 +56,9 @@ public:
   PetscErrorCode Build(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed);
   // Only the deformed vertex positions (no bins): for FindAmong on small facet sets.
   void SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed);
+  // The same in parts (threads): ResizeVertices once, then SetVerticesOf on disjoint ranges [a, b) covering the facets
+  void ResizeVertices(PetscInt nf, PetscInt dim);
+  void SetVerticesOf(const std::vector<SurfaceFacet> &facets, bool deformed, PetscInt a, PetscInt b);
   // Closest point of p among the facets cand[0..nc) (linear scan, same tie rule as Find).
   void FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt nc, PetscInt *facet, PetscReal b[], PetscReal *dist) const;
   // Closest point of p: facet index, barycentric coordinates, distance.

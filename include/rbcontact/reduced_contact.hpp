@@ -16,6 +16,7 @@
 #include <vector>
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/contact.hpp"
+#include "rbcontact/fork_join.hpp"
 #include "rbcontact/geometry_map.hpp"
 
 namespace rbc {
@@ -45,8 +46,9 @@ public:
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   // Nodal displacement: U = theta v + uD (reduced coordinates, length N) or a given nodal field
   // (nnode x dim, Dirichlet values included).
+  // pool (may be null): the facets' copies, deformed master vertices and facet normals in parts on its threads
   void SetReduced(const PetscReal *v);
-  void SetNodal(const std::vector<PetscReal> &U);
+  void SetNodal(const std::vector<PetscReal> &U, ForkJoin *pool = nullptr);
   // Nodal field (nnode x dim) of a full-order free-dof vector in canonical order (Dirichlet values added).
   void NodalFromCanonical(const std::vector<PetscReal> &u, std::vector<PetscReal> *U) const;
   // kappa (np x N, row-major) and gamma (np) at points idx[0..np); hit (optional): master facet found;
@@ -81,10 +83,12 @@ public:
   std::vector<PetscInt>     candStart, cand; // per point master candidates (CSR); empty: all searchable, binned
 
 private:
-  void PrepareMaster();
+  // The master's deformed vertices and vertex normals from the facets' U; U given: copied to the master facets first
+  void PrepareMaster(ForkJoin *pool = nullptr, const std::vector<PetscReal> *U = nullptr);
   PetscInt PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit, PetscReal *wn) const;
   std::vector<PetscReal> meas_;    // slave facet measure at mu
   std::vector<PetscReal> vnormal_; // nvertex x 3
+  std::vector<PetscReal> fnormal_; // master facets x 3: their normals (PrepareMaster, smooth normals)
   std::vector<PetscInt>  vcount_;  // per point scratch
   ClosestPoint           cp_;
   bool                   binned_ = false;

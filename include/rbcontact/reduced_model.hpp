@@ -216,6 +216,13 @@ public:
   // closest-point scans and kernels, and the points' sum split into n parts of the points; docs/online.md "Threads").
   // The same answer to the float sums' rounding (the parts' sums added in double).
   PetscInt  threads = 1;
+  // The CPUs the workers of -rom_threads run on (Linux CPU numbers; empty: the calling thread's, inherited).
+  // validate sets them to the cores of the ranks that wait asleep while rank 0 times (-validate_threads).
+  void SetThreadCpus(const std::vector<int> &cpus) { pool_.SetCpus(cpus); }
+  // How many CPUs those threads may use (report rom.threads_cpus; 0 where the system does not say). Fewer than
+  // -rom_threads: the threads share cores (under mpirun's default binding of a rank to a core), and the first
+  // threaded solve warns.
+  PetscInt ThreadCpus() const;
   ReducedQP qp;
 
 private:
@@ -258,7 +265,7 @@ private:
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place
   ForkJoinHolder         pool_;   // -rom_threads > 1: the workers (a copy of the model starts its own)
-  std::vector<std::vector<PetscReal>> cKt_; // the points' sum of each thread but the first (rp x Na each)
+  std::vector<std::vector<PetscReal>> cKt_, cGt_; // the points' sum of each thread but the first (rp x Na each), and its g^ (rp)
 };
 
 // The stored basis columns of a model of sizes (n, r): the leading n POD modes, then the supremizers of the

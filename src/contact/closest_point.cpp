@@ -10,11 +10,24 @@ namespace rbc {
 
 void ClosestPoint::SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt dim, bool deformed)
 {
+  ResizeVertices((PetscInt)facets.size(), dim);
+  SetVerticesOf(facets, deformed, 0, (PetscInt)facets.size());
+}
+
+void ClosestPoint::ResizeVertices(PetscInt nf, PetscInt dim)
+{
   dim_ = dim;
   nv_  = dim;
-  const PetscInt nf = (PetscInt)facets.size();
-  xdef_.assign(9 * nf, 0.0);
-  for (PetscInt f = 0; f < nf; ++f) {
+  // (resize, not assign: every facet's entries are written by SetVerticesOf; 2D leaves the unused ones 0)
+  xdef_.resize(9 * nf, 0.0);
+  sphere_.resize(dim == 3 ? 4 * nf : 0, 0.0); // 3D: a bounding sphere per triangle (centroid, radius), FindAmong's lower bound
+  invLen2_.resize(dim == 2 ? nf : 0, 0.0);
+}
+
+void ClosestPoint::SetVerticesOf(const std::vector<SurfaceFacet> &facets, bool deformed, PetscInt a, PetscInt b)
+{
+  const PetscInt dim = dim_;
+  for (PetscInt f = a; f < b; ++f) {
     const SurfaceFacet &F = facets[f];
     for (PetscInt k = 0; k < nv_; ++k) {
       // vertex node i with nodeKind k
@@ -23,10 +36,8 @@ void ClosestPoint::SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt
       for (PetscInt d = 0; d < dim; ++d) xdef_[9 * f + k * dim + d] = F.X[k * dim + d] + (deformed && node >= 0 ? F.U[node * dim + d] : 0.0);
     }
   }
-  // 3D: a bounding sphere per triangle (centroid, radius) for FindAmong's lower bound on the distance
-  sphere_.assign(dim == 3 ? 4 * nf : 0, 0.0);
   if (dim == 3)
-    for (PetscInt f = 0; f < nf; ++f) {
+    for (PetscInt f = a; f < b; ++f) {
       const PetscReal *x = &xdef_[9 * f];
       PetscReal       *c = &sphere_[4 * f], r2 = 0;
       for (PetscInt d = 0; d < 3; ++d) c[d] = (x[d] + x[3 + d] + x[6 + d]) / 3;
@@ -37,9 +48,8 @@ void ClosestPoint::SetVertices(const std::vector<SurfaceFacet> &facets, PetscInt
       }
       c[3] = std::sqrt(r2) * (1 + 1e-12); // rounding: the sphere must contain the triangle
     }
-  invLen2_.assign(dim == 2 ? nf : 0, 0.0);
   if (dim == 2)
-    for (PetscInt f = 0; f < nf; ++f) {
+    for (PetscInt f = a; f < b; ++f) {
       const PetscReal *x = &xdef_[9 * f], tt = (x[2] - x[0]) * (x[2] - x[0]) + (x[3] - x[1]) * (x[3] - x[1]);
       invLen2_[f] = tt > 0 ? 1.0 / tt : 0.0;
     }

@@ -12,6 +12,7 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/fork_join.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "rbcontact/snapshot_file.hpp"
 #include "rbcontact/snapshot_contact.hpp"
@@ -83,6 +84,9 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
 }
 
 static PetscLogEvent VAL_FOM = 0, VAL_ROM = 0;
+// The poll of the ranks that wait while rank 0 times (microseconds): each wake-up takes a core from rank 0's threads
+// for a moment (-validate_threads), so rarely; the wait ends at most this late, once per parameter and timing
+constexpr int kWaitPollUs = 2000;
 
 namespace {
 // The FOM test solutions of -test_snapshots (a snapshot file of offline -offline_stop snapshots, every one solved),
@@ -193,6 +197,26 @@ double Median(std::vector<double> v)
 } // namespace
 
 // ||e||_A(mu)^2 = sum_q thetaA_q(mu) e'A_q e (the affine terms: no copy of A(mu) per test parameter).
+// The CPUs of this node's ranks (the union of their affinity masks; collective on comm). Rank 0's threads may use the
+// cores of the ranks that wait asleep while it times: mpirun binds each rank to one core by default, and threads
+// started inside that binding would share the one core (docs/online.md "Threads").
+static PetscErrorCode NodeCpus(MPI_Comm comm, std::vector<int> *cpus)
+{
+  const int                  nb = 1024;
+  std::vector<unsigned char> mine(nb, 0), all(nb, 0);
+  MPI_Comm                   node;
+  PetscFunctionBeginUser;
+  for (int c : ForkJoin::CallerCpus())
+    if (c < nb) mine[c] = 1;
+  PetscCallMPI(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  PetscCallMPI(MPI_Allreduce(mine.data(), all.data(), nb, MPI_UNSIGNED_CHAR, MPI_MAX, node));
+  PetscCallMPI(MPI_Comm_free(&node));
+  cpus->clear();
+  for (int c = 0; c < nb; ++c)
+    if (all[c]) cpus->push_back(c);
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode EnergyNorm2(const AffineDecomposition &aff, const std::vector<PetscReal> &mu, Vec e, Vec work, PetscReal *n2)
 {
   PetscFunctionBeginUser;
@@ -410,8 +434,14 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   // mediansNoEstimate (may be null): the same timing with -rom_error_estimate false, when the model estimates
   PetscMPIInt rank;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  // the CPUs for the timed threads (-rom_threads, -validate_threads) of rank 0, the others waiting asleep
+  std::vector<int> timingCpus = ForkJoin::CallerCpus();
+  PetscInt         maxThreads = model.threads;
+  for (PetscInt t : settings.threadValues) maxThreads = std::max(maxThreads, t);
+  if (maxThreads > 1 && !settings.timeAllRanks) PetscCall(NodeCpus(comm, &timingCpus));
   auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols, std::vector<double> *mediansNoEstimate = nullptr, std::vector<std::vector<double>> *mediansByThreads = nullptr) -> PetscErrorCode {
     PetscFunctionBeginUser;
+    if (timed && rank == 0 && !settings.timeAllRanks) m.SetThreadCpus(timingCpus); // the workers' (timeSolves)
     for (PetscInt j = 0; j < nt; ++j) {
       ReducedSolution sol;
       PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
@@ -424,6 +454,13 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
         double              med = 0;
         PetscFunctionBeginUser;
         if (settings.timeAllRanks || rank == 0) {
+          // threads alone on rank 0: on this node's cores (the calling thread's own restored after)
+          const std::vector<int> own   = ForkJoin::CallerCpus();
+          const bool             widen = !settings.timeAllRanks && m.threads > 1 && timingCpus.size() > own.size();
+          if (widen) {
+            (void)ForkJoin::SetCallerCpus(timingCpus);
+            m.SetThreadCpus(timingCpus);
+          }
           for (PetscInt k = 0; k < repeat; ++k) {
             PetscLogDouble a, b;
             PetscCall(PetscTime(&a));
@@ -431,6 +468,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
             PetscCall(PetscTime(&b));
             ts.push_back(b - a);
           }
+          if (widen) (void)ForkJoin::SetCallerCpus(own);
           med = Median(ts);
         }
         if (!settings.timeAllRanks) { // the other ranks wait asleep, not spinning in MPI (a core for -rom_threads)
@@ -440,7 +478,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
           for (;;) {
             PetscCallMPI(MPI_Test(&req, &done, MPI_STATUS_IGNORE));
             if (done) break;
-            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            std::this_thread::sleep_for(std::chrono::microseconds(kWaitPollUs));
           }
         }
         meds->push_back(med);
@@ -597,6 +635,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     rep.root["online_time_s"]["estimate_cost_ratio"]     = Median(mediansNoEstimate) > 0 ? onlineMedian / Median(mediansNoEstimate) : 0.0;
   }
   rep.root["online_time_s"]["threads"] = (long long)model.threads; // -rom_threads of the timing above
+  rep.root["online_time_s"]["threads_cpus"] = (long long)timingCpus.size(); // the CPUs those threads could use
   for (size_t k = 0; k < settings.threadValues.size(); ++k) { // -validate_threads: the same solves on other numbers of threads
     JsonValue    row;
     const double med = Median(mediansByThreads[k]);

@@ -1,6 +1,11 @@
 // src/rom/fork_join.cpp: the fork-join pool of the online solve's threads (include/rbcontact/fork_join.hpp).
 #include "rbcontact/fork_join.hpp"
 
+#if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
+#endif
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define RBC_PAUSE() _mm_pause()
@@ -22,7 +27,60 @@ void ForkJoin::SetThreads(int n)
   stop_ = false;
   // the generation before any region of these workers (a worker may start only after the first Run)
   const unsigned long g = generation_.load();
-  for (int t = 1; t < n; ++t) workers_.emplace_back([this, t, g] { Work(t, g); });
+  for (int t = 1; t < n; ++t) {
+    workers_.emplace_back([this, t, g] { Work(t, g); });
+    Pin(workers_.back());
+  }
+}
+
+void ForkJoin::SetCpus(const std::vector<int> &cpus)
+{
+  cpus_ = cpus;
+  for (auto &w : workers_) Pin(w);
+}
+
+#if defined(__linux__)
+static bool ToSet(const std::vector<int> &cpus, cpu_set_t *set)
+{
+  CPU_ZERO(set);
+  for (int c : cpus)
+    if (c >= 0 && c < CPU_SETSIZE) CPU_SET(c, set);
+  return CPU_COUNT(set) > 0;
+}
+#endif
+
+void ForkJoin::Pin(std::thread &w) const
+{
+#if defined(__linux__)
+  cpu_set_t set;
+  if (!cpus_.empty() && ToSet(cpus_, &set)) (void)pthread_setaffinity_np(w.native_handle(), sizeof(set), &set);
+#else
+  (void)w;
+#endif
+}
+
+std::vector<int> ForkJoin::CallerCpus()
+{
+  std::vector<int> cpus;
+#if defined(__linux__)
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) == 0)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) cpus.push_back(c);
+#endif
+  return cpus;
+}
+
+bool ForkJoin::SetCallerCpus(const std::vector<int> &cpus)
+{
+#if defined(__linux__)
+  cpu_set_t set;
+  return ToSet(cpus, &set) && pthread_setaffinity_np(pthread_self(), sizeof(set), &set) == 0;
+#else
+  (void)cpus;
+  return false;
+#endif
 }
 
 void ForkJoin::Stop()

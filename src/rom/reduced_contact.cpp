@@ -297,12 +297,28 @@ void ContactPatch::SetGeometry(const GeometryMap *map, const std::vector<PetscRe
   for (size_t s = 0; s < slave.size(); ++s) meas_[s] = FacetMeasure(slave[s].X.data(), dim);
 }
 
-void ContactPatch::SetNodal(const std::vector<PetscReal> &U)
+void ContactPatch::SetNodal(const std::vector<PetscReal> &U, ForkJoin *pool)
 {
-  for (auto *fs : {&slave, &master})
-    for (auto &F : *fs)
+  auto copy = [&](std::vector<SurfaceFacet> &fs, PetscInt a, PetscInt b) {
+    for (PetscInt f = a; f < b; ++f) {
+      SurfaceFacet &F = fs[f];
       for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = U[F.dof[i]];
-  PrepareMaster();
+    }
+  };
+  if (!pool) {
+    copy(slave, 0, (PetscInt)slave.size());
+    copy(master, 0, (PetscInt)master.size());
+    PrepareMaster();
+    return;
+  }
+  // the slave facets' copies here; the master facets' in PrepareMaster's region, with their vertices
+  const int nth = pool->Threads();
+  pool->Run([&](int t) {
+    PetscInt a, b;
+    ForkJoin::Part((PetscInt)slave.size(), t, nth, &a, &b);
+    copy(slave, a, b);
+  });
+  PrepareMaster(pool, &U);
 }
 
 void ContactPatch::SetReduced(const PetscReal *v)
@@ -319,19 +335,43 @@ void ContactPatch::NodalFromCanonical(const std::vector<PetscReal> &u, std::vect
   for (PetscInt r = 0; r < nnode * dim; ++r) (*U)[r] = r < (PetscInt)canon.size() && canon[r] >= 0 ? u[canon[r]] : uD[r];
 }
 
-void ContactPatch::PrepareMaster()
+void ContactPatch::PrepareMaster(ForkJoin *pool, const std::vector<PetscReal> *U)
 {
-  binned_ = candStart.size() <= 1;
-  if (binned_) (void)cp_.Build(master, dim, true);
-  else cp_.SetVertices(master, dim, true);
-  vnormal_.assign(3 * nvertex, 0.0);
-  if (smoothNormal)
-    for (PetscInt m = 0; m < (PetscInt)master.size(); ++m) {
-      PetscReal n[3];
-      FacetNormal(cp_.Vertices(m), dim, master[m].outward, n);
-      for (PetscInt k = 0; k < master[m].nv; ++k)
-        for (PetscInt d = 0; d < 3; ++d) vnormal_[3 * master[m].vglobal[k] + d] += n[d];
+  const PetscInt nm = (PetscInt)master.size();
+  binned_           = candStart.size() <= 1;
+  if (binned_) {
+    if (U)
+      for (auto &F : master)
+        for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = (*U)[F.dof[i]];
+    (void)cp_.Build(master, dim, true);
+  } else cp_.ResizeVertices(nm, dim);
+  fnormal_.resize(smoothNormal ? 3 * nm : 0);
+  // per master facet (in parts on the pool's threads): its displacement copy (U given), deformed vertices, normal
+  auto part = [&](PetscInt a, PetscInt b) {
+    if (!binned_) {
+      if (U)
+        for (PetscInt m = a; m < b; ++m) {
+          SurfaceFacet &F = master[m];
+          for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = (*U)[F.dof[i]];
+        }
+      cp_.SetVerticesOf(master, true, a, b);
     }
+    if (smoothNormal)
+      for (PetscInt m = a; m < b; ++m) FacetNormal(cp_.Vertices(m), dim, master[m].outward, &fnormal_[3 * m]);
+  };
+  if (pool) {
+    const int nth = pool->Threads();
+    pool->Run([&](int t) {
+      PetscInt a, b;
+      ForkJoin::Part(nm, t, nth, &a, &b);
+      part(a, b);
+    });
+  } else part(0, nm);
+  vnormal_.assign(3 * nvertex, 0.0);
+  if (smoothNormal) // the facets' normals summed per vertex in the facets' order (the same bits on any number of parts)
+    for (PetscInt m = 0; m < nm; ++m)
+      for (PetscInt k = 0; k < master[m].nv; ++k)
+        for (PetscInt d = 0; d < 3; ++d) vnormal_[3 * master[m].vglobal[k] + d] += fnormal_[3 * m + d];
   if (smoothNormal) // unit, once per vertex (EvaluateContactPoint); vertices of no facet stay 0 and are never read
     for (PetscInt v = 0; v < nvertex; ++v)
       if (vnormal_[3 * v] != 0 || vnormal_[3 * v + 1] != 0 || vnormal_[3 * v + 2] != 0) NormalizeVertexNormal(&vnormal_[3 * v]);

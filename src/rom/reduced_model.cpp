@@ -208,6 +208,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["gemm"]           = m.GemmName();
   (*r)["threads"]        = (long long)m.threads; // -rom_threads
+  (*r)["threads_cpus"]   = (long long)m.ThreadCpus();
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
   (*r)["kacanov_rtol_dual"]   = (double)m.loop.rtolDual;
 }
@@ -707,6 +708,8 @@ void ReducedModel::OrderCubaturePoints()
   cPw.swap(pw);
 }
 
+PetscInt ReducedModel::ThreadCpus() const { return (PetscInt)(pool_.cpus.empty() ? ForkJoin::CallerCpus().size() : pool_.cpus.size()); }
+
 PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
 {
   const PetscInt Na = (PetscInt)cols_.size(), r = r_;
@@ -759,7 +762,11 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       geomMu_ = mu;
     }
     // -rom_threads: the regions below split over the points (or the patch's rows) on nth threads
-    const int nth  = (int)threads;
+    const int nth = (int)threads;
+    if (nth > 1 && !pool_.pool) { // the first threaded solve: say so when the threads must share cores
+      const PetscInt nc = ThreadCpus();
+      if (nc > 0 && nc < nth) PetscCallAbort(PETSC_COMM_SELF, PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "WARNING: -rom_threads %d, but this process may run on %d CPU(s) only, so the threads share them and the solve may run slower than on one thread (mpirun binds each rank to a core by default: run with mpirun --bind-to none, or --map-by slot:PE=%d)\n", nth, (int)nc, nth));
+    }
     ForkJoin *pool = nth > 1 ? &pool_.Get(nth) : nullptr;
     auto      run  = [&](const std::function<void(int)> &f) { pool ? pool->Run(f) : f(0); };
     // (ContactTerms returns a count, not an error code: the events' calls abort on an error)
@@ -781,7 +788,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         ForkJoin::Part(rows, t, nth, &a, &b);
         if (b > a) RowDotsSingle(b - a, ldf, cThetaFs_.data() + (size_t)a * ldf, vfp, patch.uD.data() + a, Up + a);
       });
-      patch.SetNodal(U);
+      patch.SetNodal(U, pool);
     } else patch.SetReduced(vfull.data());
     event(ROM_CubDisp, false);
     const PetscInt rp = PaddedRows(r);
@@ -813,23 +820,38 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         // nth parts of the points, each summed into its own K (the first into cK_), then added in double
         const PetscInt ldf = PaddedRows(Na, 8);
         const size_t   mt  = ContactPatch::MaxTerms;
+        // with g^ in double over the same parts (its weights are M x rp doubles: memory traffic worth splitting)
         if ((int)cKt_.size() < nth - 1) cKt_.resize(nth - 1);
-        for (int t = 1; t < nth; ++t) cKt_[t - 1].resize((size_t)rps * Na);
+        if ((int)cGt_.size() < nth - 1) cGt_.resize(nth - 1);
+        for (int t = 1; t < nth; ++t) {
+          cKt_[t - 1].resize((size_t)rps * Na);
+          cGt_[t - 1].resize(rp);
+        }
+        cX_.resize(rp);
         const bool blas = gemmBlas;
         run([&](int t) {
           PetscInt a, b;
           ForkJoin::Part(M, t, nth, &a, &b);
           SetGemmBlas(blas); // per thread
-          PetscReal *Kt = t ? cKt_[t - 1].data() : cK_.data();
-          if (b > a) PointSumSingle(FusedPointSum(), b - a, rps, Na, cNt_.data() + a, mt, cRow_.data() + a * mt, cCoef_.data() + a * mt, cThetaFs_.data(), ldf, cPwTs_.data() + (size_t)a * rps, cXs_.data() + (size_t)a * ldf, Kt);
-          else std::fill(Kt, Kt + (size_t)rps * Na, 0.0);
+          PetscReal *Kt = t ? cKt_[t - 1].data() : cK_.data(), *gt = t ? cGt_[t - 1].data() : cX_.data();
+          if (b > a) {
+            PointSumSingle(FusedPointSum(), b - a, rps, Na, cNt_.data() + a, mt, cRow_.data() + a * mt, cCoef_.data() + a * mt, cThetaFs_.data(), ldf, cPwTs_.data() + (size_t)a * rps, cXs_.data() + (size_t)a * ldf, Kt);
+            SumOfOuterProducts(b - a, rp, 1, cPwT_.data() + (size_t)a * rp, gam_.data() + a, gt); // g^ in double
+          } else {
+            std::fill(Kt, Kt + (size_t)rps * Na, 0.0);
+            std::fill(gt, gt + rp, 0.0);
+          }
         });
-        for (int t = 1; t < nth; ++t)
+        for (int t = 1; t < nth; ++t) {
           for (size_t e = 0; e < (size_t)rps * Na; ++e) cK_[e] += cKt_[t - 1][e];
+          for (PetscInt i = 0; i < rp; ++i) cX_[i] += cGt_[t - 1][i];
+        }
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
-      cX_.resize(rp);
-      SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
+      if (cDofs_) {
+        cX_.resize(rp);
+        SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
+      }
       std::copy(cX_.begin(), cX_.begin() + r, g);
       event(ROM_CubSum, false);
       return out;
