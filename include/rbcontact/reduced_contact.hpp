@@ -46,8 +46,8 @@ public:
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   // Nodal displacement: U = theta v + uD (reduced coordinates, length N) or a given nodal field
   // (nnode x dim, Dirichlet values included).
-  // pool (may be null): the facets' copies, deformed master vertices and facet normals in parts on its threads
   void SetReduced(const PetscReal *v);
+  // pool (may be null): the facets' copies, deformed master vertices and facet normals in parts on its threads
   void SetNodal(const std::vector<PetscReal> &U, ForkJoin *pool = nullptr);
   // Nodal field (nnode x dim) of a full-order free-dof vector in canonical order (Dirichlet values added).
   void NodalFromCanonical(const std::vector<PetscReal> &u, std::vector<PetscReal> *U) const;

@@ -196,7 +196,6 @@ double Median(std::vector<double> v)
 }
 } // namespace
 
-// ||e||_A(mu)^2 = sum_q thetaA_q(mu) e'A_q e (the affine terms: no copy of A(mu) per test parameter).
 // The CPUs of this node's ranks (the union of their affinity masks; collective on comm). Rank 0's threads may use the
 // cores of the ranks that wait asleep while it times: mpirun binds each rank to one core by default, and threads
 // started inside that binding would share the one core (docs/online.md "Threads").
@@ -217,6 +216,7 @@ static PetscErrorCode NodeCpus(MPI_Comm comm, std::vector<int> *cpus)
   PetscFunctionReturn(0);
 }
 
+// ||e||_A(mu)^2 = sum_q thetaA_q(mu) e'A_q e (the affine terms: no copy of A(mu) per test parameter).
 static PetscErrorCode EnergyNorm2(const AffineDecomposition &aff, const std::vector<PetscReal> &mu, Vec e, Vec work, PetscReal *n2)
 {
   PetscFunctionBeginUser;
