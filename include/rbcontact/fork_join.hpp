@@ -41,6 +41,18 @@ public:
     *begin = count * t / n;
     *end   = count * (t + 1) / n;
   }
+  // f(begin, end, t) for each part t of [0, count) on the pool's threads (pool null: f(0, count, 0) on the caller)
+  template <class F>
+  static void ForParts(ForkJoin *pool, PetscInt count, F &&f)
+  {
+    if (!pool) return (void)f((PetscInt)0, count, 0);
+    const int n = pool->Threads();
+    pool->Run([&](int t) {
+      PetscInt a, b;
+      Part(count, t, n, &a, &b);
+      f(a, b, t);
+    });
+  }
 
 private:
   void Stop();

@@ -83,8 +83,8 @@ public:
   std::vector<PetscInt>     candStart, cand; // per point master candidates (CSR); empty: all searchable, binned
 
 private:
-  // The master's deformed vertices and vertex normals from the facets' U; U given: copied to the master facets first
-  void PrepareMaster(ForkJoin *pool = nullptr, const std::vector<PetscReal> *U = nullptr);
+  // The master's deformed vertices and vertex normals from the facets' U (pool: in parts on its threads)
+  void PrepareMaster(ForkJoin *pool = nullptr);
   PetscInt PointTerms(PetscInt p, PetscInt *nt, PetscInt rowIdx[], PetscReal coef[], PetscReal *gamma, PetscInt *hit, PetscReal *wn) const;
   std::vector<PetscReal> meas_;    // slave facet measure at mu
   std::vector<PetscReal> vnormal_; // nvertex x 3

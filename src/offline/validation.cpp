@@ -457,10 +457,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
           // threads alone on rank 0: on this node's cores (the calling thread's own restored after)
           const std::vector<int> own   = ForkJoin::CallerCpus();
           const bool             widen = !settings.timeAllRanks && m.threads > 1 && timingCpus.size() > own.size();
-          if (widen) {
-            (void)ForkJoin::SetCallerCpus(timingCpus);
-            m.SetThreadCpus(timingCpus);
-          }
+          if (widen) (void)ForkJoin::SetCallerCpus(timingCpus); // (the workers' are set above)
           for (PetscInt k = 0; k < repeat; ++k) {
             PetscLogDouble a, b;
             PetscCall(PetscTime(&a));

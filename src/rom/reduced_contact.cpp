@@ -299,26 +299,18 @@ void ContactPatch::SetGeometry(const GeometryMap *map, const std::vector<PetscRe
 
 void ContactPatch::SetNodal(const std::vector<PetscReal> &U, ForkJoin *pool)
 {
-  auto copy = [&](std::vector<SurfaceFacet> &fs, PetscInt a, PetscInt b) {
+  const PetscInt ns = (PetscInt)slave.size(), nm = (PetscInt)master.size();
+  auto           copy = [&](std::vector<SurfaceFacet> &fs, PetscInt a, PetscInt b) {
     for (PetscInt f = a; f < b; ++f) {
       SurfaceFacet &F = fs[f];
       for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = U[F.dof[i]];
     }
   };
-  if (!pool) {
-    copy(slave, 0, (PetscInt)slave.size());
-    copy(master, 0, (PetscInt)master.size());
-    PrepareMaster();
-    return;
-  }
-  // the slave facets' copies here; the master facets' in PrepareMaster's region, with their vertices
-  const int nth = pool->Threads();
-  pool->Run([&](int t) {
-    PetscInt a, b;
-    ForkJoin::Part((PetscInt)slave.size(), t, nth, &a, &b);
-    copy(slave, a, b);
+  ForkJoin::ForParts(pool, ns + nm, [&](PetscInt a, PetscInt b, int) { // the slave facets, then the master ones
+    copy(slave, std::min(a, ns), std::min(b, ns));
+    copy(master, std::max(a, ns) - ns, std::max(b, ns) - ns);
   });
-  PrepareMaster(pool, &U);
+  PrepareMaster(pool);
 }
 
 void ContactPatch::SetReduced(const PetscReal *v)
@@ -335,38 +327,19 @@ void ContactPatch::NodalFromCanonical(const std::vector<PetscReal> &u, std::vect
   for (PetscInt r = 0; r < nnode * dim; ++r) (*U)[r] = r < (PetscInt)canon.size() && canon[r] >= 0 ? u[canon[r]] : uD[r];
 }
 
-void ContactPatch::PrepareMaster(ForkJoin *pool, const std::vector<PetscReal> *U)
+void ContactPatch::PrepareMaster(ForkJoin *pool)
 {
   const PetscInt nm = (PetscInt)master.size();
   binned_           = candStart.size() <= 1;
-  if (binned_) {
-    if (U)
-      for (auto &F : master)
-        for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = (*U)[F.dof[i]];
-    (void)cp_.Build(master, dim, true);
-  } else cp_.ResizeVertices(nm, dim);
+  if (binned_) (void)cp_.Build(master, dim, true);
+  else cp_.ResizeVertices(nm, dim);
   fnormal_.resize(smoothNormal ? 3 * nm : 0);
-  // per master facet (in parts on the pool's threads): its displacement copy (U given), deformed vertices, normal
-  auto part = [&](PetscInt a, PetscInt b) {
-    if (!binned_) {
-      if (U)
-        for (PetscInt m = a; m < b; ++m) {
-          SurfaceFacet &F = master[m];
-          for (PetscInt i = 0; i < F.nnodes * dim; ++i) F.U[i] = (*U)[F.dof[i]];
-        }
-      cp_.SetVerticesOf(master, true, a, b);
-    }
+  // per master facet, in parts on the pool's threads: its deformed vertices and its normal
+  ForkJoin::ForParts(pool, nm, [&](PetscInt a, PetscInt b, int) {
+    if (!binned_) cp_.SetVerticesOf(master, true, a, b);
     if (smoothNormal)
       for (PetscInt m = a; m < b; ++m) FacetNormal(cp_.Vertices(m), dim, master[m].outward, &fnormal_[3 * m]);
-  };
-  if (pool) {
-    const int nth = pool->Threads();
-    pool->Run([&](int t) {
-      PetscInt a, b;
-      ForkJoin::Part(nm, t, nth, &a, &b);
-      part(a, b);
-    });
-  } else part(0, nm);
+  });
   vnormal_.assign(3 * nvertex, 0.0);
   if (smoothNormal) // the facets' normals summed per vertex in the facets' order (the same bits on any number of parts)
     for (PetscInt m = 0; m < nm; ++m)

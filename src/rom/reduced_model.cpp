@@ -6,7 +6,6 @@
 #include <petscblaslapack.h>
 #include <algorithm>
 #include <atomic>
-#include <functional>
 #include <numeric>
 #include <cmath>
 #include <cstring>
@@ -768,7 +767,6 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       if (nc > 0 && nc < nth) PetscCallAbort(PETSC_COMM_SELF, PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "WARNING: -rom_threads %d, but this process may run on %d CPU(s) only, so the threads share them and the solve may run slower than on one thread (mpirun binds each rank to a core by default: run with mpirun --bind-to none, or --map-by slot:PE=%d)\n", nth, (int)nc, nth));
     }
     ForkJoin *pool = nth > 1 ? &pool_.Get(nth) : nullptr;
-    auto      run  = [&](const std::function<void(int)> &f) { pool ? pool->Run(f) : f(0); };
     // (ContactTerms returns a count, not an error code: the events' calls abort on an error)
     PetscCallAbort(PETSC_COMM_SELF, RegisterEvents()); // (callers other than Solve: the offline stage's)
     auto event = [](PetscLogEvent e, bool begin) { PetscCallAbort(PETSC_COMM_SELF, begin ? PetscLogEventBegin(e, 0, 0, 0, 0) : PetscLogEventEnd(e, 0, 0, 0, 0)); };
@@ -783,9 +781,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       // (pointers: a thread_local named inside the lambda would be the worker's own)
       const float *vfp = vf.data();
       PetscReal   *Up  = U.data();
-      run([&](int t) {
-        PetscInt a, b;
-        ForkJoin::Part(rows, t, nth, &a, &b);
+      ForkJoin::ForParts(pool, rows, [&](PetscInt a, PetscInt b, int) {
         if (b > a) RowDotsSingle(b - a, ldf, cThetaFs_.data() + (size_t)a * ldf, vfp, patch.uD.data() + a, Up + a);
       });
       patch.SetNodal(U, pool);
@@ -798,9 +794,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     event(ROM_CubPoints, true);
     if (cDofs_ || cSingle_) { // the points' closest-point scans and kernels, nth parts of the points
       std::atomic<PetscInt> outs{0}; // (no allocation on the default, serial path)
-      run([&](int t) {
-        PetscInt a, b;
-        ForkJoin::Part(M, t, nth, &a, &b);
+      ForkJoin::ForParts(pool, M, [&](PetscInt a, PetscInt b, int) {
         const size_t mt = ContactPatch::MaxTerms, d = patch.dim;
         if (b > a) outs += patch.EvaluateCoefficients(cPoint.data() + a, b - a, cNt_.data() + a, cRow_.data() + a * mt, cCoef_.data() + a * mt, gam_.data() + a, wn_.data() + a * d);
       });
@@ -829,9 +823,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         }
         cX_.resize(rp);
         const bool blas = gemmBlas;
-        run([&](int t) {
-          PetscInt a, b;
-          ForkJoin::Part(M, t, nth, &a, &b);
+        ForkJoin::ForParts(pool, M, [&](PetscInt a, PetscInt b, int t) {
           SetGemmBlas(blas); // per thread
           PetscReal *Kt = t ? cKt_[t - 1].data() : cK_.data(), *gt = t ? cGt_[t - 1].data() : cX_.data();
           if (b > a) {
