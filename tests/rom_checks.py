@@ -22,6 +22,7 @@
 import argparse
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -529,8 +530,10 @@ def sphere_block3d(args):
     # mpirun binds each rank to a core by default, so rank 0's threads would share its one core: validate times them on
     # the cores of all its node's ranks (those that wait asleep), and says how many (docs/online.md "Threads"). The
     # union measured here independently, from the ranks' affinity masks under the same mpirun
-    p = subprocess.run(["mpirun", "-n", "2", sys.executable, "-c", "import os; print(sorted(os.sched_getaffinity(0)))"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    masks = [json.loads(l) for l in p.stdout.splitlines() if l.startswith("[")]
+    # (the two ranks' lines may interleave in mpirun's output: each mask is read by its own marker, not by line)
+    p = subprocess.run(["mpirun", "-n", "2", sys.executable, "-c", "import os; print('<mask %s>' % ','.join(map(str, sorted(os.sched_getaffinity(0)))))"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    masks = [[int(c) for c in m.split(",")] for m in re.findall(r"<mask ([0-9,]+)>", p.stdout)]
     union = set().union(*masks) if len(masks) == 2 else set()
     check(len(masks) == 2 and ot.get("threads_cpus") == len(union),
           "validate's threads ran on the node's %s CPUs (report online_time_s.threads_cpus %s; the ranks' masks %s)" % (len(union), ot.get("threads_cpus"), masks))
