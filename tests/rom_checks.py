@@ -750,6 +750,95 @@ def dual_select(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def dual_refit(args):
+    """The online model refitted to the R chosen on held-out solutions (-dual_select_refit) and its manual form
+    (-dual_truncate; docs/dual_basis.md "The cubature refitted to the chosen R"): the rule of keeping it recomputed from
+    the report, the files' sizes, the same model from -dual_truncate on 2 and 1 ranks, the exact-contact errors those of
+    the uncut file at the same R (the same basis functions), bad input."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_refit_")
+    # the lambda fit, whose point count follows the fitted rows (the finest 3D level's); with a 4 x 4 grid every dual
+    # vector is the best choice, so the rule is loosened (lambda within 1.5x of the best, u and force unguarded) for a
+    # smaller one to be chosen
+    opts = ["-options_file", "runs/sphere_block3d.opts", "-train_size", "4", "-snapshots_sensitivities", "-snapshots", d + "/snap.h5",
+            "-ecsw_fit", "lambda", "-ecsw_tol", "1e-3"]
+    run(args, 2, "offline", ["-options_file", "runs/sphere_block3d.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "6", "-train_seed", "11",
+                             "-snapshots_subcomm", "1", "-snapshots", d + "/held.h5", "-report", d + "/held.json"])
+    sel = ["-dual_select_snapshots", d + "/held.h5", "-dual_select_slack", "0.5", "-dual_select_guard", "10"]
+    run(args, 2, "offline", opts + ["-rom", d + "/plain.h5", "-report", d + "/plain.json"] + sel)
+    run(args, 2, "offline", opts + ["-snapshots_restart", "-rom", d + "/rom.h5", "-report", d + "/off.json", "-dual_select_refit"] + sel)
+    plain, off = report(d + "/plain.json"), report(d + "/off.json")
+    ds, rf = off["dual_select"], off["dual_select"]["refit"]
+    c = [x for x in ds["candidates"] if x["R"] == ds["R"]][0]
+    print("  chosen R %d (N %d) of %d; refit: Mc %d -> %d, held-out lambda %.3e -> %.3e, u %.3e -> %.3e, force %.3e -> %.3e, kept %s"
+          % (ds["R"], ds["N"], ds["R_stored"], rf["Mc_before"], rf["Mc"], c["max_rel_err_lambda"], rf["max_rel_err_lambda"], c["max_rel_err_u"],
+             rf["max_rel_err_u"], c["max_rel_err_force"], rf["max_rel_err_force"], rf["kept"]))
+    check(ds["R"] < ds["R_stored"] and plain["dual_select"]["R"] == ds["R"] and rf["Mc_before"] == plain["rom"]["Mc"],
+          "the same choice as without the refit (R %d < %d), Mc before the refit = that model's (%d)" % (ds["R"], ds["R_stored"], plain["rom"]["Mc"]))
+    g, sl = 1 + ds["guard"], 1 + rf["slack"]
+    rule = (not rf["failed"] and rf["max_rel_err_lambda"] <= sl * c["max_rel_err_lambda"]
+            and all(rf["max_rel_err_" + q] <= g * c["max_rel_err_" + q] for q in ("u", "force")))
+    check(rf["kept"] == rule, "kept (%s) = the rule on the reported errors (lambda within %g, u and force within %g)" % (rf["kept"], rf["slack"], ds["guard"]))
+    sizes = datasets(d + "/rom.h5")
+    with h5py.File(d + "/rom.h5", "r") as f:
+        z = [int(v) for v in f["online/sizes"][:]]
+        has_sel = "online/dual_select" in f
+    with h5py.File(d + "/rom.basis.h5", "r") as f:
+        nmodes, rdual = f["pod/modes"].shape[0], f["dual/basis"].shape[0]
+    if rf["kept"]:
+        check(z[4] == ds["R"] and z[1] == ds["N"] and nmodes == ds["N"] and rdual == ds["R"] and not has_sel and off["rom"]["Mc"] == rf["Mc"]
+              and off["dual"]["r"] == ds["R"] and off["dual"]["truncated_from"] == ds["R_stored"],
+              "kept: the ROM and basis files hold the chosen R %d and N %d only (sizes %s, modes %d, dual vectors %d), Mc %d"
+              % (ds["R"], ds["N"], z, nmodes, rdual, off["rom"]["Mc"]))
+    else:
+        check(z[4] == ds["R_stored"] and has_sel and off["rom"]["Mc"] == plain["rom"]["Mc"], "not kept: the files and report as without the refit")
+    # a refit that is not kept (a cubature 50x looser for the refit only): the files and the report as without it
+    run(args, 2, "offline", opts + ["-snapshots_restart", "-rom", d + "/drop.h5", "-report", d + "/drop.json", "-dual_select_refit",
+                                    "-dual_select_refit_ecsw_tol", "5e-2"] + sel)
+    dr = report(d + "/drop.json")
+    rd = dr["dual_select"]["refit"]
+    same = True
+    with h5py.File(d + "/plain.h5", "r") as f, h5py.File(d + "/drop.h5", "r") as g:
+        names = []
+        f.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        for n in names:
+            same = same and n in g and np.array_equal(f[n][()], g[n][()])
+    with h5py.File(d + "/drop.basis.h5", "r") as f:
+        nm, nr = f["pod/modes"].shape[0], f["dual/basis"].shape[0]
+    check(not rd["kept"] and rd["ecsw_tol"] == 5e-2 and rd["Mc"] < rd["Mc_before"] and rd["max_rel_err_lambda"] > (1 + rd["slack"]) * c["max_rel_err_lambda"]
+          and same and nm == plain["pod"]["n"] and nr == ds["R_stored"] and dr["rom"]["Mc"] == plain["rom"]["Mc"] and dr["ecsw"]["tol"] == plain["ecsw"]["tol"] and dr["pod"]["n"] == plain["pod"]["n"],
+          "-dual_select_refit_ecsw_tol 5e-2: Mc %d, held-out lambda %.3e > %.3e: not kept; every dataset of the ROM file, the basis file's %d modes and %d dual "
+          "vectors and the report's sizes as without the refit" % (rd["Mc"], rd["max_rel_err_lambda"], (1 + rd["slack"]) * c["max_rel_err_lambda"], nm, nr))
+    # the manual form from the same snapshots, on 2 and 1 ranks: the same model (the cubature fitted to the same rows)
+    for np_ in (2, 1):
+        run(args, np_, "offline", opts + ["-snapshots_restart", "-rom", "%s/t%d.h5" % (d, np_), "-report", "%s/t%d.json" % (d, np_), "-dual_truncate", str(ds["R"])])
+        t = report("%s/t%d.json" % (d, np_))
+        run(args, 2, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", "%s/t%d.h5" % (d, np_), "-test_snapshots", d + "/held.h5",
+                                  "-validate_repeat", "1", "-report", "%s/vt%d.json" % (d, np_)])
+        v = report("%s/vt%d.json" % (d, np_))["test"]
+        dev = max(abs(v["max_rel_err_" + q] - rf["max_rel_err_" + q]) / rf["max_rel_err_" + q] for q in ("u", "lambda", "force"))
+        check(t["rom"]["R"] == ds["R"] and t["rom"]["N"] == ds["N"] and t["rom"]["Mc"] == rf["Mc"] and dev <= 1e-6,
+              "-dual_truncate %d on %d rank(s): R %d, N %d, Mc %d (refit: %d); held-out errors those of the refit to %.1e (<= 1e-6)"
+              % (ds["R"], np_, t["rom"]["R"], t["rom"]["N"], t["rom"]["Mc"], rf["Mc"], dev))
+    # the same basis functions as the uncut file at its chosen R: the exact-contact reduced model's errors are equal when
+    # both reduced Kacanov loops converge tightly (their warm starts differ: the training multipliers' coefficients
+    # in 24 or in 34 dual vectors)
+    tight = ["-test_snapshots", d + "/held.h5", "-validate_repeat", "1", "-rom_ecsw_precision", "double", "-rom_kacanov_rtol_primal", "1e-10", "-rom_kacanov_rtol_dual", "1e-10",
+             "-rom_kacanov_max_it", "200"]
+    for f in ("plain", "t2"):
+        run(args, 2, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", "%s/%s.h5" % (d, f), "-report", "%s/x%s.json" % (d, f)] + tight)
+    ep, et = report(d + "/xplain.json")["test_exact"], report(d + "/xt2.json")["test_exact"]
+    dev = max(abs(ep["max_rel_err_" + q] - et["max_rel_err_" + q]) / ep["max_rel_err_" + q] for q in ("u", "lambda", "force"))
+    check(dev <= 1e-8, "exact contact terms: the cut file = the uncut one at its chosen R to %.1e (<= 1e-8)" % dev)
+    for extra, words, what in ((["-dual_truncate", "-1"], ["-dual_truncate", "-1"], "-dual_truncate negative"),
+                               (["-dual_select_refit"], ["-dual_select_refit", "-dual_select_snapshots"], "-dual_select_refit without a choice"),
+                               (sel + ["-dual_select_refit", "-dual_select_refit_slack", "-0.5"], ["-dual_select_refit_slack", "-0.5"], "a negative refit slack"),
+                               (sel + ["-dual_select_refit", "-dual_select_refit_ecsw_tol", "2"], ["-dual_select_refit_ecsw_tol", "2"], "a refit tolerance of 2"),
+                               (["-dual_truncate", "5", "-estimate"], ["-dual_truncate", "-estimate"], "-dual_truncate with -estimate")):
+        expect_error(args, opts + ["-snapshots_restart", "-rom", d + "/bad.h5"] + extra, words, "offline " + what, stage="offline", np_=2)
+    check(not os.path.exists(d + "/bad.h5"), "refused before the bases: no ROM file written")
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def residual(args):
     """validate -validate_residual (docs/error_estimate.md): the residual indicator of every reduced solution on the mesh
     and its effectivity against the energy error, on 1 and 2 ranks."""
@@ -916,7 +1005,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -29,6 +29,13 @@ struct DualSelectionOptions {
   PetscReal             minFraction = 0.5;  // -dual_select_min_fraction: the smallest candidate, as a fraction of R
   PetscInt              count = 16;         // -dual_select_count: candidates from there to R, evenly spaced
   std::vector<PetscInt> candidates;         // -dual_select_R: the candidates themselves (R is always added)
+  bool                  refit = false;      // -dual_select_refit: below the stored R, the bases cut to the chosen R and the
+                                            // online model (the cubature) built again for them (TruncateBases)
+  PetscReal             refitSlack = 0.05;  // -dual_select_refit_slack: the refitted model is kept if its held-out lambda is
+                                            // within it of the chosen row's (u and force: within -dual_select_guard)
+  PetscReal             refitEcswTol = 0;   // -dual_select_refit_ecsw_tol: the refit's cubature tolerance (0: -ecsw_tol's)
+  PetscInt              truncate = 0;       // -dual_truncate: the bases cut to this many dual vectors before the online
+                                            // model is built (0: all; TruncateBases)
   bool Enabled() const { return size > 0 || !snapshots.empty(); }
 };
 
@@ -55,6 +62,13 @@ size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, Pet
 // mean_rel_err_{u,lambda,force}, failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the chosen row),
 // max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use become the
 // chosen sizes; time_s.dual_select its seconds. Collective on world.
-PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep);
+// chosen (optional): the chosen row (R = the stored count when the options are disabled: .N 0).
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep, DualSizeRow *chosen = nullptr);
+
+// -dual_select_refit: the ROM at romPath, built again for the chosen R (its every dual vector), validated on the same
+// held-out solutions; the rule of keeping it (RefitKept): lambda within (1 + refitSlack) of the chosen row's, u and
+// force (max and mean) within (1 + guard) of it. rows: the refitted model's one row.
+PetscErrorCode ValidateRefit(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, DualSizeRow *row);
+bool           RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard);
 
 } // namespace rbc

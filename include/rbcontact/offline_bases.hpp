@@ -53,6 +53,13 @@ PetscErrorCode DualSensitivityStepFromOptions(MPI_Comm comm, PetscReal *step);
 PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snapshot> &snaps, const std::string &path);
 PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b, bool sensitivities = false, const std::string &source = "");
 
+// The bases cut to the leading r dual vectors and the supremizers of those (the columns the online stage uses with
+// -rom_R r, ReducedColumns): dual.W keeps its first r columns, the POD keeps its modes and min(nsup, r) supremizers
+// (pod.modes and modes). Nothing changes when r >= the dual vectors there are. What the offline stage fits to the
+// bases after them (the cubature) then fits only the answer's sizes (-dual_truncate, -dual_select_refit;
+// docs/dual_basis.md "The cubature refitted to the chosen R").
+PetscErrorCode TruncateBases(OfflineBasisSet *b, PetscInt r);
+
 // The multiplier snapshots of `rbcontact dualbasis -snapshots spec` as a matrix (rows = multipliers, columns =
 // snapshots): "file.h5:/dataset" or a PETSc binary matrix (ImportSnapshotMatrix), or an offline snapshot file
 // (its lambda); negative entries beyond round-off (-1e-12 max |.|) are refused, round-off ones clipped to 0.

@@ -12,7 +12,7 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
 {
   char      path[PETSC_MAX_PATH_LEN] = "";
   PetscInt  rbuf[256], nr = 256;
-  PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE;
+  PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE, refit = o->refit ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, "dual_select_", "The answer's dual vectors chosen on held-out FOM solutions (offline)", "SelectDualSize");
@@ -24,6 +24,13 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCall(PetscOptionsReal("-min_fraction", "the smallest candidate R as a fraction of the dual vectors stored", "", o->minFraction, &o->minFraction, NULL));
   PetscCall(PetscOptionsInt("-count", "candidates from there to all, evenly spaced", "", o->count, &o->count, NULL));
   PetscCall(PetscOptionsIntArray("-R", "the candidates themselves (all dual vectors always added)", "", rbuf, &nr, &rset));
+  PetscCall(PetscOptionsBool("-refit", "below the stored count: the bases cut to the chosen R and the online model (its cubature) built again for them", "", refit, &refit, NULL));
+  PetscCall(PetscOptionsReal("-refit_slack", "the refitted model kept if its held-out lambda error is within this relative slack of the chosen row's", "", o->refitSlack, &o->refitSlack, NULL));
+  PetscCall(PetscOptionsReal("-refit_ecsw_tol", "the refit's cubature tolerance (0: -ecsw_tol's)", "", o->refitEcswTol, &o->refitEcswTol, NULL));
+  PetscOptionsEnd();
+  o->refit = refit == PETSC_TRUE;
+  PetscOptionsBegin(comm, "dual_", "The dual basis cut before the online model is built (offline)", "TruncateBases");
+  PetscCall(PetscOptionsInt("-truncate", "keep the leading dual vectors (and their supremizers) only, before the online model (0: all)", "", o->truncate, &o->truncate, NULL));
   PetscOptionsEnd();
   if (pset) o->snapshots = path;
   if (rset) o->candidates.assign(rbuf, rbuf + nr);
@@ -32,6 +39,10 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCheck(o->guard >= 0 && o->guard <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_guard %g out of range [0, 10]", (double)o->guard);
   PetscCheck(o->minFraction > 0 && o->minFraction <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_min_fraction %g is not in (0, 1]", (double)o->minFraction);
   PetscCheck(o->count >= 1 && o->count <= 1000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_count %" PetscInt_FMT " out of range [1, 1000]", o->count);
+  PetscCheck(o->refitSlack >= 0 && o->refitSlack <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_refit_slack %g out of range [0, 10]", (double)o->refitSlack);
+  PetscCheck(o->refitEcswTol >= 0 && o->refitEcswTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_refit_ecsw_tol %g out of range [0, 1) (0: -ecsw_tol's)", (double)o->refitEcswTol);
+  PetscCheck(o->truncate >= 0 && o->truncate <= 1000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_truncate %" PetscInt_FMT " out of range [0, 1e6] (0: every dual vector)", o->truncate);
+  PetscCheck(!o->refit || o->Enabled(), comm, PETSC_ERR_ARG_INCOMP, "-dual_select_refit refits the model for the R chosen on held-out solutions: give -dual_select_size or -dual_select_snapshots");
   for (PetscInt r : o->candidates) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
   if (!o->snapshots.empty()) {
     std::error_code ec;
@@ -41,6 +52,7 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
     PetscCheck(!h.trainingPoints.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "-dual_select_snapshots %s holds no parameters", o->snapshots.c_str());
   }
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-estimate", &estimate, NULL));
+  PetscCheck(!(o->truncate > 0 && estimate), comm, PETSC_ERR_ARG_INCOMP, "-dual_truncate cuts the dual vectors beyond the answer's; it does not combine with -estimate, whose enrichment they are");
   PetscCheck(!(o->Enabled() && estimate), comm, PETSC_ERR_ARG_INCOMP, "-dual_select_%s chooses the answer's R among all stored dual vectors; it does not combine with -estimate, whose enrichment is the dual vectors beyond the answer's", o->snapshots.empty() ? "size" : "snapshots");
   PetscFunctionReturn(0);
 }
@@ -83,7 +95,39 @@ size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, Pet
   return chosen == rows.size() ? all : chosen;
 }
 
-PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep)
+// The held-out parameters (those of -dual_select_snapshots, whose FOM solutions validate reads, or -dual_select_size
+// random ones, solved by it) and validate's settings for them: one timed solve, no table printed.
+static PetscErrorCode HeldOutSet(const SceneSpec &scene, const DualSelectionOptions &o, ParameterSet *held, ValidationSettings *vs)
+{
+  PetscFunctionBeginUser;
+  for (const auto &p : scene.params) held->names.push_back(p.name);
+  if (o.snapshots.empty()) held->points = RandomSample(scene.params, o.size, (unsigned long long)o.seed);
+  else {
+    SnapshotHeader h;
+    PetscCall(SnapshotFile::ReadHeader(o.snapshots, &h));
+    held->points            = h.trainingPoints;
+    vs->testSnapshots       = o.snapshots;
+    vs->testSnapshotsOption = "offline: -dual_select_snapshots";
+  }
+  vs->repeat = 1;
+  vs->print  = false;
+  PetscFunctionReturn(0);
+}
+
+// The count of dual vectors stored in the ROM file at romPath (/online/sizes).
+static PetscErrorCode StoredDualCount(MPI_Comm world, const std::string &romPath, PetscInt *R)
+{
+  std::vector<unsigned long long> dims;
+  std::vector<double>             sizes; // {dim, N, N_pod, n_supremizers, R, 0} (docs/rom_file.md)
+
+  PetscFunctionBeginUser;
+  PetscCall(RomReadDataset(romPath, "/online/sizes", &dims, &sizes));
+  PetscCheck(sizes.size() == 6, world, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/sizes holds %zu values, expected 6", romPath.c_str(), sizes.size());
+  *R = (PetscInt)sizes[4];
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep, DualSizeRow *chosen)
 {
   DualSelectionOptions o;
 
@@ -91,28 +135,15 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   PetscCall(DualSelectionFromOptions(world, &o));
   JsonValue &d = rep->root["dual_select"];
   d["enabled"] = o.Enabled();
+  PetscInt R;
+  PetscCall(StoredDualCount(world, romPath, &R));
+  if (chosen) *chosen = DualSizeRow{R, 0};
   if (!o.Enabled()) PetscFunctionReturn(0);
   PetscLogDouble t0, t1;
   PetscCall(PetscTime(&t0));
-  std::vector<unsigned long long> dims;
-  std::vector<double>             sizes; // {dim, N, N_pod, n_supremizers, R, 0} (docs/rom_file.md)
-  PetscCall(RomReadDataset(romPath, "/online/sizes", &dims, &sizes));
-  PetscCheck(sizes.size() == 6, world, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/sizes holds %zu values, expected 6", romPath.c_str(), sizes.size());
-  const PetscInt R = (PetscInt)sizes[4];
-
-  ParameterSet held;
-  for (const auto &p : scene.params) held.names.push_back(p.name);
+  ParameterSet       held;
   ValidationSettings vs;
-  if (o.snapshots.empty()) held.points = RandomSample(scene.params, o.size, (unsigned long long)o.seed);
-  else {
-    SnapshotHeader h;
-    PetscCall(SnapshotFile::ReadHeader(o.snapshots, &h));
-    held.points            = h.trainingPoints;
-    vs.testSnapshots       = o.snapshots;
-    vs.testSnapshotsOption = "offline: -dual_select_snapshots";
-  }
-  vs.repeat  = 1;
-  vs.print   = false;
+  PetscCall(HeldOutSet(scene, o, &held, &vs));
   vs.rValues = DualSelectionCandidates(o, R);
   std::vector<DualSizeRow> rows;
   vs.rRows = &rows;
@@ -121,6 +152,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
 
   d["candidates"] = vr.root["sweep_R"]; // validate's rows (-validate_sweep_R), one per candidate
   const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack, o.guard)], &a = rows.back();
+  if (chosen) *chosen = c;
   if (c.R < R) { // R itself: no dataset (the file's default), the file as written
     w->Dataset("/online/dual_select", {1}, {(double)c.R});
     PetscCall(w->Write(world, romPath));
@@ -146,6 +178,30 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   rep->root["rom"]["N_in_use"]       = (long long)c.N;
   PetscCall(PetscPrintf(world, "rbcontact offline: R chosen on %zu held-out FOM solutions: %" PetscInt_FMT " of %" PetscInt_FMT " dual vectors (N %" PetscInt_FMT "), max rel err lambda %.3e u %.3e force %.3e (all %" PetscInt_FMT ": %.3e, %.3e, %.3e)\n", held.points.size(), c.R, R, c.N, c.lambda, c.u, c.force, R, a.lambda, a.u, a.force));
   PetscFunctionReturn(0);
+}
+
+PetscErrorCode ValidateRefit(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, DualSizeRow *row)
+{
+  PetscFunctionBeginUser;
+  ParameterSet       held;
+  ValidationSettings vs;
+  PetscCall(HeldOutSet(scene, o, &held, &vs));
+  PetscInt R;
+  PetscCall(StoredDualCount(world, romPath, &R));
+  vs.rValues = {R};
+  std::vector<DualSizeRow> rows;
+  vs.rRows = &rows;
+  Report vr;
+  PetscCall(RunValidation(world, scene, romPath, held, vs, &vr));
+  PetscCheck(rows.size() == 1, world, PETSC_ERR_PLIB, "ValidateRefit: %zu rows for one R", rows.size());
+  *row = rows[0];
+  PetscFunctionReturn(0);
+}
+
+bool RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard)
+{
+  const PetscReal g = 1 + guard;
+  return !refit.failed && refit.lambda <= (1 + refitSlack) * chosen.lambda && refit.u <= g * chosen.u && refit.force <= g * chosen.force && refit.meanU <= g * chosen.meanU && refit.meanForce <= g * chosen.meanForce;
 }
 
 } // namespace rbc

@@ -363,6 +363,35 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode TruncateBases(OfflineBasisSet *b, PetscInt r)
+{
+  PetscFunctionBeginUser;
+  DualBasisResult &d = b->dual;
+  PetscCheck(r >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "TruncateBases: %" PetscInt_FMT " dual vectors (at least 1)", r);
+  if (r >= d.W.cols) PetscFunctionReturn(0);
+  d.W.a.resize((size_t)d.W.rows * r); // column-major: the leading r columns
+  d.W.cols = r;
+  if ((PetscInt)d.selected.size() > r) d.selected.resize(r);
+  const PetscInt Npod = b->pod.N - b->nsup, nsup = std::min(b->nsup, r), N = Npod + nsup;
+  if (N < b->pod.N) {
+    const size_t ndofs = b->modes.size() / (size_t)b->pod.N;
+    BV           V;
+    PetscCall(BVDuplicateResize(b->pod.modes, N, &V)); // carries the modes' inner-product matrix
+    for (PetscInt j = 0; j < N; ++j) {
+      Vec x;
+      PetscCall(BVGetColumn(b->pod.modes, j, &x));
+      PetscCall(BVInsertVec(V, j, x));
+      PetscCall(BVRestoreColumn(b->pod.modes, j, &x));
+    }
+    PetscCall(BVDestroy(&b->pod.modes));
+    b->pod.modes = V;
+    b->modes.resize((size_t)N * ndofs); // N x ndofs, the leading N modes
+    b->pod.N = N;
+    b->nsup  = nsup;
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::string &snapPath, const std::string &romPath, const SnapshotHeader &header, Report *rep, ContactMap *cmap, bool onlineRom, const std::string &basisPath, bool partial, bool sensitivities)
 {
   PetscMPIInt     wrank;
@@ -375,9 +404,13 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   const PetscInt m = (PetscInt)snaps.size(), ntrain = (PetscInt)header.trainingPoints.size(), R = header.nmult;
   PetscCheck(m == ntrain || (partial && m > 0), world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' holds %" PetscInt_FMT " of %" PetscInt_FMT " snapshots: finish it first (offline -offline_stop snapshots -snapshots_restart)", snapPath.c_str(), m, ntrain);
   PetscCall(BuildBases(world, fom, order, snaps, R, cmap, &bs, sensitivities, snapPath));
+  DualSelectionOptions dso;
+  PetscCall(DualSelectionFromOptions(world, &dso));
+  const PetscInt rBuilt = bs.dual.W.cols;
+  if (R > 0 && dso.truncate > 0) PetscCall(TruncateBases(&bs, dso.truncate)); // -dual_truncate
   PODResult            &pod   = bs.pod;
   DualBasisResult      &dual  = bs.dual;
-  const PetscInt        nsup  = bs.nsup;
+  const PetscInt       &nsup  = bs.nsup; // TruncateBases (-dual_select_refit) may cut it
   SupremizerEnrichment &enr   = bs.enr;
   std::vector<double>  &modes = bs.modes;
   const char           *inner = bs.inner.c_str();
@@ -417,32 +450,100 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     x->Attr("pod_inner", inner);
     x->Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
   };
-  if (wrank == 0) {
-    provenance(&w);
-    std::vector<double> box;
-    for (size_t i = 0; i < header.paramMin.size(); ++i) { box.push_back(header.paramMin[i]); box.push_back(header.paramMax[i]); }
-    w.Dataset("/params/box", {header.paramMin.size(), 2}, box);
-    w.Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
-    if (R > 0) WriteDualBasis(dual, &w, true);
-  }
+  // the basis file's datasets (w) and, with the online ROM, the online model (wr)
+  auto writers = [&](RomWriter *bw, RomWriter *rw) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    if (wrank == 0) {
+      provenance(bw);
+      std::vector<double> box;
+      for (size_t i = 0; i < header.paramMin.size(); ++i) { box.push_back(header.paramMin[i]); box.push_back(header.paramMax[i]); }
+      bw->Dataset("/params/box", {header.paramMin.size(), 2}, box);
+      bw->Dataset("/pod/modes", {(unsigned long long)pod.N, (unsigned long long)header.ndofs}, modes);
+      if (R > 0) WriteDualBasis(dual, bw, true);
+    }
+    if (onlineRom) {
+      PetscCheck(cmap, world, PETSC_ERR_ARG_WRONGSTATE, "offline: the online ROM needs the contact surfaces (-contact_slave, -contact_master)");
+      // the online ROM: everything the online stage needs, nothing of the size of the mesh
+      PetscCheck(R > 0, world, PETSC_ERR_SUP, "offline: no multipliers (R = 0): nothing to reduce for contact");
+      rw->version = 2;
+      if (wrank == 0) {
+        provenance(rw);
+        rw->Attr("basis_file", RelativeTo(basisPath, romPath)); // read back relative to the ROM file (rom_fields.cpp)
+        WriteDualBasis(dual, rw, false);
+      }
+      PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, rw, rep, bs.nDefault, bs.rDefault));
+    }
+    PetscFunctionReturn(0);
+  };
+  // -dual_select_refit (docs/dual_basis.md "The cubature refitted to the chosen R"): the bases cut to the chosen R, the
+  // online model built again for them (its cubature fitted to the answer's terms only) and validated on the same
+  // held-out solutions; kept when RefitKept, else both files and the report as they were
+  const DualBasisResult dualBuilt = bs.dual; // R x r: small
+  bool                  refitDropped = false;
+  PetscInt              nFile = 0, nsupFile = 0; // the files' sizes before a refit
+  auto refitChosen = [&](const DualSizeRow &chosen) -> PetscErrorCode {
+    PetscLogDouble t0, t1;
+    PetscFunctionBeginUser;
+    PetscCall(PetscTime(&t0));
+    const JsonValue before   = rep->root;
+    const long long mcBefore = (long long)rep->root["rom"]["Mc"].AsNumber();
+    nFile = pod.N;
+    nsupFile = nsup;
+    PetscCall(TruncateBases(&bs, chosen.R));
+    // -dual_select_refit_ecsw_tol: the cubature's tolerance for the refit only (the options database as it was after)
+    char      tolWas[64] = "";
+    PetscBool tolSet     = PETSC_FALSE;
+    if (dso.refitEcswTol > 0) {
+      char tol[64];
+      PetscCall(PetscOptionsGetString(NULL, NULL, "-ecsw_tol", tolWas, sizeof tolWas, &tolSet));
+      PetscCall(PetscSNPrintf(tol, sizeof tol, "%.17g", (double)dso.refitEcswTol));
+      PetscCall(PetscOptionsSetValue(NULL, "-ecsw_tol", tol));
+    }
+    RomWriter bw, rw;
+    PetscCall(writers(&bw, &rw));
+    if (dso.refitEcswTol > 0) PetscCall(tolSet ? PetscOptionsSetValue(NULL, "-ecsw_tol", tolWas) : PetscOptionsClearValue(NULL, "-ecsw_tol"));
+    const long long mc       = (long long)rep->root["rom"]["Mc"].AsNumber();
+    const double    refitTol = rep->root["ecsw"]["tol"].AsNumber();
+    PetscCall(bw.Write(world, bpath));
+    PetscCall(rw.Write(world, romPath));
+    DualSizeRow row;
+    PetscCall(ValidateRefit(world, fom.scene, romPath, dso, &row));
+    const bool kept = RefitKept(row, chosen, dso.refitSlack, dso.guard);
+    if (!kept) {
+      rep->root = before;
+      PetscCall(w.Write(world, bpath));
+      PetscCall(wr.Write(world, romPath));
+      bs.dual      = dualBuilt;
+      refitDropped = true;
+    }
+    PetscCall(PetscTime(&t1));
+    JsonValue &r           = rep->root["dual_select"]["refit"];
+    r["R"]                 = (long long)row.R;
+    r["N"]                 = (long long)row.N;
+    r["Mc_before"]         = mcBefore;
+    r["Mc"]                = mc;
+    r["max_rel_err_u"]     = row.u;
+    r["max_rel_err_lambda"] = row.lambda;
+    r["max_rel_err_force"] = row.force;
+    r["failed"]            = row.failed;
+    r["slack"]             = (double)dso.refitSlack;
+    r["ecsw_tol"]          = refitTol; // the refit's cubature tolerance (the report's ecsw: the kept model's)
+    r["kept"]              = kept;
+    rep->root["time_s"]["dual_select_refit"] = (double)(t1 - t0);
+    PetscCall(PetscPrintf(world, "rbcontact offline: the online model refitted to R %" PetscInt_FMT " (N %" PetscInt_FMT "): Mc %lld -> %lld, held-out max rel err lambda %.3e u %.3e force %.3e (before: %.3e, %.3e, %.3e): %s\n", row.R, row.N, mcBefore, mc, row.lambda, row.u, row.force, chosen.lambda, chosen.u, chosen.force, kept ? "kept" : "not kept (-dual_select_refit_slack, -dual_select_guard), the files as before"));
+    PetscFunctionReturn(0);
+  };
+  PetscCall(writers(&w, &wr));
   // the bases alone (-offline_stop bases) are written now; with the online ROM, after it is built, so
   // that a failed run leaves the previous ROM and basis file together (and rom_id tells a torn pair)
   if (!onlineRom) PetscCall(w.Write(world, bpath));
   if (onlineRom) {
-    PetscCheck(cmap, world, PETSC_ERR_ARG_WRONGSTATE, "offline: the online ROM needs the contact surfaces (-contact_slave, -contact_master)");
-    // the online ROM: everything the online stage needs, nothing of the size of the mesh
-    PetscCheck(R > 0, world, PETSC_ERR_SUP, "offline: no multipliers (R = 0): nothing to reduce for contact");
-    wr.version = 2;
-    if (wrank == 0) {
-      provenance(&wr);
-      wr.Attr("basis_file", RelativeTo(basisPath, romPath)); // read back relative to the ROM file (rom_fields.cpp)
-      WriteDualBasis(dual, &wr, false);
-    }
-    PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, &wr, rep, bs.nDefault, bs.rDefault));
     PetscCall(w.Write(world, bpath));
     PetscCall(wr.Write(world, romPath));
     if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
-    PetscCall(SelectDualSize(world, fom.scene, romPath, &wr, rep)); // -dual_select_*: the answer's R on held-out solutions
+    DualSizeRow chosen;
+    PetscCall(SelectDualSize(world, fom.scene, romPath, &wr, rep, &chosen)); // -dual_select_*: the answer's R on held-out solutions
+    if (dso.refit && chosen.R < dual.W.cols) PetscCall(refitChosen(chosen));
     unsigned long long big[2] = {0, 0};
     std::string        bigName;
     if (wrank == 0) {
@@ -458,12 +559,12 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   }
 
   JsonValue &p = rep->root["pod"];
-  p["n"]               = (long long)pod.N;
+  p["n"]               = (long long)(refitDropped ? nFile : pod.N); // the files' (a dropped refit cut only the memory's)
   p["inner"]           = inner;
   p["singular_values"] = pod.singularValues;
   p["energy_captured"] = (double)pod.energyCaptured;
   p["orthonormality_error"] = (double)pod.orthonormalityError;
-  p["supremizers"]     = (long long)nsup;
+  p["supremizers"]     = (long long)(refitDropped ? nsupFile : nsup);
   p["sensitivity_vectors"] = (long long)bs.sensitivityVectors;
   rep->root["dual"]["predicted_columns"] = (long long)bs.dualPredicted;
   if (enr.candidates > 0) {
@@ -479,6 +580,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     ps["elastic_solver"]      = fom.ElasticSolverName(); // the supremizers' A^{-1}: a MUMPS factor, or CG + GAMG (-fom_saddle_solver gamg)
   }
   if (R > 0) PetscCall(ReportDualBasis(world, dual, rep));
+  if (R > 0 && dual.W.cols < rBuilt) rep->root["dual"]["truncated_from"] = (long long)rBuilt; // -dual_truncate, -dual_select_refit
   rep->root["time_s"]["pod"]  = (double)bs.seconds[0];
   rep->root["time_s"]["dual"] = (double)bs.seconds[1];
   rep->root["time_s"]["snapshot_contact"] = (double)bs.contactSeconds; // the snapshots' K(u_j), reassembled for the supremizers
