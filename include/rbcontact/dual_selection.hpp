@@ -31,8 +31,10 @@ struct DualSelectionOptions {
   std::vector<PetscInt> candidates;         // -dual_select_R: the candidates themselves (R is always added)
   bool                  refit = false;      // -dual_select_refit: below the stored R, the bases cut to the chosen R and the
                                             // online model (the cubature) built again for them (TruncateBases)
-  PetscReal             refitSlack = 0.05;  // -dual_select_refit_slack: the refitted model is kept if its held-out lambda is
-                                            // within it of the chosen row's (u and force: within -dual_select_guard)
+  PetscReal             refitSlack = 0.1;   // -dual_select_refit_slack: the refitted model is kept if its held-out lambda is
+                                            // within it of the chosen row's (u and force: within -dual_select_guard); the
+                                            // guard's default: the chosen row is a minimum over the candidates, biased low
+                                            // by their spread (docs/dual_basis.md)
   PetscReal             refitEcswTol = 0;   // -dual_select_refit_ecsw_tol: the refit's cubature tolerance (0: -ecsw_tol's)
   PetscInt              truncate = 0;       // -dual_truncate: the bases cut to this many dual vectors before the online
                                             // model is built (0: all; TruncateBases)
