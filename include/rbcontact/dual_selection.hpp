@@ -41,9 +41,10 @@ struct DualSelectionOptions {
   bool Enabled() const { return size > 0 || !snapshots.empty(); }
 };
 
-// Reads and checks the options (prefix dual_select_); the offline stage calls it before its snapshots (hours on a
-// real scene) and again at the end. Errors: ranges, a missing or unreadable snapshot file, -estimate (whose
-// enrichment is the dual vectors beyond the answer's).
+// Reads and checks the options (prefix dual_select_, and -dual_truncate); the offline stage calls it before its
+// snapshots (hours on a real scene) and again at the end. Errors: ranges, a missing or unreadable snapshot file,
+// -estimate (whose enrichment is the dual vectors beyond the answer's) with a choice or -dual_truncate, -dual_select_refit
+// without a choice.
 PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o);
 
 // The candidates for a file of R dual vectors: -dual_select_R (those above R left out: R is the dual greedy's, not
@@ -69,7 +70,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
 
 // -dual_select_refit: the ROM at romPath, built again for the chosen R (its every dual vector), validated on the same
 // held-out solutions; the rule of keeping it (RefitKept): lambda within (1 + refitSlack) of the chosen row's, u and
-// force (max and mean) within (1 + guard) of it. rows: the refitted model's one row.
+// force (max and mean) within (1 + guard) of it. row: the refitted model's held-out errors.
 PetscErrorCode ValidateRefit(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, DualSizeRow *row);
 bool           RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard);
 
