@@ -58,15 +58,15 @@ std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, Pet
 // largest R when none is. Returns the chosen row's index.
 size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack);
 
-// With the options enabled: validates the ROM at romPath (w: its writer, holding the model) on the held-out FOM
-// solutions for every candidate, chooses R (ChooseDualSize) and, when R is below the stored count, writes
-// /online/dual_select (the file rewritten atomically). Report keys: dual_select {enabled, heldout, seed or
-// snapshots, slack, guard, candidates [validate's sweep_R rows: R, N, max_rel_err_{u,lambda,force},
+// With the options o (DualSelectionFromOptions) enabled: validates the ROM at romPath (w: its writer, holding the
+// model) on the held-out FOM solutions for every candidate, chooses R (ChooseDualSize) and, when R is below the
+// stored count, writes /online/dual_select (the file rewritten atomically). Report keys: dual_select {enabled,
+// heldout, seed or snapshots, slack, guard, candidates [validate's sweep_R rows: R, N, max_rel_err_{u,lambda,force},
 // mean_rel_err_{u,lambda,force}, failed], R, N, R_stored, max_rel_err_{u,lambda,force} (the chosen row),
 // max_rel_err_{u,lambda,force}_all (every dual vector), fom_median_s}; rom.R_in_use and rom.N_in_use become the
 // chosen sizes; time_s.dual_select its seconds. Collective on world.
 // chosen (optional): the chosen row (R = the stored count when the options are disabled: .N 0).
-PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep, DualSizeRow *chosen = nullptr);
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, RomWriter *w, Report *rep, DualSizeRow *chosen = nullptr);
 
 // -dual_select_refit: the ROM at romPath, built again for the chosen R (its every dual vector), validated on the same
 // held-out solutions; the rule of keeping it (RefitKept): lambda within (1 + refitSlack) of the chosen row's, u and

@@ -23,8 +23,9 @@ PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h);
 
 // V: the primal basis (Npod POD modes then nsup supremizers) on fom's DM; modes: the same, N x ndofs
 // row-major in canonical order, on every rank of fom's communicator. order's multipliers are numbered
-// here when a resumed run solved no snapshot. Report keys eim {...}, rom {...}.
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault = -1, PetscInt rDefault = -1);
+// here when a resumed run solved no snapshot. ecswTol > 0: the cubature's tolerance instead of -ecsw_tol's
+// (-dual_select_refit_ecsw_tol). Report keys eim {...}, rom {...}.
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault = -1, PetscInt rDefault = -1, PetscReal ecswTol = 0);
 
 // The reduced model with exact contact terms: reduced affine terms V'A_qV, V'f_q and the full contact patch
 // (every -eim_quadrature_subdivisions point of the slave facets on the support of the dual basis) with

@@ -127,12 +127,9 @@ static PetscErrorCode StoredDualCount(MPI_Comm world, const std::string &romPath
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep, DualSizeRow *chosen)
+PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, RomWriter *w, Report *rep, DualSizeRow *chosen)
 {
-  DualSelectionOptions o;
-
   PetscFunctionBeginUser;
-  PetscCall(DualSelectionFromOptions(world, &o));
   JsonValue &d = rep->root["dual_select"];
   d["enabled"] = o.Enabled();
   PetscInt R;

@@ -451,7 +451,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     x->Dataset("/pod/singular_values", {pod.singularValues.size()}, pod.singularValues);
   };
   // the basis file's datasets (w) and, with the online ROM, the online model (wr)
-  auto writers = [&](RomWriter *bw, RomWriter *rw) -> PetscErrorCode {
+  // (ecswTol > 0: the cubature's tolerance instead of -ecsw_tol's)
+  auto writers = [&](RomWriter *bw, RomWriter *rw, PetscReal ecswTol) -> PetscErrorCode {
     PetscFunctionBeginUser;
     if (wrank == 0) {
       provenance(bw);
@@ -471,7 +472,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
         rw->Attr("basis_file", RelativeTo(basisPath, romPath)); // read back relative to the ROM file (rom_fields.cpp)
         WriteDualBasis(dual, rw, false);
       }
-      PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, rw, rep, bs.nDefault, bs.rDefault));
+      PetscCall(OfflineReducedModel(world, fom, *cmap, order, snaps, pod.modes, modes, pod.N - nsup, nsup, dual, rw, rep, bs.nDefault, bs.rDefault, ecswTol));
     }
     PetscFunctionReturn(0);
   };
@@ -490,18 +491,8 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     nFile = pod.N;
     nsupFile = nsup;
     PetscCall(TruncateBases(&bs, chosen.R));
-    // -dual_select_refit_ecsw_tol: the cubature's tolerance for the refit only (the options database as it was after)
-    char      tolWas[64] = "";
-    PetscBool tolSet     = PETSC_FALSE;
-    if (dso.refitEcswTol > 0) {
-      char tol[64];
-      PetscCall(PetscOptionsGetString(NULL, NULL, "-ecsw_tol", tolWas, sizeof tolWas, &tolSet));
-      PetscCall(PetscSNPrintf(tol, sizeof tol, "%.17g", (double)dso.refitEcswTol));
-      PetscCall(PetscOptionsSetValue(NULL, "-ecsw_tol", tol));
-    }
     RomWriter bw, rw;
-    PetscCall(writers(&bw, &rw));
-    if (dso.refitEcswTol > 0) PetscCall(tolSet ? PetscOptionsSetValue(NULL, "-ecsw_tol", tolWas) : PetscOptionsClearValue(NULL, "-ecsw_tol"));
+    PetscCall(writers(&bw, &rw, dso.refitEcswTol)); // -dual_select_refit_ecsw_tol (0: -ecsw_tol's)
     const long long mc       = (long long)rep->root["rom"]["Mc"].AsNumber();
     const double    refitTol = rep->root["ecsw"]["tol"].AsNumber();
     PetscCall(bw.Write(world, bpath));
@@ -533,7 +524,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(PetscPrintf(world, "rbcontact offline: the online model refitted to R %" PetscInt_FMT " (N %" PetscInt_FMT "): Mc %lld -> %lld, held-out max rel err lambda %.3e u %.3e force %.3e (before: %.3e, %.3e, %.3e): %s\n", row.R, row.N, mcBefore, mc, row.lambda, row.u, row.force, chosen.lambda, chosen.u, chosen.force, kept ? "kept" : "not kept (-dual_select_refit_slack, -dual_select_guard), the files as before"));
     PetscFunctionReturn(0);
   };
-  PetscCall(writers(&w, &wr));
+  PetscCall(writers(&w, &wr, 0));
   // the bases alone (-offline_stop bases) are written now; with the online ROM, after it is built, so
   // that a failed run leaves the previous ROM and basis file together (and rom_id tells a torn pair)
   if (!onlineRom) PetscCall(w.Write(world, bpath));
@@ -542,7 +533,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(wr.Write(world, romPath));
     if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
     DualSizeRow chosen;
-    PetscCall(SelectDualSize(world, fom.scene, romPath, &wr, rep, &chosen)); // -dual_select_*: the answer's R on held-out solutions
+    PetscCall(SelectDualSize(world, fom.scene, romPath, dso, &wr, rep, &chosen)); // -dual_select_*: the answer's R on held-out solutions
     if (dso.refit && chosen.R < dual.W.cols) PetscCall(refitChosen(chosen));
     unsigned long long big[2] = {0, 0};
     std::string        bigName;

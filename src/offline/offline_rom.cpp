@@ -246,7 +246,7 @@ static PetscErrorCode LambdaFitMetric(ElasticFOM &fom, ContactMap &cmap, Canonic
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault, PetscInt rDefault)
+PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, const std::vector<Snapshot> &snaps, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, RomWriter *w, Report *rep, PetscInt nDefault, PetscInt rDefault, PetscReal ecswTol)
 {
   PetscLogDouble t0, t1, t2;
   PetscMPIInt    wrank;
@@ -517,6 +517,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   PetscInt               metricForceRank = 0; // -ecsw_fit lambda: the rank of its force metric (0: left out)
   if (hyper.ecsw) {
     PetscCall(CubatureOptionsFromOptions(world, "ecsw_", &co));
+    if (ecswTol > 0) co.tol = ecswTol;
     if (wrank != 0) co.monitor = false;
     // with the error estimate's enrichment (offline -estimate) the points are fitted to every stored basis function
     // (-estimate_cubature enriched, the default: the tighter estimate) or to the answer's sizes only (answer: the
