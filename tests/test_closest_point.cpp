@@ -2,6 +2,7 @@
 // on a circle polyline (2D segments) and a triangulated sphere patch (3D triangles), and the facet
 // Lagrange basis (partition of unity, nodal interpolation) for P1 and P2.
 #include "rbcontact/contact.hpp"
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -50,6 +51,81 @@ int main(int argc, char **argv)
       worst = std::max(worst, std::abs(d - best));
     }
     Check(worst <= 1e-14, "2D: binned distance equals brute force (2000 points)", worst);
+    // FindAmong (pruned by the segments' bounding circles after the first candidate) against a plain scan of
+    // DistToFacet2 over candidate lists: the same facet and coordinates, bit for bit. Random points with random subsets
+    // (in random order), and points radially outside a vertex with the lists of its neighbourhood: there both
+    // segments of the vertex are at the same distance up to rounding (the ties the pruning must not decide)
+    int mismatch = 0, lists = 0;
+    for (int k = 0; k < 4000; ++k) {
+      PetscReal             p[2];
+      std::vector<PetscInt> cand;
+      if (k < 2000) {
+        p[0] = U(gen);
+        p[1] = U(gen);
+        for (PetscInt j = 0; j < n; ++j)
+          if (U(gen) < (k % 2 ? -1.35 : 0.0)) cand.push_back(j);
+        std::shuffle(cand.begin(), cand.end(), gen);
+      } else {
+        const PetscInt   v = k % n;
+        const PetscReal *x = cp.Vertices(v); // its first vertex: shared with segment v - 1
+        const double     s = 1 + 0.2 * (U(gen) + 1.5);
+        p[0]               = s * x[0];
+        p[1]               = s * x[1];
+        for (PetscInt j = -4; j <= 4; ++j) cand.push_back(((v + j) % n + n) % n);
+        std::shuffle(cand.begin(), cand.end(), gen);
+      }
+      if (cand.empty()) continue;
+      ++lists;
+      PetscInt  m, mref = -1;
+      PetscReal b[3], d, bref[3] = {0, 0, 0}, best = PETSC_MAX_REAL;
+      cp.FindAmong(p, cand.data(), (PetscInt)cand.size(), &m, b, &d);
+      for (PetscInt j : cand) {
+        PetscReal       bb[3];
+        const PetscReal dd = cp.DistToFacet2(j, p, bb);
+        if (dd < best || (dd == best && j < mref)) {
+          best = dd;
+          mref = j;
+          for (int e = 0; e < 2; ++e) bref[e] = bb[e];
+        }
+      }
+      if (m != mref || b[0] != bref[0] || b[1] != bref[1] || d != std::sqrt(best)) ++mismatch;
+    }
+    Check(mismatch == 0 && lists > 3000, "2D: FindAmong (bounding-circle pruning) equals the plain scan on 4000 candidate lists (mismatches)", mismatch);
+  }
+  // 2D, the bound where it is tight: p on the line of segment A beyond its end (|p - c_A| = d_A + r_A exactly), and
+  // first in the list a decoy B at the relative distance 1 + eps of d_A (eps 1e-13..1e-3). A must be visited and win:
+  // a circle even 1e-10 too small would skip it for the smallest eps
+  {
+    std::vector<SurfaceFacet> f;
+    std::vector<PetscReal>    pts;
+    std::uniform_real_distribution<double> V(0, 1);
+    for (int k = 0; k < 1000; ++k) {
+      const double th = 2 * M_PI * V(gen), L = 0.5 + 1.5 * V(gen), s = 0.01 + V(gen), eps = std::pow(10.0, -3 - 10 * V(gen));
+      const double u[2] = {std::cos(th), std::sin(th)}, w[2] = {-u[1], u[0]}, a0[2] = {U(gen), U(gen)};
+      const double p[2] = {a0[0] + (L + s) * u[0], a0[1] + (L + s) * u[1]}, o = s * (1 + eps);
+      SurfaceFacet A, B;
+      A.nv = B.nv = 2; A.nnodes = B.nnodes = 2;
+      A.nodeKind[0] = B.nodeKind[0] = 0; A.nodeKind[1] = B.nodeKind[1] = 1;
+      A.X[0] = a0[0]; A.X[1] = a0[1]; A.X[2] = a0[0] + L * u[0]; A.X[3] = a0[1] + L * u[1];
+      B.X[0] = p[0] + o * w[0] - u[0]; B.X[1] = p[1] + o * w[1] - u[1]; B.X[2] = p[0] + o * w[0] + u[0]; B.X[3] = p[1] + o * w[1] + u[1];
+      f.push_back(A);
+      f.push_back(B);
+      pts.push_back(p[0]);
+      pts.push_back(p[1]);
+    }
+    ClosestPoint cp;
+    cp.SetVertices(f, 2, false);
+    int wrong = 0;
+    for (int k = 0; k < 1000; ++k) {
+      const PetscInt list[2] = {2 * k + 1, 2 * k}; // the decoy first
+      PetscInt       m;
+      PetscReal      b[3], d, bb[3];
+      cp.FindAmong(&pts[2 * k], list, 2, &m, b, &d);
+      const PetscReal dA = cp.DistToFacet2(2 * k, &pts[2 * k], bb), dB = cp.DistToFacet2(2 * k + 1, &pts[2 * k], bb);
+      const PetscInt  ref = dA <= dB ? 2 * k : 2 * k + 1; // the plain scan's (a tie to the lower index, A)
+      wrong += m != ref;
+    }
+    Check(wrong == 0, "2D: FindAmong visits the segment whose circle bound is tight (1000 decoys at 1 + 1e-13..1e-3)", wrong);
   }
   // 3D: triangulated patch z = 0.2 sin(x) cos(y) on [-1,1]^2
   {

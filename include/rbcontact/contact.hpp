@@ -76,7 +76,7 @@ private:
   PetscInt              dim_ = 2, nv_ = 2;
   std::vector<PetscReal> xdef_;
   std::vector<PetscReal> invLen2_; // 2D: 1 / |x1 - x0|^2 per facet (0 for a degenerate one), set with the vertices
-  std::vector<PetscReal> sphere_;  // 3D: per facet a bounding sphere (centroid, radius), set with the vertices
+  std::vector<PetscReal> sphere_;  // per facet a bounding sphere (3D: centroid, radius; 2D: midpoint, 0, half length), set with the vertices
   PetscReal             lo_[3] = {0, 0, 0}, h_[3] = {1, 1, 1};
   PetscInt              nb_[3] = {1, 1, 1};
   std::vector<PetscInt> binStart_, binFacets_;

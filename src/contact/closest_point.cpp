@@ -20,7 +20,7 @@ void ClosestPoint::ResizeVertices(PetscInt nf, PetscInt dim)
   nv_  = dim;
   // (resize, not assign: every facet's entries are written by SetVerticesOf; 2D leaves the unused ones 0)
   xdef_.resize(9 * nf, 0.0);
-  sphere_.resize(dim == 3 ? 4 * nf : 0, 0.0); // 3D: a bounding sphere per triangle (centroid, radius), FindAmong's lower bound
+  sphere_.resize(4 * nf, 0.0); // a bounding sphere per facet (centre, radius; 2D: midpoint, 0, half length), FindAmong's lower bound
   invLen2_.resize(dim == 2 ? nf : 0, 0.0);
 }
 
@@ -51,7 +51,12 @@ void ClosestPoint::SetVerticesOf(const std::vector<SurfaceFacet> &facets, bool d
   if (dim == 2)
     for (PetscInt f = a; f < b; ++f) {
       const PetscReal *x = &xdef_[9 * f], tt = (x[2] - x[0]) * (x[2] - x[0]) + (x[3] - x[1]) * (x[3] - x[1]);
-      invLen2_[f] = tt > 0 ? 1.0 / tt : 0.0;
+      PetscReal       *c = &sphere_[4 * f];
+      invLen2_[f]        = tt > 0 ? 1.0 / tt : 0.0;
+      c[0]               = 0.5 * (x[0] + x[2]);
+      c[1]               = 0.5 * (x[1] + x[3]);
+      c[2]               = 0;
+      c[3]               = 0.5 * std::sqrt(tt) * (1 + 1e-12); // rounding: the circle must contain the segment
     }
 }
 
@@ -63,9 +68,17 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
     // DistToFacet2's 2D branch written into the loop (the same arithmetic, so the same facet and
     // coordinates): the reduced model's cubature points call this once per point and iterate over
     // 7-20 candidates, and the call per candidate cost more than the distance (docs/online.md).
-    PetscReal sbest = 0;
+    // After the first candidate (the lists are sorted nearest first offline), a segment whose bounding circle
+    // (midpoint c, half length r) is out of reach, |p - c| > sqrt(best) + r, is strictly farther than the best so far
+    // and skipped, as in 3D below: the same facet and coordinates as the full scan (ties are never skipped).
+    PetscReal sbest = 0, sb = PETSC_MAX_REAL;
     for (PetscInt i = 0; i < nc; ++i) {
       const PetscInt   f    = cand[i];
+      if (i > 0) {
+        const PetscReal *c     = &sphere_[4 * f];
+        const PetscReal  reach = sb + c[3];
+        if ((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) > reach * reach) continue;
+      }
       const PetscReal *x    = &xdef_[9 * f];
       const PetscReal  t[2] = {x[2] - x[0], x[3] - x[1]};
       PetscReal        s    = ((p[0] - x[0]) * t[0] + (p[1] - x[1]) * t[1]) * invLen2_[f];
@@ -76,6 +89,7 @@ void ClosestPoint::FindAmong(const PetscReal p[], const PetscInt *cand, PetscInt
         best   = dd;
         *facet = f;
         sbest  = s;
+        sb     = std::sqrt(best);
       }
     }
     if (*facet >= 0) {
