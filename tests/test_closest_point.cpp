@@ -15,6 +15,27 @@ static void Check(bool ok, const char *what, double v)
   if (!ok) ++failures;
 }
 
+// FindAmong against a plain scan of DistToFacet2 over the same list (ties to the lower facet number): the same facet,
+// the same nb barycentric coordinates and distance, bit for bit.
+static bool SameAsPlainScan(const ClosestPoint &cp, const PetscReal p[], const std::vector<PetscInt> &cand, int nb)
+{
+  PetscInt  m, mref = -1;
+  PetscReal b[3], d, bref[3] = {0, 0, 0}, best = PETSC_MAX_REAL;
+  cp.FindAmong(p, cand.data(), (PetscInt)cand.size(), &m, b, &d);
+  for (PetscInt j : cand) {
+    PetscReal       bb[3];
+    const PetscReal dd = cp.DistToFacet2(j, p, bb);
+    if (dd < best || (dd == best && j < mref)) {
+      best = dd;
+      mref = j;
+      for (int e = 0; e < nb; ++e) bref[e] = bb[e];
+    }
+  }
+  bool same = m == mref && d == std::sqrt(best);
+  for (int e = 0; e < nb; ++e) same = same && b[e] == bref[e];
+  return same;
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
@@ -76,19 +97,7 @@ int main(int argc, char **argv)
       }
       if (cand.empty()) continue;
       ++lists;
-      PetscInt  m, mref = -1;
-      PetscReal b[3], d, bref[3] = {0, 0, 0}, best = PETSC_MAX_REAL;
-      cp.FindAmong(p, cand.data(), (PetscInt)cand.size(), &m, b, &d);
-      for (PetscInt j : cand) {
-        PetscReal       bb[3];
-        const PetscReal dd = cp.DistToFacet2(j, p, bb);
-        if (dd < best || (dd == best && j < mref)) {
-          best = dd;
-          mref = j;
-          for (int e = 0; e < 2; ++e) bref[e] = bb[e];
-        }
-      }
-      if (m != mref || b[0] != bref[0] || b[1] != bref[1] || d != std::sqrt(best)) ++mismatch;
+      mismatch += !SameAsPlainScan(cp, p, cand, 2);
     }
     Check(mismatch == 0 && lists > 3000, "2D: FindAmong (bounding-circle pruning) equals the plain scan on 4000 candidate lists (mismatches)", mismatch);
   }
@@ -116,15 +125,7 @@ int main(int argc, char **argv)
     ClosestPoint cp;
     cp.SetVertices(f, 2, false);
     int wrong = 0;
-    for (int k = 0; k < 1000; ++k) {
-      const PetscInt list[2] = {2 * k + 1, 2 * k}; // the decoy first
-      PetscInt       m;
-      PetscReal      b[3], d, bb[3];
-      cp.FindAmong(&pts[2 * k], list, 2, &m, b, &d);
-      const PetscReal dA = cp.DistToFacet2(2 * k, &pts[2 * k], bb), dB = cp.DistToFacet2(2 * k + 1, &pts[2 * k], bb);
-      const PetscInt  ref = dA <= dB ? 2 * k : 2 * k + 1; // the plain scan's (a tie to the lower index, A)
-      wrong += m != ref;
-    }
+    for (int k = 0; k < 1000; ++k) wrong += !SameAsPlainScan(cp, &pts[2 * k], {2 * k + 1, 2 * k}, 2); // the decoy first
     Check(wrong == 0, "2D: FindAmong visits the segment whose circle bound is tight (1000 decoys at 1 + 1e-13..1e-3)", wrong);
   }
   // 3D: triangulated patch z = 0.2 sin(x) cos(y) on [-1,1]^2
@@ -176,19 +177,7 @@ int main(int argc, char **argv)
       for (PetscInt j = 0; j < cp.NumFacets(); ++j)
         if (U(gen) < (k % 2 ? 0.05 : 0.5)) cand.push_back(j);
       if (cand.empty()) continue;
-      PetscInt  m, mref = -1;
-      PetscReal b[3], d, bref[3] = {0, 0, 0}, best = PETSC_MAX_REAL;
-      cp.FindAmong(p, cand.data(), (PetscInt)cand.size(), &m, b, &d);
-      for (PetscInt j : cand) {
-        PetscReal       bb[3];
-        const PetscReal dd = cp.DistToFacet2(j, p, bb);
-        if (dd < best || (dd == best && j < mref)) {
-          best = dd;
-          mref = j;
-          for (int e = 0; e < 3; ++e) bref[e] = bb[e];
-        }
-      }
-      if (m != mref || b[0] != bref[0] || b[1] != bref[1] || b[2] != bref[2] || d != std::sqrt(best)) ++mismatch;
+      mismatch += !SameAsPlainScan(cp, p, cand, 3);
     }
     Check(mismatch == 0, "3D: FindAmong (bounding-sphere pruning) equals the plain scan on 2000 random candidate sets (mismatches)", mismatch);
   }
