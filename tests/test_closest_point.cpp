@@ -1,5 +1,6 @@
 // tests/test_closest_point.cpp: the binned closest-point search against brute force over all facets,
-// on a circle polyline (2D segments) and a triangulated sphere patch (3D triangles), and the facet
+// on a circle polyline (2D segments) and a triangulated sphere patch (3D triangles); the candidate scan
+// FindAmong (pruned by bounding circles and spheres) against the plain scan, bit for bit; and the facet
 // Lagrange basis (partition of unity, nodal interpolation) for P1 and P2.
 #include "rbcontact/contact.hpp"
 #include <algorithm>
