@@ -477,6 +477,12 @@ def half_disks(args):
     print("  test (5 random points): max rel err u %.2e lambda %.2e force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
     check(t["n"] == 5 and t["failed"] == 0, "the ROM converges on 5 random (radius, displacement)")
     check(t["max_rel_err_u"] < 1e-2, "2 parameters, 16 training points: u error %.2e < 1e-2" % t["max_rel_err_u"])
+    # the sweep's timing (rounds over the 5 test parameters), broadcast from the timing rank 0 to the report
+    ot = v["online_time_s"]
+    sw = ot["sweep_per_parameter_median"]
+    check(len(sw) == 5 and min(sw) > 0 and ot["sweep_median"] == sorted(sw)[2] and ot["sweep_max"] == max(sw)
+          and v["speedup_median_sweep"] > 0, "validate times a sweep too: 5 per-parameter medians > 0, median %.2e s (repeats %.2e s), max %.2e s"
+          % (ot["sweep_median"], ot["median"], ot["sweep_max"]))
     # the cubature's K^ summed by points and by patch dofs: the same terms, the same reduced solution
     for k in ("points", "dofs"):
         run(args, 1, "online", ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_sum", k, "-report", "%s/sum_%s.json" % (d, k)])
@@ -489,6 +495,21 @@ def half_disks(args):
     check(sp["rom"]["ecsw_sum"] == "points" and sd["rom"]["ecsw_sum"] == "dofs" and sp["kacanov_iterations"] == sd["kacanov_iterations"]
           and du <= 1e-12 and dl <= 1e-8, "-rom_ecsw_sum points vs dofs: u_hat rel diff %.1e <= 1e-12, lambda_hat %.1e <= 1e-8 (coefficients of a "
           "nearly collinear dual basis), %d vs %d iterations" % (du, dl, sp["kacanov_iterations"], sd["kacanov_iterations"]))
+    # A^ does not depend on mu here (a 2D dilation leaves the stiffness unchanged): by default factored once, the QP
+    # taking K^ L^{-T} summed from L^{-1}-transformed basis rows; -rom_factor_a_once false forms K^ and solves with A^
+    # at every iterate. The same reduced solution to rounding, at two parameters.
+    for mu in ("0.93,0.1", "1.1,0.07"):
+        for k in ("true", "false"):
+            run(args, 1, "online", ["-rom", rom, "-mu", mu, "-rom_factor_a_once", k, "-report", "%s/fa_%s.json" % (d, k)])
+        sf, sn = report(d + "/fa_true.json"), report(d + "/fa_false.json")
+        du = np.abs(np.array(sf["u_hat"]) - np.array(sn["u_hat"])).max() / np.abs(np.array(sn["u_hat"])).max()
+        lf, ln = np.array(sf["lambda_hat"]), np.array(sn["lambda_hat"])
+        dl = np.abs(lf - ln).max() / np.abs(ln).max()
+        kf = max(sf["kkt"].values())
+        check(sf["rom"]["factor_a_once"] is True and sn["rom"]["factor_a_once"] is False and sf["kacanov_iterations"] == sn["kacanov_iterations"]
+              and du <= 1e-10 and dl <= 1e-8 and kf <= 1e-12,
+              "mu %s: A^ factored once vs per iterate: u_hat rel diff %.1e <= 1e-10, lambda_hat %.1e <= 1e-8, its KKT residual %.1e <= 1e-12"
+              % (mu, du, dl, kf))
     expect_error(args, ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_sum", "bogus"], ["bogus", "-rom_ecsw_sum"], "unknown -rom_ecsw_sum")
     expect_error(args, ["-rom", rom, "-mu", "0.93,0.1", "-rom_ecsw_precision", "half"], ["half", "-rom_ecsw_precision"], "unknown -rom_ecsw_precision")
     shutil.rmtree(d, ignore_errors=True)
@@ -527,6 +548,9 @@ def sphere_block3d(args):
     bt = ot.get("by_threads", [])
     check(ot.get("threads") == 1 and [b["threads"] for b in bt] == [1, 2] and all(len(b["per_parameter_median"]) == 9 and min(b["per_parameter_median"]) > 0 and b["speedup_median"] > 0 for b in bt),
           "validate -validate_threads 1,2: rows %s, each with 9 medians > 0" % [b["threads"] for b in bt])
+    check(all(len(b["sweep_per_parameter_median"]) == 9 and min(b["sweep_per_parameter_median"]) > 0 and b["speedup_median_sweep"] > 0 for b in bt)
+          and len(ot["sweep_per_parameter_median"]) == 9, "the sweep's timing on 1 and 2 threads too: medians %s ms"
+          % ["%.3f" % (1e3 * b["sweep_median"]) for b in bt])
     # mpirun binds each rank to a core by default, so rank 0's threads would share its one core: validate times them on
     # the cores of all its node's ranks (those that wait asleep), and says how many (docs/online.md "Threads"). The
     # union measured here independently, from the ranks' affinity masks under the same mpirun

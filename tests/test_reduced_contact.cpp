@@ -8,7 +8,8 @@
 //   3. ReducedParametrization::FromFOM gives the FOM's affine coefficients, survives a ROM-file
 //      roundtrip, and CheckBox rejects a parameter outside the box;
 //   4. a patch serialized to a ROM file and read back evaluates bitwise identically;
-//   and the offline store of contact states by their terms (ContactStates) gives Evaluate's values bit for bit.
+//   and the offline store of contact states by their terms (ContactStates) gives Evaluate's values bit for bit, also
+//   after SetGeometry has moved between parameters (the facets of an unmoved body kept).
 #include "rbcontact/canonical_order.hpp"
 #include "rbcontact/contact_states.hpp"
 #include "rbcontact/fom.hpp"
@@ -365,6 +366,29 @@ static PetscErrorCode Run()
       same = same && std::memcmp(&cs.ForceWeights()[(size_t)s * Q * dim], wref[s].data(), (size_t)Q * dim * sizeof(PetscReal)) == 0;
     }
     PetscCall(Check(comm, cs.Size() == 2 && same, "ContactStates: kappa blocks, gamma, w n2, hits of 2 states bit for bit those of Evaluate", same ? 0.0 : 1.0, 0));
+    // SetGeometry keeps the facets of a body whose map did not change (the block's) and maps the others again: back at
+    // mu after mu2, the evaluation is bit for bit the first one at mu
+    Eval back;
+    full.SetGeometry(&fom.map, mu);
+    full.SetReduced(v);
+    EvaluatePatch(full, all, &back);
+    const bool again = Bitwise(back.kappa, ref[0].kappa) && Bitwise(back.gamma, ref[0].gamma) && back.hit == ref[0].hit;
+    PetscCall(Check(comm, again, "SetGeometry at mu, 1.01 mu, then mu again: kappa, gamma, hits bit for bit those of the first visit", again ? 0.0 : 1.0, 0));
+    // every facet's coordinates are its body's map at the last parameter applied to its reference ones (mu2, mu, mu2)
+    bool mapped = true;
+    for (const auto &m : {mu2, mu, mu2}) {
+      full.SetGeometry(&fom.map, m);
+      for (const auto *fs : {&full.slave, &full.master})
+        for (const auto &F : *fs) {
+          const Affine a = fom.map.Evaluate(F.body, m);
+          for (PetscInt k = 0; k < F.nv; ++k) {
+            PetscReal y[3];
+            a.Apply(dim, &F.Xref[k * dim], y);
+            for (PetscInt d = 0; d < dim; ++d) mapped = mapped && y[d] == F.X[k * dim + d];
+          }
+        }
+    }
+    PetscCall(Check(comm, mapped, "SetGeometry at 1.01 mu, mu, 1.01 mu: every facet's coordinates its body's map at that parameter", mapped ? 0.0 : 1.0, 0));
   }
 
   // ---------------------------------------------------------------- 3. parametrization

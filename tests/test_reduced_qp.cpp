@@ -1,7 +1,8 @@
 // tests/test_reduced_qp.cpp: the online reduced QP (rbc::ReducedQP): active set vs TAO BQPIP on random
 // problems (also with badly scaled constraint rows), an analytic case, warm starts (iterations, bitwise
 // reuse of the cached factorization), dependent constraints (R > N, S singular), infeasible
-// constraints, a non-SPD A, the iteration limit, the options, and no heap allocation in Solve after Reserve.
+// constraints, a non-SPD A, the iteration limit, the options, no heap allocation in Solve after Reserve, and A
+// factored once (FactorA, SolveFactored) against Solve.
 #include "rbcontact/reduced_qp.hpp"
 #include <atomic>
 #include <cmath>
@@ -428,6 +429,85 @@ int main(int argc, char **argv)
     PetscCall(qp.Solve(q.N, q.R, q.A.data(), q.f.data(), q.D.data(), q.c.data(), v.data(), l.data(), &ia)); // warm, new A
     PetscCall(qp.Solve(p2.N, p2.R, p2.A.data(), p2.f.data(), p2.D.data(), p2.c.data(), v.data(), l.data(), &ia)); // smaller sizes
     Check(gAllocs - before == 0, "heap allocations in 4 Solve calls after Reserve", (double)(gAllocs - before), 0);
+  }
+
+  std::printf("8. A factored once (FactorA, SolveFactored with D L^{-T} formed by the caller) against Solve\n");
+  for (Size sz : {Size{8, 5, false}, Size{60, 12, false}, Size{40, 30, true}}) {
+    const Problem p = RandomProblem(sz.N, sz.R, 700 + sz.N + sz.R, sz.bad);
+    const PetscInt N = p.N, R = p.R;
+    ReducedQP      fq, ft, ref;
+    PetscCall(ft.SetFromOptions("t_")); // TAO through the factored path too
+    ReducedQPInfo  fi;
+    PetscCall(fq.FactorA(N, p.A.data(), &fi));
+    CheckTrue(fi.status == ReducedQPStatus::Ok && fq.HasFactor(N) && !fq.HasFactor(N - 1), "FactorA: ok, HasFactor(N) only");
+    // the factor against A (L L' = A), and GT = D L^{-T} by plain forward substitution in the test
+    const PetscReal *L = fq.FactorL();
+    double           dA = 0;
+    for (PetscInt i = 0; i < N; ++i)
+      for (PetscInt j = 0; j <= i; ++j) {
+        double a = 0;
+        for (PetscInt k = 0; k <= j; ++k) a += L[i + k * N] * L[j + k * N];
+        dA = std::max(dA, std::abs(a - p.A[i + j * N]));
+      }
+    Vecd GT(R * N);
+    for (PetscInt k = 0; k < N; ++k)
+      for (PetscInt i = 0; i < R; ++i) {
+        double x = p.D[i + k * R];
+        for (PetscInt m = 0; m < k; ++m) x -= L[k + m * N] * GT[i + m * R];
+        GT[i + k * R] = x / L[k + k * N];
+      }
+    Vecd vf(N), lf(R, 0.0), vr, lr(R, 0.0);
+    PetscCall(fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi));
+    PetscCall(Run(ref, p, &vr, &lr, &ia));
+    double dv = 0, dl = 0;
+    for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vf[i] - vr[i]));
+    for (PetscInt i = 0; i < R; ++i) dl = std::max(dl, std::abs(lf[i] - lr[i]));
+    dv /= NormInf(vr);
+    dl /= NormInf(lr);
+    std::printf(" N = %d R = %d%s: ||L L' - A|| %.1e, factored %d its, %d active; v rel diff %.1e, lambda %.1e\n", (int)N, (int)R, sz.bad ? " (rows scaled)" : "", dA, (int)fi.iterations, (int)fi.nactive, dv, dl);
+    Check(dA <= 1e-13 * NormInf(p.A), "FactorL(): L L' = A", dA, 1e-13 * NormInf(p.A));
+    CheckTrue(fi.status == ReducedQPStatus::Ok && fi.nactive == ia.nactive, "SolveFactored: ok, the same active count as Solve");
+    Check(dv <= 1e-10, "v: SolveFactored vs Solve (relative, inf norm)", dv, 1e-10);
+    Check(dl <= 1e-9, "lambda: SolveFactored vs Solve (relative, inf norm)", dl, 1e-9);
+    Check(WorstKKT(p, vf, lf) <= 1e-12, "SolveFactored: independently computed scaled KKT residuals (A, D)", WorstKKT(p, vf, lf), 1e-12);
+    Check(std::abs(WorstKKT(p, vf, lf) - InfoWorst(fi)) <= 1e-3 * WorstKKT(p, vf, lf) + 1e-15, "SolveFactored: reported KKT (D = GT L') equals the independent one", std::abs(WorstKKT(p, vf, lf) - InfoWorst(fi)), 1e-3 * WorstKKT(p, vf, lf) + 1e-15);
+    // TAO on the factored set-up
+    PetscCall(ft.FactorA(N, p.A.data(), &fi));
+    Vecd vt2(N), lt2(R, 0.0);
+    PetscCall(ft.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vt2.data(), lt2.data(), &fi));
+    double dvt = 0;
+    for (PetscInt i = 0; i < N; ++i) dvt = std::max(dvt, std::abs(vt2[i] - vr[i]));
+    Check(fi.status == ReducedQPStatus::Ok && dvt <= 1e-6 * NormInf(vr), "TAO through SolveFactored: ok, v vs the active set (relative)", dvt / NormInf(vr), 1e-6);
+    PetscCall(ft.Reset());
+    // warm start from the multipliers: one iteration, no allocation
+    fq.Reserve(N, R);
+    long before = gAllocs;
+    PetscCall(fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi));
+    PetscCall(fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi));
+    Check(fi.iterations == 1, "SolveFactored, warm start: iterations", (double)fi.iterations, 1);
+    Check(gAllocs - before == 0, "heap allocations in 2 SolveFactored calls after Reserve", (double)(gAllocs - before), 0);
+    // a Solve with another A replaces the factor: SolveFactored refuses
+    Problem q = p;
+    q.A[0] *= 1 + 1e-12;
+    PetscCall(fq.Solve(N, R, q.A.data(), q.f.data(), q.D.data(), q.c.data(), vf.data(), lf.data(), &fi));
+    CheckTrue(!fq.HasFactor(N), "Solve with another A: HasFactor false");
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    PetscErrorCode ierr = fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi);
+    PetscCall(PetscPopErrorHandler());
+    CheckTrue(ierr == PETSC_ERR_ORDER, "SolveFactored without a factor: PETSC_ERR_ORDER");
+    // a non-SPD A: FactorA reports it, no factor
+    Problem ns = p;
+    ns.A[0] = -1;
+    PetscCall(fq.FactorA(N, ns.A.data(), &fi));
+    CheckTrue(fi.status == ReducedQPStatus::NotSPD && !fq.HasFactor(N) && !fi.message.empty(), "FactorA on a non-SPD A: NotSPD with a message, no factor");
+    // a NaN in GT: PETSC_ERR_FP, finite output
+    PetscCall(fq.FactorA(N, p.A.data(), &fi));
+    Vecd GTn = GT;
+    GTn[1]   = NAN;
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = fq.SolveFactored(N, R, p.f.data(), GTn.data(), p.c.data(), vf.data(), lf.data(), &fi);
+    PetscCall(PetscPopErrorHandler());
+    CheckTrue(ierr == PETSC_ERR_FP && AllFinite(vf) && AllFinite(lf), "NaN in D L^{-T}: PETSC_ERR_FP, finite output");
   }
 
   PetscCall(as.Reset());

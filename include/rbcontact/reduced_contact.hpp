@@ -12,6 +12,7 @@
 // keeps the facets around the EIM points only: the online data, independent of the mesh size.
 #pragma once
 #include <petscsys.h>
+#include <array>
 #include <string>
 #include <vector>
 #include "rbcontact/canonical_order.hpp"
@@ -42,7 +43,8 @@ public:
   // The patch with the basis functions cols (indices into 0..N-1), in that order.
   void SelectBasis(const std::vector<PetscInt> &cols, ContactPatch *out) const;
 
-  // Physical geometry at mu (map may be null: identity).
+  // Physical geometry at mu (map may be null: identity). The facets of a body whose affine map is bitwise the one of
+  // the previous call keep their coordinates (ring_on_block: the block's, for every radius).
   void SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu);
   // Nodal displacement: U = theta v + uD (reduced coordinates, length N) or a given nodal field
   // (nnode x dim, Dirichlet values included).
@@ -91,6 +93,9 @@ private:
   std::vector<PetscReal> fnormal_; // master facets x 3: their normals (PrepareMaster, smooth normals)
   std::vector<PetscInt>  vcount_;  // per point scratch
   ClosestPoint           cp_;
+  // SetGeometry's last affine map of bodies 0..7 (geomSet_: applied to every facet of that body since the facets were set)
+  std::array<Affine, 8> geomAff_{};
+  std::array<char, 8>   geomSet_{};
   bool                   binned_ = false;
 };
 

@@ -37,6 +37,8 @@ public:
   // A clear error naming the parameter, the value and the box when mu is outside it (or has the wrong size).
   PetscErrorCode CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const;
   PetscInt       NumA() const { return (PetscInt)thetaA.size(); }
+  // Every coefficient of A a constant (no material parameter, map or parameter enters it): A^(mu) is A^ for every mu.
+  bool           AConstant() const;
   PetscInt       NumF() const { return (PetscInt)thetaF.size(); }
 
   PetscInt                 dim = 2;
@@ -211,6 +213,14 @@ public:
   bool FusedPointSum() const; // the points' sum in single precision runs fused (requested, the CPU has AVX-512F)
   // The name of the sum in effect (report key rom.gemm): fused, blas or builtin
   const char *GemmName() const { return FusedPointSum() ? "fused" : gemmBlas ? "blas" : "builtin"; }
+  // -rom_factor_a_once (default true): where A^ does not depend on mu (ReducedParametrization::AConstant: a 2D
+  // dilation leaves the stiffness unchanged) and the cubature sums by dofs in double precision, A^ = L L' is factored
+  // once (Truncate) and the sum gives K^ L^{-T} directly from L^{-1} theta(:, cols)', which the QP takes as it is
+  // (ReducedQP::SolveFactored): no comparison of A^ and no triangular solve of K^ per Kacanov iterate
+  // (docs/online.md "A factored once"). AFactored(): in effect for the current sizes and mode (report key
+  // rom.factor_a_once).
+  PetscBool factorAOnce = PETSC_TRUE;
+  bool AFactored() const { return aFactored_ && mode_ == ContactMode::Cubature; }
   bool      recordIterates = false;
   // -rom_threads n (default 1): the cubature's contact terms on n threads (the patch's displacement, the points'
   // closest-point scans and kernels, and the points' sum split into n parts of the points; docs/online.md "Threads").
@@ -229,6 +239,8 @@ private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
   // The error estimate of a converged sol (ErrorEstimate), from the contact terms' last evaluation.
   PetscErrorCode EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  // ContactTerms; factored (AFactored() only): K holds K^ L^{-T}, summed from cThetaTw_
+  PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g, bool factored);
   // [K g] of the cubature over the last point evaluation, rows PwT (padded to rp), nc columns (ContactTerms, EstimateError)
   void CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, const std::vector<PetscReal> &ThetaT, const PetscInt *cols, PetscInt nc, std::vector<PetscReal> *Q, std::vector<PetscReal> *X, std::vector<PetscReal> *Kp);
   ReducedQP              qpEst_;                      // the enriched QP (all stored sizes)
@@ -261,6 +273,8 @@ private:
   std::vector<float>     cThetaFs_;                   // ... theta's used columns (nnode dim x ldf; points: the nodal displacement, kappa's rows from cNt_, cRow_, cCoef_)
   bool                   kapStale_ = false;           // the last evaluation formed kappa in float only (kap_ not its rows)
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
+  std::vector<PetscReal> cThetaTw_;                   // factorAOnce: L^{-1} theta(:, cols)' (Na x nd), A^ = L L'
+  bool                   aFactored_ = false;          // cThetaTw_ and qp's factor set for the current sizes (Truncate)
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place

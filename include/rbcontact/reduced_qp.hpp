@@ -54,6 +54,19 @@ public:
 
   PetscErrorCode Reset(); // destroys the TAO objects and forgets the cached factorization
 
+  // A that does not change between solves (a reduced model whose A^ does not depend on mu): FactorA factors it once
+  // (info NotSPD as Solve would report it); SolveFactored then takes GT = D L^{-T} (R x N, column-major; A = L L',
+  // L = FactorL(), lower N x N) in place of A and D, and skips the comparison of A with the previous call's and the
+  // triangular solve of D that Solve does. The caller forms GT itself, e.g. from basis rows transformed by L^{-1}.
+  // Same outputs, statuses and residual definitions as Solve (its residuals from D = GT L', formed once, and the A of
+  // FactorA). A Solve with another A (or Reset) replaces the factor: HasFactor(N) tells, SolveFactored refuses.
+  PetscErrorCode FactorA(PetscInt N, const PetscReal *A, ReducedQPInfo *info);
+  bool           HasFactor(PetscInt N) const { return factored_ && cN_ == N; }
+  const PetscReal *FactorL() const { return L_.data(); }
+  PetscErrorCode SolveFactored(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *GT, const PetscReal *c, PetscReal *v, PetscReal *lambda, ReducedQPInfo *info);
+  // The scaled KKT residuals (as Residuals) of (v, lambda) for the data of the last SolveFactored, D = GT L' formed here.
+  void ResidualsFactored(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *GT, const PetscReal *c, const PetscReal *v, const PetscReal *lambda, ReducedQPInfo *info);
+
   ReducedQPType type  = ReducedQPType::ActiveSet;
   PetscInt      maxIt = 200;
   // Reuse the Cholesky factor of A when A is bitwise equal to the previous call's, and S (and D L^{-T})
@@ -68,6 +81,11 @@ public:
 
 private:
   PetscErrorCode Setup(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *D, const PetscReal *c, ReducedQPInfo *info);
+  PetscErrorCode FactorInto(PetscInt N, const PetscReal *A, ReducedQPInfo *info);
+  void           DualHessian(PetscInt N, PetscInt R);
+  void           RightHandSide(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *c);
+  PetscErrorCode Finish(PetscInt N, PetscInt R, PetscReal *v, PetscReal *lambda, ReducedQPInfo *info);
+  void           TaoStatus(PetscInt R, const PetscReal *lambda, ReducedQPInfo *info);
   void           ActiveSet(PetscInt R, PetscReal *l, ReducedQPInfo *info);
   PetscErrorCode SolveTao(PetscInt R, PetscReal *l, ReducedQPInfo *info);
   PetscErrorCode SetupTao(PetscInt R);
@@ -80,6 +98,7 @@ private:
   PetscInt    nCap_ = 0, rCap_ = 0;
   // cache of the last A, D (bitwise) and what depends only on them
   bool                   cachedA_ = false, cachedD_ = false;
+  bool                   factored_ = false; // L_ is FactorA's factor of A (Ac_, N = cN_)
   PetscInt               cN_ = -1, cR_ = -1;
   std::vector<PetscReal> Ac_, Dc_;
   PetscReal              normA_ = 0, normD_ = 0; // ||A||_inf, ||D||_inf

@@ -1,6 +1,6 @@
 // src/rom/dense_kernels.cpp: CombineRows, SumOfOuterProducts, ScatterRows (and their single-precision variants for
 // -rom_ecsw_precision single), RowDots, and the reduced QP's
-// RightSolveT and LowerGram (dense_kernels.hpp). A portable version of each and, on x86-64 with GCC or
+// RightSolveT, RightMulLT and LowerGram (dense_kernels.hpp). A portable version of each and, on x86-64 with GCC or
 // clang, an AVX2+FMA version (intrinsics for the contact kernels, where the auto-vectorizer shuffled the
 // wrong dimension; the QP's loops compiled for AVX2), chosen once from __builtin_cpu_supports. The
 // blocked sum keeps a 4 x 4 (12 x 4) block of K in registers over all points; the plain rank-1 update loop
@@ -64,6 +64,26 @@ RBC_INLINE void RightSolveTBody(PetscInt r, PetscInt n, const PetscReal *L, cons
   }
 }
 
+// D = G L' (G, D: r x n column-major, leading dimension r; L lower n x n): column j of D is
+// sum_{k<=j} L(j,k) G(:,k), four columns k at a time (RightSolveT's product, undone).
+RBC_INLINE void RightMulLTBody(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *G, PetscReal *D)
+{
+  for (PetscInt j = 0; j < n; ++j) {
+    PetscReal *d = &D[(size_t)j * r];
+    std::fill(d, d + r, 0.0);
+    PetscInt k = 0;
+    for (; k + 4 <= j + 1; k += 4) {
+      const PetscReal  l0 = L[j + k * n], l1 = L[j + (k + 1) * n], l2 = L[j + (k + 2) * n], l3 = L[j + (k + 3) * n];
+      const PetscReal *g0 = &G[(size_t)k * r], *g1 = g0 + r, *g2 = g1 + r, *g3 = g2 + r;
+      for (PetscInt i = 0; i < r; ++i) d[i] += l0 * g0[i] + l1 * g1[i] + l2 * g2[i] + l3 * g3[i];
+    }
+    for (; k <= j; ++k) {
+      const PetscReal  lk = L[j + k * n], *gk = &G[(size_t)k * r];
+      for (PetscInt i = 0; i < r; ++i) d[i] += lk * gk[i];
+    }
+  }
+}
+
 // Lower triangle of S = X X' (X r x n, S r x r, both leading dimension r): rank-4 updates with
 // contiguous columns. About 1.7x faster than the reference BLAS syrk for n <= 60.
 RBC_INLINE void LowerGramBody(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)
@@ -91,6 +111,7 @@ RBC_INLINE void LowerGramBody(PetscInt r, PetscInt n, const PetscReal *X, PetscR
 
 void RightSolveTPortable(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
 void LowerGramPortable(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
+void RightMulLTPortable(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *G, PetscReal *D) { RightMulLTBody(r, n, L, G, D); }
 
 // T = double (K in place) or float (-rom_ecsw_precision single: the sum in float, K in double); rows in blocks of
 // 32 bytes (4 doubles, 8 floats)
@@ -424,6 +445,7 @@ __attribute__((target("avx2,fma"))) void CombineAvx2F(PetscInt nt, const PetscRe
 // The same loops vectorized 4-wide with FMA by the compiler (the inner loops run over the r rows, contiguous)
 __attribute__((target("avx2,fma"))) void RightSolveTAvx2(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X) { RightSolveTBody(r, n, L, D, X); }
 __attribute__((target("avx2,fma"))) void LowerGramAvx2(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S) { LowerGramBody(r, n, X, S); }
+__attribute__((target("avx2,fma"))) void RightMulLTAvx2(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *G, PetscReal *D) { RightMulLTBody(r, n, L, G, D); }
 
 bool HaveAvx2();
 
@@ -657,6 +679,14 @@ void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D,
   if (HaveAvx2()) return RightSolveTAvx2(r, n, L, D, X);
 #endif
   RightSolveTPortable(r, n, L, D, X);
+}
+
+void RightMulLT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *G, PetscReal *D)
+{
+#ifdef RBC_KERNEL_DISPATCH
+  if (HaveAvx2()) return RightMulLTAvx2(r, n, L, G, D);
+#endif
+  RightMulLTPortable(r, n, L, G, D);
 }
 
 void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S)

@@ -58,6 +58,8 @@ void RowDotsSingle(PetscInt rows, PetscInt n, const float *A, const float *v, co
 // dimension r; L lower n x n, column-major) and the lower triangle of S = X X' (S r x r).
 void RightSolveT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *D, PetscReal *X);
 void LowerGram(PetscInt r, PetscInt n, const PetscReal *X, PetscReal *S);
+// D = G L' (G, D r x n, leading dimension r; L lower n x n): the reduced QP's D from D L^{-T} (ReducedQP::ResidualsFactored).
+void RightMulLT(PetscInt r, PetscInt n, const PetscReal *L, const PetscReal *G, PetscReal *D);
 
 // rp for r rows: r rounded up to the kernel's block (4 doubles; 8 floats for the single-precision dof sum).
 inline PetscInt PaddedRows(PetscInt r, PetscInt block = 4) { return (r + block - 1) / block * block; }

@@ -124,6 +124,7 @@ PetscErrorCode ContactPatch::BuildFull(MPI_Comm comm, const ContactMap &map, con
   for (PetscInt v = 0; v < nvertex; ++v) vertexEnd[v] = degree[v] < (dim == 2 ? 2 : 0) ? 1 : 0;
   slave  = Skeep;
   master = M;
+  geomSet_.fill(0); // (SetGeometry: the facets' coordinates are not those of any map yet)
   searchable.assign(master.size(), 1);
   // Integration points: nsub pieces x the map's Gauss rule (2D); the plain rule in 3D
   const auto    &qp = map.QuadraturePoints();
@@ -185,6 +186,7 @@ void ContactPatch::Restrict(const std::vector<PetscInt> &keep, const std::vector
   out->smoothNormal = smoothNormal;
   out->slave.clear();
   out->master.clear();
+  out->geomSet_.fill(0);
   out->searchable.clear();
   auto renode = [&](SurfaceFacet F) {
     for (PetscInt a = 0; a < F.nnodes; ++a) {
@@ -278,23 +280,36 @@ void ContactPatch::SelectBasis(const std::vector<PetscInt> &cols, ContactPatch *
 
 void ContactPatch::SetGeometry(const GeometryMap *map, const std::vector<PetscReal> &mu)
 {
-  // one affine map per body
-  std::array<Affine, 8>    cache;
-  std::array<bool, 8>      have{};
-  for (auto *fs : {&slave, &master})
-    for (auto &F : *fs) {
-      Affine a;
+  // one affine map per body; a body whose map is bitwise the last call's keeps its facets' coordinates and measures
+  std::array<Affine, 8> cache;
+  std::array<char, 8>   have{}, same{};
+  if (meas_.size() != slave.size()) { // the facets were (re)set: every body afresh
+    meas_.assign(slave.size(), 0.0);
+    geomSet_.fill(0);
+  }
+  for (int fs = 0; fs < 2; ++fs) {
+    auto &facets = fs ? master : slave;
+    for (size_t f = 0; f < facets.size(); ++f) {
+      SurfaceFacet &F = facets[f];
+      Affine        a;
       if (map && F.body >= 0 && F.body < 8) {
         if (!have[F.body]) {
           cache[F.body] = map->Evaluate(F.body, mu);
-          have[F.body]  = true;
+          have[F.body]  = 1;
+          same[F.body]  = geomSet_[F.body] && cache[F.body].G == geomAff_[F.body].G && cache[F.body].t == geomAff_[F.body].t;
         }
+        if (same[F.body]) continue;
         a = cache[F.body];
       } else if (map) a = map->Evaluate(F.body, mu);
       for (PetscInt k = 0; k < F.nv; ++k) a.Apply(dim, &F.Xref[k * dim], &F.X[k * dim]);
+      if (!fs) meas_[f] = FacetMeasure(F.X.data(), dim);
     }
-  meas_.resize(slave.size());
-  for (size_t s = 0; s < slave.size(); ++s) meas_[s] = FacetMeasure(slave[s].X.data(), dim);
+  }
+  for (int b = 0; b < 8; ++b)
+    if (have[b]) {
+      geomAff_[b] = cache[b];
+      geomSet_[b] = 1;
+    }
 }
 
 void ContactPatch::SetNodal(const std::vector<PetscReal> &U, ForkJoin *pool)
@@ -476,6 +491,7 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
   std::vector<double>             meta, data;
 
   PetscFunctionBeginUser;
+  geomSet_.fill(0);
   PetscCall(RomReadDataset(file, group + "/meta", &dims, &meta));
   PetscCheck(meta.size() == 8, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta has %zu entries (8 expected)", file.c_str(), group.c_str(), meta.size());
   dim          = (PetscInt)meta[0];

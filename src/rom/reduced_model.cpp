@@ -164,6 +164,13 @@ void ReducedParametrization::ThetaA(const std::vector<PetscReal> &mu, std::vecto
   for (size_t q = 0; q < thetaA.size(); ++q) (*th)[q] = thetaA[q].Evaluate(*light_, &map, mu);
 }
 
+bool ReducedParametrization::AConstant() const
+{
+  for (const auto &c : thetaA)
+    if (c.tensorBody >= 0 || c.detBody >= 0 || c.surfBody >= 0 || c.param >= 0) return false;
+  return true;
+}
+
 void ReducedParametrization::ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const
 {
   th->resize(thetaF.size());
@@ -206,6 +213,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["ecsw_sum"] = m.EcswSumsByDofs() ? "dofs" : "points";
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["gemm"]           = m.GemmName();
+  (*r)["factor_a_once"]  = m.AFactored(); // -rom_factor_a_once and in effect (A^ independent of mu, dofs sum in double)
   (*r)["threads"]        = (long long)m.threads; // -rom_threads
   (*r)["threads_cpus"]   = (long long)m.ThreadCpus();
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
@@ -452,6 +460,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
     }
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
+  PetscCall(PetscOptionsBool("-factor_a_once", "where A^ does not depend on mu (and the cubature sums by dofs in double precision): factor it once and sum K^ L^{-T} for the QP directly (docs/online.md \"A factored once\")", "", factorAOnce, &factorAOnce, NULL));
   PetscCall(PetscOptionsInt("-threads", "threads of the cubature's contact terms (the patch displacement, the points' scans and kernels, the points' sum; docs/online.md \"Threads\")", "", threads, &threads, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's: the offline stage's held-out choice, /online/dual_select, else all but the estimate's enrichment)", "", r, &r, NULL));
@@ -583,6 +592,31 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
       }
     }
   }
+  // A^ independent of mu and the dofs sum in double: A^ = L L' once, and L^{-1} theta(:, cols)' for the sum of K^ L^{-T}
+  aFactored_ = false;
+  cThetaTw_.clear();
+  if (factorAOnce && cDofs_ && !cSingle_ && Na > 0 && par.AConstant()) {
+    std::vector<PetscReal> mu0(par.params.size()), A0, f0;
+    for (size_t i = 0; i < mu0.size(); ++i) mu0[i] = par.params[i].def;
+    AffineAt(mu0, cols_.data(), Na, &A0, &f0);
+    ReducedQPInfo info;
+    PetscCall(qp.FactorA(Na, A0.data(), &info));
+    if (info.status == ReducedQPStatus::Ok) { // (else the per-solve path, whose QP reports the failure)
+      const PetscInt   nd = cNd_;
+      const PetscReal *L  = qp.FactorL();
+      cThetaTw_           = cThetaT_;
+      for (PetscInt c = 0; c < Na; ++c) { // row c of L^{-1} X: (x_c - sum_{m<c} L(c, m) row m) / L(c, c), rows of length nd
+        PetscReal *xc = &cThetaTw_[(size_t)c * nd];
+        for (PetscInt m = 0; m < c; ++m) {
+          const PetscReal lcm = L[c + (size_t)m * Na], *xm = &cThetaTw_[(size_t)m * nd];
+          for (PetscInt a = 0; a < nd; ++a) xc[a] -= lcm * xm[a];
+        }
+        const PetscReal inv = 1.0 / L[c + (size_t)c * Na];
+        for (PetscInt a = 0; a < nd; ++a) xc[a] *= inv;
+      }
+      aFactored_ = true;
+    }
+  }
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
@@ -709,7 +743,9 @@ void ReducedModel::OrderCubaturePoints()
 
 PetscInt ReducedModel::ThreadCpus() const { return (PetscInt)(pool_.cpus.empty() ? ForkJoin::CallerCpus().size() : pool_.cpus.size()); }
 
-PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g)
+PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g) { return ContactTerms(mu, v, K, g, false); }
+
+PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g, bool factored)
 {
   const PetscInt Na = (PetscInt)cols_.size(), r = r_;
   thread_local std::vector<PetscReal> vfull;
@@ -848,7 +884,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       event(ROM_CubSum, false);
       return out;
     }
-    CubatureSum(rp, cPwT_, cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
+    CubatureSum(rp, cPwT_, factored && AFactored() ? cThetaTw_ : cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
     for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
     event(ROM_CubSum, false);
@@ -976,6 +1012,15 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     for (PetscInt i = 0; i < r; ++i) sol->lambda[i] = std::max<PetscReal>(sol->lambda[i], 0);
   }
   thread_local std::vector<PetscReal> vprev, lprev, vnew, lnew, vnext;
+  // A^ factored once (Truncate): the QP takes K^ L^{-T}; its factor is Truncate's unless another Solve replaced it
+  const bool factored = AFactored();
+  if (factored && !qp.HasFactor(Na)) {
+    PetscCall(qp.FactorA(Na, A_.data(), &sol->qp));
+    if (sol->qp.status != ReducedQPStatus::Ok) {
+      sol->message = "reduced QP failed before the first Kacanov iteration (" + std::string(ReducedQPStatusName(sol->qp.status)) + "): " + sol->qp.message;
+      PetscFunctionReturn(0);
+    }
+  }
   loop.Begin(Na);
   vnext.resize(Na);
   for (PetscInt it = 1; it <= loop.maxIt; ++it) {
@@ -983,11 +1028,12 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     lprev = sol->lambda;
     if (recordIterates) sol->iterates.insert(sol->iterates.end(), vprev.begin(), vprev.end());
     PetscCall(PetscLogEventBegin(ROM_Contact, 0, 0, 0, 0));
-    sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data());
+    sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data(), factored); // factored: K_ is K^ L^{-T}
     PetscCall(PetscLogEventEnd(ROM_Contact, 0, 0, 0, 0));
     vnew.resize(Na);
     PetscCall(PetscLogEventBegin(ROM_QP, 0, 0, 0, 0));
-    PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
+    if (factored) PetscCall(qp.SolveFactored(Na, r, f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
+    else PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
     PetscCall(PetscLogEventEnd(ROM_QP, 0, 0, 0, 0));
     sol->iterations = it;
     lnew            = sol->lambda;
@@ -1025,7 +1071,8 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     PetscCall(loop.Record(PETSC_COMM_SELF, it, du, dl, nact, r, loop.monitor ? detail : nullptr, &done, dualIsChange));
     if (done) {
       // the KKT residuals of the last QP only (the loop's QPs skip them: -log_view 1-2 % of a solve)
-      qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
+      if (factored) qp.ResidualsFactored(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
+      else qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
       ResultantForce(lnew, &sol->force);
       sol->converged = true;
       break;

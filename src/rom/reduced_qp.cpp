@@ -2,7 +2,8 @@
 // dual (Cholesky of A, S = D A^{-1} D', b), the Lawson-Hanson-type active-set method on S with
 // incremental Cholesky factors of S on the free set (dependent constraints handled by null-space ray
 // steps, unboundedness = primal infeasibility), the TAO BQPIP cross-check, v = A^{-1}(f - D'lambda) and
-// the scaled KKT residuals. See docs/reduced_qp.md.
+// the scaled KKT residuals; for an A that does not change between solves, its factor kept (FactorA) and the set-up
+// from D L^{-T} formed by the caller (SolveFactored). See docs/reduced_qp.md.
 #include "rbcontact/tao_recipe.hpp"
 #include "rbcontact/reduced_qp.hpp"
 #include "dense_kernels.hpp"
@@ -93,7 +94,7 @@ PetscErrorCode ReducedQP::Reset()
   PetscCall(VecDestroy(&lo_));
   PetscCall(VecDestroy(&hi_));
   taoR_   = -1;
-  cachedA_ = cachedD_ = false;
+  cachedA_ = cachedD_ = factored_ = false;
   PetscFunctionReturn(0);
 }
 
@@ -135,12 +136,67 @@ void ReducedQP::Reserve(PetscInt N, PetscInt R)
   blocked_.resize(r);
 }
 
+// A = L L' into L_ and ||A||_inf into normA_ (A finite: checked here); info NotSPD when a pivot breaks down or is
+// negligible.
+PetscErrorCode ReducedQP::FactorInto(PetscInt N, const PetscReal *A, ReducedQPInfo *info)
+{
+  const PetscBLASInt n = B(N), ldn = B(std::max<PetscInt>(N, 1));
+
+  PetscFunctionBeginUser;
+  factored_ = false;
+  PetscCheck(MaxRowSum(N, N, A, tN_.data(), &normA_), PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in A (or a row sum overflows)");
+  PetscReal amax = 0;
+  std::copy_n(A, N * N, L_.data());
+  for (PetscInt i = 0; i < N; ++i) amax = std::max(amax, A[i + i * N]);
+  PetscBLASInt linfo = 0;
+  if (N) LAPACKpotrf_("L", &n, L_.data(), &ldn, &linfo);
+  PetscInt  bad   = linfo > 0 ? (PetscInt)linfo - 1 : -1;
+  PetscReal pivot = linfo > 0 ? L_[bad + bad * N] : 0;
+  for (PetscInt i = 0; bad < 0 && i < N; ++i)
+    if (L_[i + i * N] * L_[i + i * N] <= kSPDTol * amax) { bad = i; pivot = L_[i + i * N] * L_[i + i * N]; }
+  if (bad >= 0 || (amax <= 0 && N > 0)) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf, "reduced matrix A is not symmetric positive definite (Cholesky breaks down at row %" PetscInt_FMT ": squared pivot %g, largest diagonal entry %g): the primal reduced basis is not linearly independent or the reduced operator is wrong", bad, (double)pivot, (double)amax);
+    info->message = buf;
+    info->status  = ReducedQPStatus::NotSPD;
+  }
+  PetscFunctionReturn(0);
+}
+
+// From GT = D L^{-T} in G_ (R x N): the lower triangle of S = GT GT', the equilibration s (unit diagonal; 1 for a zero
+// row of D), S made full, the rows of GT scaled by s.
+void ReducedQP::DualHessian(PetscInt N, PetscInt R)
+{
+  LowerGram(R, N, G_.data(), S_.data());
+  for (PetscInt i = 0; i < R; ++i) s_[i] = S_[i + i * R] > 0 ? 1.0 / std::sqrt(S_[i + i * R]) : 1.0;
+  for (PetscInt j = 0; j < R; ++j) {
+    for (PetscInt i = j + 1; i < R; ++i) {
+      const PetscReal sij = S_[i + j * R] * s_[i] * s_[j];
+      S_[i + j * R]       = sij;
+      S_[j + i * R]       = sij;
+    }
+    S_[j + j * R] = S_[j + j * R] > 0 ? 1.0 : 0.0;
+  }
+  for (PetscInt k = 0; k < N; ++k)
+    for (PetscInt i = 0; i < R; ++i) G_[i + k * R] *= s_[i];
+}
+
+// y = L^{-1} f, b = GT y - diag(s) c (f, c finite: checked by the caller)
+void ReducedQP::RightHandSide(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *c)
+{
+  std::copy_n(f, N, y_.data());
+  ForwardSolve(N, L_.data(), y_.data());
+  for (PetscInt i = 0; i < R; ++i) b_[i] = -s_[i] * c[i];
+  for (PetscInt k = 0; k < N; ++k) {
+    const PetscReal yk = y_[k], *g = &G_[(size_t)k * R];
+    for (PetscInt i = 0; i < R; ++i) b_[i] += yk * g[i];
+  }
+}
+
 // Factorization of A, S = diag(s) D A^{-1} D' diag(s) (unit diagonal) and b = diag(s)(D A^{-1} f - c).
 // The Cholesky factor of A is kept while A stays bitwise the same, GT and S while A and D do.
 PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *D, const PetscReal *c, ReducedQPInfo *info)
 {
-  const PetscBLASInt n = B(N), ldn = B(std::max<PetscInt>(N, 1));
-
   PetscFunctionBeginUser;
   bool finite = true;
   for (PetscInt i = 0; i < N; ++i) finite = finite && std::isfinite(f[i]);
@@ -150,25 +206,8 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
   const bool hitD = hitA && cachedD_ && cR_ == R && std::equal(D, D + (size_t)R * N, Dc_.data());
   if (!hitA) {
     cachedA_ = cachedD_ = false;
-    finite              = MaxRowSum(N, N, A, tN_.data(), &normA_) && finite;
-    PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in A (or a row sum overflows)");
-    // A = L L'
-    PetscReal amax = 0;
-    std::copy_n(A, N * N, L_.data());
-    for (PetscInt i = 0; i < N; ++i) amax = std::max(amax, A[i + i * N]);
-    PetscBLASInt linfo = 0;
-    if (N) LAPACKpotrf_("L", &n, L_.data(), &ldn, &linfo);
-    PetscInt  bad   = linfo > 0 ? (PetscInt)linfo - 1 : -1;
-    PetscReal pivot = linfo > 0 ? L_[bad + bad * N] : 0;
-    for (PetscInt i = 0; bad < 0 && i < N; ++i)
-      if (L_[i + i * N] * L_[i + i * N] <= kSPDTol * amax) { bad = i; pivot = L_[i + i * N] * L_[i + i * N]; }
-    if (bad >= 0 || (amax <= 0 && N > 0)) {
-      char buf[320];
-      std::snprintf(buf, sizeof buf, "reduced matrix A is not symmetric positive definite (Cholesky breaks down at row %" PetscInt_FMT ": squared pivot %g, largest diagonal entry %g): the primal reduced basis is not linearly independent or the reduced operator is wrong", bad, (double)pivot, (double)amax);
-      info->message = buf;
-      info->status  = ReducedQPStatus::NotSPD;
-      PetscFunctionReturn(0);
-    }
+    PetscCall(FactorInto(N, A, info));
+    if (info->status == ReducedQPStatus::NotSPD) PetscFunctionReturn(0);
     if (reuseFactorization) {
       std::copy_n(A, N * N, Ac_.data());
       cachedA_ = true;
@@ -179,35 +218,33 @@ PetscErrorCode ReducedQP::Setup(PetscInt N, PetscInt R, const PetscReal *A, cons
     cachedD_ = false;
     finite   = MaxRowSum(R, N, D, tR_.data(), &normD_) && finite;
     PetscCheck(finite, PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in D (or a row sum overflows)");
-    // GT = D L^{-T} (R x N; GT' = L^{-1} D'), then the lower triangle of S = GT GT'
+    // GT = D L^{-T} (R x N; GT' = L^{-1} D'), then S and the equilibration
     RightSolveT(R, N, L_.data(), D, G_.data());
-    LowerGram(R, N, G_.data(), S_.data());
-    // equilibrate to unit diagonal (s_i = S_ii^{-1/2}; 1 for a zero row of D), make S full, scale the rows of GT
-    for (PetscInt i = 0; i < R; ++i) s_[i] = S_[i + i * R] > 0 ? 1.0 / std::sqrt(S_[i + i * R]) : 1.0;
-    for (PetscInt j = 0; j < R; ++j) {
-      for (PetscInt i = j + 1; i < R; ++i) {
-        const PetscReal sij = S_[i + j * R] * s_[i] * s_[j];
-        S_[i + j * R]       = sij;
-        S_[j + i * R]       = sij;
-      }
-      S_[j + j * R] = S_[j + j * R] > 0 ? 1.0 : 0.0;
-    }
-    for (PetscInt k = 0; k < N; ++k)
-      for (PetscInt i = 0; i < R; ++i) G_[i + k * R] *= s_[i];
+    DualHessian(N, R);
     if (reuseFactorization) {
       std::copy_n(D, R * N, Dc_.data());
       cachedD_ = true;
       cR_      = R;
     }
   }
-  // y = L^{-1} f, b = GT y - diag(s) c
-  std::copy_n(f, N, y_.data());
-  ForwardSolve(N, L_.data(), y_.data());
-  for (PetscInt i = 0; i < R; ++i) b_[i] = -s_[i] * c[i];
-  for (PetscInt k = 0; k < N; ++k) {
-    const PetscReal yk = y_[k], *g = &G_[(size_t)k * R];
-    for (PetscInt i = 0; i < R; ++i) b_[i] += yk * g[i];
-  }
+  RightHandSide(N, R, f, c);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedQP::FactorA(PetscInt N, const PetscReal *A, ReducedQPInfo *info)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(N >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "ReducedQP: size N = %" PetscInt_FMT " must be >= 0", N);
+  info->status = ReducedQPStatus::Ok;
+  info->message.clear();
+  if (N > nCap_ || !nCap_) Reserve(N, std::max<PetscInt>(rCap_, 1));
+  cachedA_ = cachedD_ = false;
+  PetscCall(FactorInto(N, A, info));
+  if (info->status != ReducedQPStatus::Ok) PetscFunctionReturn(0);
+  std::copy_n(A, N * N, Ac_.data()); // Solve with this A reuses the factor (and SolveFactored's residuals read it)
+  cachedA_  = reuseFactorization;
+  cN_       = N;
+  factored_ = true;
   PetscFunctionReturn(0);
 }
 
@@ -572,13 +609,63 @@ PetscErrorCode ReducedQP::Solve(PetscInt N, PetscInt R, const PetscReal *A, cons
       PetscCall(ierr);
     }
   }
-  PetscReal *l = l_.data();
   if (info->status == ReducedQPStatus::NotSPD) {
     std::fill(v, v + N, 0.0);
     std::fill(lambda, lambda + R, 0.0);
     KKT(N, R, A, f, D, c, v, lambda, info);
     PetscFunctionReturn(0);
   }
+  PetscCall(Finish(N, R, v, lambda, info));
+  if (residuals || type == ReducedQPType::Tao) KKT(N, R, A, f, D, c, v, lambda, info);
+  TaoStatus(R, lambda, info);
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ReducedQP::SolveFactored(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *GT, const PetscReal *c, PetscReal *v, PetscReal *lambda, ReducedQPInfo *info)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(R >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "ReducedQP: size R = %" PetscInt_FMT " must be >= 0", R);
+  PetscCheck(HasFactor(N), PETSC_COMM_SELF, PETSC_ERR_ORDER, "ReducedQP::SolveFactored: no factor of A with N = %" PetscInt_FMT " (call FactorA first; a Solve with another A replaces it)", N);
+  info->status     = ReducedQPStatus::Ok;
+  info->iterations = 0;
+  info->nactive    = 0;
+  info->message.clear();
+  if (R > rCap_) Reserve(N, R);
+  bool finite = true;
+  for (PetscInt i = 0; i < N; ++i) finite = finite && std::isfinite(f[i]);
+  for (PetscInt i = 0; i < R; ++i) finite = finite && std::isfinite(c[i]);
+  PetscReal gn = 0;
+  finite = MaxRowSum(R, N, GT, tR_.data(), &gn) && finite;
+  if (!finite) {
+    std::fill(v, v + N, 0.0);
+    std::fill(lambda, lambda + R, 0.0);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in f, c or D L^{-T} (or a row sum overflows)");
+  }
+  cachedD_ = false; // G_ and S_ are GT's now
+  std::copy_n(GT, (size_t)R * N, G_.data());
+  DualHessian(N, R);
+  RightHandSide(N, R, f, c);
+  PetscCall(Finish(N, R, v, lambda, info));
+  if (residuals || type == ReducedQPType::Tao) ResidualsFactored(N, R, Ac_.data(), f, GT, c, v, lambda, info);
+  TaoStatus(R, lambda, info);
+  PetscFunctionReturn(0);
+}
+
+void ReducedQP::ResidualsFactored(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *GT, const PetscReal *c, const PetscReal *v, const PetscReal *lambda, ReducedQPInfo *info)
+{
+  // D = GT L' into the D cache's storage, then the residuals with D
+  cachedD_     = false;
+  PetscReal *D = Dc_.data();
+  RightMulLT(R, N, L_.data(), GT, D);
+  (void)MaxRowSum(R, N, D, tR_.data(), &normD_);
+  KKT(N, R, A, f, D, c, v, lambda, info);
+}
+
+// The dual's solution from S_, b_ (the multipliers' warm start in lambda), v, lambda and the counts into info.
+PetscErrorCode ReducedQP::Finish(PetscInt N, PetscInt R, PetscReal *v, PetscReal *lambda, ReducedQPInfo *info)
+{
+  PetscFunctionBeginUser;
+  PetscReal *l = l_.data();
   if (type == ReducedQPType::ActiveSet) {
     for (PetscInt i = 0; i < R; ++i) l[i] = std::isfinite(lambda[i]) && lambda[i] > 0 ? lambda[i] / s_[i] : 0.0;
     ActiveSet(R, l, info);
@@ -601,24 +688,27 @@ PetscErrorCode ReducedQP::Solve(PetscInt N, PetscInt R, const PetscReal *A, cons
     }
   }
   info->primal = info->dual = info->complementarity = info->stationarity = 0;
-  if (residuals || type == ReducedQPType::Tao) KKT(N, R, A, f, D, c, v, lambda, info);
-  if (type == ReducedQPType::Tao) {
-    PetscReal lmax = 0;
-    PetscInt  nact = 0;
-    for (PetscInt i = 0; i < R; ++i) lmax = std::max(lmax, lambda[i]);
-    for (PetscInt i = 0; i < R; ++i) nact += lambda[i] > 1e-6 * lmax;
-    info->nactive = nact;
-    if (info->status == ReducedQPStatus::MaxIt) {
-      const PetscReal worst = std::max(std::max(info->primal, info->dual), std::max(info->complementarity, info->stationarity));
-      if (worst <= kTaoAcceptKKT) info->status = ReducedQPStatus::Ok;
-      else {
-        char buf[300];
-        std::snprintf(buf, sizeof buf, "TAO reached its iteration limit with scaled KKT residual %g > %g: increase -%sqp_tao_max_it or use -%sqp_type activeset", (double)worst, (double)kTaoAcceptKKT, prefix_.c_str(), prefix_.c_str());
-        info->message = buf;
-      }
+  PetscFunctionReturn(0);
+}
+
+// TAO: its count of active multipliers (> 1e-6 max lambda) and the iteration limit accepted when the KKT residuals are small.
+void ReducedQP::TaoStatus(PetscInt R, const PetscReal *lambda, ReducedQPInfo *info)
+{
+  if (type != ReducedQPType::Tao) return;
+  PetscReal lmax = 0;
+  PetscInt  nact = 0;
+  for (PetscInt i = 0; i < R; ++i) lmax = std::max(lmax, lambda[i]);
+  for (PetscInt i = 0; i < R; ++i) nact += lambda[i] > 1e-6 * lmax;
+  info->nactive = nact;
+  if (info->status == ReducedQPStatus::MaxIt) {
+    const PetscReal worst = std::max(std::max(info->primal, info->dual), std::max(info->complementarity, info->stationarity));
+    if (worst <= kTaoAcceptKKT) info->status = ReducedQPStatus::Ok;
+    else {
+      char buf[300];
+      std::snprintf(buf, sizeof buf, "TAO reached its iteration limit with scaled KKT residual %g > %g: increase -%sqp_tao_max_it or use -%sqp_type activeset", (double)worst, (double)kTaoAcceptKKT, prefix_.c_str(), prefix_.c_str());
+      info->message = buf;
     }
   }
-  PetscFunctionReturn(0);
 }
 
 } // namespace rbc
