@@ -15,7 +15,9 @@ Tables:
      answer's R chosen on 6 held-out FOM solutions (seed 11: -dual_select_size 6, with --rom-workdir a checkpointed
      snapshot file held6.h5 read by -dual_select_snapshots), validate on 20 random parameters: N, R (of those stored),
      Mc, max relative errors u, lambda, force (targets 1e-3, 2e-2, 1e-3), online median (target 200 us), FOM median,
-     speedup (target 1e4 at the finest level; the verdict is met on 1 thread or else on the FOM's cores, -validate_threads). --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of
+     speedup (target 1e4 at the finest level; the verdict is met on 1 thread or else on the FOM's cores, -validate_threads;
+     since 2026-11-28 the online target and the verdict are judged on validate's sweep of distinct parameters, a line
+     "in a sweep" under the row, the thread lines giving both). --no-rom skips it (the hertz3d mesh's offline stage takes 81 FOM solves of
      ~10 s). With --rom-workdir DIR every step is kept in DIR/<mesh> and resumed by the next run (the finest level needs
      it: 44 + 6 + 20 FOM solves of 40-90 s), in this order: the training snapshots (from their nearest solved
      neighbour, with inexact Kacanov iterates: -snapshots_initial_guess nearest -fom_saddle_rtol_forcing 1e-3), the
@@ -281,20 +283,28 @@ def rom3d(args, extra):
         t, ro = v["test"], v["rom"]
         rstored = off.get("rom", {}).get("R", ro["R"])  # R in use (the held-out choice) of the stored dual vectors
         met = t["max_rel_err_u"] <= 1e-3 and t["max_rel_err_lambda"] <= 2e-2 and t["max_rel_err_force"] <= 1e-3
-        fast = v["online_time_s"]["median"] <= 200e-6
+        # the online time and speedup of a sweep of distinct parameters (validate's online_time_s.sweep_*, since
+        # 2026-11-28: repeats at one parameter reuse its set-up; docs/online.md "Validation"); older reports: the repeats'
+        ot = v["online_time_s"]
+        sweep = lambda r: r.get("sweep_median", r["median"])
+        ssp = lambda r: r.get("speedup_median_sweep", r["speedup_median"])
+        fast = sweep(ot) <= 200e-6
         # the speedup target (1e4) is the finest level's
         verdict = "online %s" % ("met" if fast else "MISSED")
         if tag == "finest":  # on 1 thread; else on the FOM's cores (the test set's FOM solves ran on --rom-np ranks), if there
-            same = [r for r in v["online_time_s"].get("by_threads", []) if 1 < r["threads"] <= args.rom_np and r["speedup_median"] >= 1e4]
-            verdict += ", speedup %s" % ("met" if v["speedup_median"] >= 1e4 else
-                                         "met on %d threads (the FOM's %d cores), MISSED on 1" % (same[0]["threads"], args.rom_np) if same else "MISSED")
+            same = [r for r in ot.get("by_threads", []) if 1 < r["threads"] <= args.rom_np and ssp(r) >= 1e4]
+            verdict += ", speedup in a sweep %s" % ("met" if v.get("speedup_median_sweep", v["speedup_median"]) >= 1e4 else
+                                                    "met on %d threads (the FOM's %d cores), MISSED on 1" % (same[0]["threads"], args.rom_np) if same else "MISSED")
         print("| %s | %d | %d | %d | %d of %d | %d | %.2e | %.2e | %.2e | %.2e | %.0f us | %.2f s | %.0f | %.1f | accuracy %s, %s |"
               % (label, off.get("ndofs", 0), off.get("ntrain", 0), ro["N"], ro["R"], rstored, ro["Mc"], t["max_rel_err_u"], t["max_rel_err_lambda"],
                  t["max_rel_err_force"], t["max_rel_err_force_online"], 1e6 * v["online_time_s"]["median"], v["fom_time_s"]["median"],
                  v["speedup_median"], off["time_s"]["total"], "met" if met else "MISSED", verdict))
-        for row in v["online_time_s"].get("by_threads", []):  # -validate_threads: the same solves on other numbers of threads
-            print("|   %s, -rom_threads %d |||||||||| %.0f us || %.0f ||%s |" % (label, row["threads"], 1e6 * row["median"], row["speedup_median"],
-                  " speedup %s" % ("met" if row["speedup_median"] >= 1e4 else "MISSED") if tag == "finest" else ""))
+        if "sweep_median" in ot:
+            print("|   %s, in a sweep |||||||||| %.0f us || %.0f ||%s |" % (label, 1e6 * ot["sweep_median"], v["speedup_median_sweep"], ""))
+        for row in ot.get("by_threads", []):  # -validate_threads: the same solves on other numbers of threads (repeats; sweep)
+            print("|   %s, -rom_threads %d |||||||||| %.0f us (sweep %.0f us) || %.0f (sweep %.0f) ||%s |"
+                  % (label, row["threads"], 1e6 * row["median"], 1e6 * sweep(row), row["speedup_median"], ssp(row),
+                     " speedup in a sweep %s" % ("met" if ssp(row) >= 1e4 else "MISSED") if tag == "finest" else ""))
 
 
 if __name__ == "__main__":
