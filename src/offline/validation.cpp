@@ -455,6 +455,34 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   PetscInt         maxThreads = model.threads;
   for (PetscInt t : settings.threadValues) maxThreads = std::max(maxThreads, t);
   if (maxThreads > 1 && !settings.timeAllRanks) PetscCall(NodeCpus(comm, &timingCpus));
+  // Rounds of m.Solve over the test parameters idx (one round after the other, so that with several parameters no
+  // solve follows one at its own parameter), timed on rank 0 while the other ranks wait in the broadcast of its
+  // per-parameter medians (-validate_time_all_ranks false): the same solve timed on every rank at once measures the
+  // ranks slowing each other down (on the 2-vCPU VM by a third, evenly over the solve's phases), not one online solve
+  // (docs/online.md "Validation"). Threads alone on rank 0 run on this node's cores (the caller's own restored after).
+  auto timeRounds = [&](ReducedModel &m, const std::vector<PetscInt> &idx, std::vector<double> *meds) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    meds->assign(idx.size(), 0.0);
+    if (settings.timeAllRanks || rank == 0) {
+      const std::vector<int> own   = ForkJoin::CallerCpus();
+      const bool             widen = !settings.timeAllRanks && m.threads > 1 && timingCpus.size() > own.size();
+      if (widen) (void)ForkJoin::SetCallerCpus(timingCpus); // (the workers' are set by evaluate)
+      std::vector<std::vector<double>> ts(idx.size());
+      ReducedSolution                  sol;
+      for (PetscInt k = 0; k < repeat; ++k)
+        for (size_t j = 0; j < idx.size(); ++j) {
+          PetscLogDouble a, b;
+          PetscCall(PetscTime(&a));
+          PetscCall(m.Solve(F[idx[j]].mu, &sol));
+          PetscCall(PetscTime(&b));
+          ts[j].push_back(b - a);
+        }
+      if (widen) (void)ForkJoin::SetCallerCpus(own);
+      for (size_t j = 0; j < idx.size(); ++j) (*meds)[j] = Median(ts[j]);
+    }
+    if (!settings.timeAllRanks) PetscCall(BcastAsleep(comm, meds->data(), (int)idx.size()));
+    PetscFunctionReturn(0);
+  };
   auto evaluate = [&](ReducedModel &m, bool timed, Errors *E, std::vector<double> *medians, std::vector<PetscInt> *its, std::vector<ReducedSolution> *sols, std::vector<double> *mediansNoEstimate = nullptr, std::vector<std::vector<double>> *mediansByThreads = nullptr) -> PetscErrorCode {
     PetscFunctionBeginUser;
     if (timed && rank == 0 && !settings.timeAllRanks) m.SetThreadCpus(timingCpus); // the workers' (timeSolves)
@@ -462,30 +490,12 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       ReducedSolution sol;
       PetscCall(PetscLogEventBegin(VAL_ROM, 0, 0, 0, 0));
       PetscCall(m.Solve(F[j].mu, &sol)); // warm-up
-      // timed on rank 0 while the other ranks wait in the broadcast of its median (-validate_time_all_ranks false):
-      // the same solve timed on every rank at once measures the ranks slowing each other down (on the 2-vCPU VM by a
-      // third, evenly over the solve's phases), not one online solve (docs/online.md "Validation")
+      // repeated at this parameter (timeRounds)
       auto timeSolves = [&](std::vector<double> *meds) -> PetscErrorCode {
-        std::vector<double> ts;
-        double              med = 0;
+        std::vector<double> med;
         PetscFunctionBeginUser;
-        if (settings.timeAllRanks || rank == 0) {
-          // threads alone on rank 0: on this node's cores (the calling thread's own restored after)
-          const std::vector<int> own   = ForkJoin::CallerCpus();
-          const bool             widen = !settings.timeAllRanks && m.threads > 1 && timingCpus.size() > own.size();
-          if (widen) (void)ForkJoin::SetCallerCpus(timingCpus); // (the workers' are set above)
-          for (PetscInt k = 0; k < repeat; ++k) {
-            PetscLogDouble a, b;
-            PetscCall(PetscTime(&a));
-            PetscCall(m.Solve(F[j].mu, &sol));
-            PetscCall(PetscTime(&b));
-            ts.push_back(b - a);
-          }
-          if (widen) (void)ForkJoin::SetCallerCpus(own);
-          med = Median(ts);
-        }
-        if (!settings.timeAllRanks) PetscCall(BcastAsleep(comm, &med, 1));
-        meds->push_back(med);
+        PetscCall(timeRounds(m, {j}, &med));
+        meds->push_back(med[0]);
         PetscFunctionReturn(0);
       };
       if (timed && mediansNoEstimate && sol.estimate.available) {
@@ -551,37 +561,16 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   // own parameter. Repeating one parameter reuses what a sweep cannot: the patch's geometry at mu, the reduced QP's
   // set-up when D repeats, the branch history of the candidate scans (docs/online.md "Validation"). Per-parameter
   // medians over the rounds; with one test parameter the same as the repeats above.
-  auto timeSweep = [&](ReducedModel &m, std::vector<double> *meds) -> PetscErrorCode {
-    PetscFunctionBeginUser;
-    meds->assign(nt, 0.0);
-    if (settings.timeAllRanks || rank == 0) {
-      const std::vector<int> own   = ForkJoin::CallerCpus();
-      const bool             widen = !settings.timeAllRanks && m.threads > 1 && timingCpus.size() > own.size();
-      if (widen) (void)ForkJoin::SetCallerCpus(timingCpus);
-      std::vector<std::vector<double>> ts(nt);
-      ReducedSolution                  sol;
-      for (PetscInt k = 0; k < repeat; ++k)
-        for (PetscInt j = 0; j < nt; ++j) {
-          PetscLogDouble a, b;
-          PetscCall(PetscTime(&a));
-          PetscCall(m.Solve(F[j].mu, &sol));
-          PetscCall(PetscTime(&b));
-          ts[j].push_back(b - a);
-        }
-      if (widen) (void)ForkJoin::SetCallerCpus(own);
-      for (PetscInt j = 0; j < nt; ++j) (*meds)[j] = Median(ts[j]);
-    }
-    if (!settings.timeAllRanks) PetscCall(BcastAsleep(comm, meds->data(), (int)nt));
-    PetscFunctionReturn(0);
-  };
+  std::vector<PetscInt> all(nt);
+  std::iota(all.begin(), all.end(), (PetscInt)0);
   std::vector<double>              mediansSweep(nt, 0.0);
   std::vector<std::vector<double>> sweepByThreads(settings.threadValues.size());
   if (!E.failed) {
-    PetscCall(timeSweep(model, &mediansSweep));
+    PetscCall(timeRounds(model, all, &mediansSweep));
     const PetscInt t0 = model.threads; // -validate_threads: the sweep on those numbers of threads too
     for (size_t k = 0; k < settings.threadValues.size(); ++k) {
       model.threads = settings.threadValues[k];
-      PetscCall(timeSweep(model, &sweepByThreads[k]));
+      PetscCall(timeRounds(model, all, &sweepByThreads[k]));
     }
     model.threads = t0;
   }

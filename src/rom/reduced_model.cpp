@@ -602,18 +602,9 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     ReducedQPInfo info;
     PetscCall(qp.FactorA(Na, A0.data(), &info));
     if (info.status == ReducedQPStatus::Ok) { // (else the per-solve path, whose QP reports the failure)
-      const PetscInt   nd = cNd_;
-      const PetscReal *L  = qp.FactorL();
-      cThetaTw_           = cThetaT_;
-      for (PetscInt c = 0; c < Na; ++c) { // row c of L^{-1} X: (x_c - sum_{m<c} L(c, m) row m) / L(c, c), rows of length nd
-        PetscReal *xc = &cThetaTw_[(size_t)c * nd];
-        for (PetscInt m = 0; m < c; ++m) {
-          const PetscReal lcm = L[c + (size_t)m * Na], *xm = &cThetaTw_[(size_t)m * nd];
-          for (PetscInt a = 0; a < nd; ++a) xc[a] -= lcm * xm[a];
-        }
-        const PetscReal inv = 1.0 / L[c + (size_t)c * Na];
-        for (PetscInt a = 0; a < nd; ++a) xc[a] *= inv;
-      }
+      // (L^{-1} theta(:, cols)')' = theta(:, cols) L^{-T}: cThetaT_ read as the nd x Na column-major theta(:, cols)
+      cThetaTw_.resize(cThetaT_.size());
+      RightSolveT(cNd_, Na, qp.FactorL(), cThetaT_.data(), cThetaTw_.data());
       aFactored_ = true;
     }
   }
