@@ -507,6 +507,7 @@ def half_disks(args):
         dl = np.abs(lf - ln).max() / np.abs(ln).max()
         kf = max(sf["kkt"].values())
         check(sf["rom"]["factor_a_once"] is True and sn["rom"]["factor_a_once"] is False and sf["kacanov_iterations"] == sn["kacanov_iterations"]
+              and sf["rom"]["a_diagonalized"] is False and sn["rom"]["a_diagonalized"] is False  # (a constant A^ is never diagonalized)
               and du <= 1e-10 and dl <= 1e-8 and kf <= 1e-12,
               "mu %s: A^ factored once vs per iterate: u_hat rel diff %.1e <= 1e-10, lambda_hat %.1e <= 1e-8, its KKT residual %.1e <= 1e-12"
               % (mu, du, dl, kf))
@@ -586,6 +587,23 @@ def sphere_block3d(args):
         dd = max(abs(a - b) for a, b in zip(vals[1][k], vd["test"][k]))
         print("  single against double precision: max |change| of %s %.1e (bound %.0e)" % (k, dd, bound))
         check(dd <= bound, "single precision moves %s by %.1e <= %.0e" % (k, dd, bound))
+    # A^(mu) = s A_sphere + A_block (two affine terms): diagonalized once by default (-rom_diagonalize_a, docs/online.md
+    # "A diagonalized once"), the QP solved where A^(mu) is the identity; -rom_diagonalize_a false factors A^(mu) at every
+    # parameter. In double precision the same reduced solution to rounding (lambda_hat: coefficients of a nearly
+    # collinear dual basis, 1e-7); in single (the file's) to the float sum's noise (u and the force: 1e-5, as above).
+    for mu in ("0.85,0.035", "1.15,0.048"):
+        for prec, bu, bl in (("double", 1e-10, 1e-7), ("single", 1e-5, None)):
+            for k in ("true", "false"):
+                run(args, 1, "online", ["-rom", rom, "-mu", mu, "-rom_ecsw_precision", prec, "-rom_diagonalize_a", k, "-report", "%s/ad_%s.json" % (d, k)])
+            sa, sn = report(d + "/ad_true.json"), report(d + "/ad_false.json")
+            du = np.abs(np.array(sa["u_hat"]) - np.array(sn["u_hat"])).max() / np.abs(np.array(sn["u_hat"])).max()
+            dl = np.abs(np.array(sa["lambda_hat"]) - np.array(sn["lambda_hat"])).max() / np.abs(np.array(sn["lambda_hat"])).max()
+            fa, fn = sa["outputs"]["contact_force"], sn["outputs"]["contact_force"]
+            df, ka = abs(fa - fn) / fn, max(sa["kkt"].values())
+            check(sa["rom"]["a_diagonalized"] is True and sn["rom"]["a_diagonalized"] is False and sa["rom"]["factor_a_once"] is False
+                  and sa["converged"] and sa["kacanov_iterations"] == sn["kacanov_iterations"] and du <= bu and df <= bu and (bl is None or dl <= bl) and ka <= 1e-12,
+                  "mu %s, %s: A^ diagonalized once vs factored per parameter: u_hat rel diff %.1e, force %.1e <= %.0e, lambda_hat %.1e%s, KKT %.1e <= 1e-12"
+                  % (mu, prec, du, df, bu, dl, " <= %.0e" % bl if bl else " (not bounded: float noise)", ka))
     # the points' sum has a single-precision path too (since 2026-11-26; it ran in double before), and the outer products
     # are summed by the BLAS's gemm or by the built-in kernels (-rom_gemm): the same reduced solution to the float sum's
     # noise (about 1e-6 on u: bound 1e-5; a misplaced row or column moves it by O(1))
@@ -832,17 +850,29 @@ def dual_refit(args):
           and same and nm == plain["pod"]["n"] and nr == ds["R_stored"] and dr["rom"]["Mc"] == plain["rom"]["Mc"] and dr["ecsw"]["tol"] == plain["ecsw"]["tol"] and dr["pod"]["n"] == plain["pod"]["n"],
           "-dual_select_refit_ecsw_tol 5e-2: Mc %d, held-out lambda %.3e > %.3e: not kept; every dataset of the ROM file, the basis file's %d modes and %d dual "
           "vectors and the report's sizes as without the refit" % (rd["Mc"], rd["max_rel_err_lambda"], (1 + rd["slack"]) * c["max_rel_err_lambda"], nm, nr))
-    # the manual form from the same snapshots, on 2 and 1 ranks: the same model (the cubature fitted to the same rows)
+    # the manual form from the same snapshots, on 2 and 1 ranks: the same model (the cubature fitted to the same rows).
+    # On 2 ranks (the refit's) the same errors; the 1-rank file's bases differ from it by rounding, which the single
+    # precision sums of the file (-rom_ecsw_precision single) would turn into their noise: A^ = s A_sphere + A_block is
+    # diagonalized once (docs/online.md "A diagonalized once"), and V rotates freely within its nearly equal eigenvalues
+    # (modes living on one body), so the float-rounded rows theta V differ. The two files are compared summed in double.
     for np_ in (2, 1):
         run(args, np_, "offline", opts + ["-snapshots_restart", "-rom", "%s/t%d.h5" % (d, np_), "-report", "%s/t%d.json" % (d, np_), "-dual_truncate", str(ds["R"])])
         t = report("%s/t%d.json" % (d, np_))
-        run(args, 2, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", "%s/t%d.h5" % (d, np_), "-test_snapshots", d + "/held.h5",
-                                  "-validate_repeat", "1", "-report", "%s/vt%d.json" % (d, np_)])
-        v = report("%s/vt%d.json" % (d, np_))["test"]
+        for prec in ("single", "double"):
+            run(args, 2, "validate", ["-options_file", "runs/sphere_block3d.opts", "-rom", "%s/t%d.h5" % (d, np_), "-test_snapshots", d + "/held.h5",
+                                      "-validate_repeat", "1", "-rom_ecsw_precision", prec, "-report", "%s/vt%d_%s.json" % (d, np_, prec)])
+        v = report("%s/vt%d_single.json" % (d, np_))["test"]
         dev = max(abs(v["max_rel_err_" + q] - rf["max_rel_err_" + q]) / rf["max_rel_err_" + q] for q in ("u", "lambda", "force"))
-        check(t["rom"]["R"] == ds["R"] and t["rom"]["N"] == ds["N"] and t["rom"]["Mc"] == rf["Mc"] and dev <= 1e-6,
-              "-dual_truncate %d on %d rank(s): R %d, N %d, Mc %d (refit: %d); held-out errors those of the refit to %.1e (<= 1e-6)"
-              % (ds["R"], np_, t["rom"]["R"], t["rom"]["N"], t["rom"]["Mc"], rf["Mc"], dev))
+        if np_ == 2:
+            check(t["rom"]["R"] == ds["R"] and t["rom"]["N"] == ds["N"] and t["rom"]["Mc"] == rf["Mc"] and dev <= 1e-6,
+                  "-dual_truncate %d on %d rank(s): R %d, N %d, Mc %d (refit: %d); held-out errors those of the refit to %.1e (<= 1e-6)"
+                  % (ds["R"], np_, t["rom"]["R"], t["rom"]["N"], t["rom"]["Mc"], rf["Mc"], dev))
+        else:
+            v1, v2 = report("%s/vt1_double.json" % d)["test"], report("%s/vt2_double.json" % d)["test"]
+            dd = max(abs(v1["max_rel_err_" + q] - v2["max_rel_err_" + q]) / v2["max_rel_err_" + q] for q in ("u", "lambda", "force"))
+            check(t["rom"]["R"] == ds["R"] and t["rom"]["N"] == ds["N"] and t["rom"]["Mc"] == rf["Mc"] and dd <= 1e-6,
+                  "-dual_truncate %d on 1 rank: R %d, N %d, Mc %d (refit: %d); held-out errors, summed in double, those of the 2-rank file to %.1e "
+                  "(<= 1e-6; in single precision %.1e from the refit's)" % (ds["R"], t["rom"]["R"], t["rom"]["N"], t["rom"]["Mc"], rf["Mc"], dd, dev))
     # the same basis functions as the uncut file at its chosen R: the exact-contact reduced model's errors are equal when
     # both reduced Kacanov loops converge tightly (their warm starts differ: the training multipliers' coefficients
     # in 24 or in 34 dual vectors)

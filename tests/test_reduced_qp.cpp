@@ -2,7 +2,9 @@
 // problems (also with badly scaled constraint rows), an analytic case, warm starts (iterations, bitwise
 // reuse of the cached factorization), dependent constraints (R > N, S singular), infeasible
 // constraints, a non-SPD A, the iteration limit, the options, no heap allocation in Solve after Reserve, and A
-// factored once (FactorA, SolveFactored) against Solve.
+// factored once (FactorA, SolveFactored) against Solve, and a two-term A diagonalized once (AffineDiagonalization,
+// SetIdentityA) against Solve.
+#include "rbcontact/affine_diagonalization.hpp"
 #include "rbcontact/reduced_qp.hpp"
 #include <atomic>
 #include <cmath>
@@ -508,6 +510,126 @@ int main(int argc, char **argv)
     ierr = fq.SolveFactored(N, R, p.f.data(), GTn.data(), p.c.data(), vf.data(), lf.data(), &fi);
     PetscCall(PetscPopErrorHandler());
     CheckTrue(ierr == PETSC_ERR_FP && AllFinite(vf) && AllFinite(lf), "NaN in D L^{-T}: PETSC_ERR_FP, finite output");
+  }
+
+  std::printf("9. A with two affine terms diagonalized once (AffineDiagonalization; SetIdentityA, SolveFactored in z) against Solve\n");
+  for (Size sz : {Size{8, 5, false}, Size{44, 30, false}, Size{40, 30, true}}) {
+    // A(theta) = theta_0 A_0 + theta_1 A_1: A_0 the random SPD matrix, A_1 = M'M/N (positive semidefinite, rank N/2)
+    const Problem  p = RandomProblem(sz.N, sz.R, 900 + sz.N + sz.R, sz.bad);
+    const PetscInt N = p.N, R = p.R;
+    std::mt19937   gen(17 + N);
+    std::normal_distribution<double> G(0, 1);
+    Vecd Aq(2 * N * N, 0.0), M((N / 2) * N);
+    for (auto &x : M) x = G(gen);
+    for (PetscInt i = 0; i < N * N; ++i) Aq[i] = p.A[i];
+    for (PetscInt i = 0; i < N; ++i)
+      for (PetscInt j = 0; j < N; ++j)
+        for (PetscInt k = 0; k < N / 2; ++k) Aq[N * N + i + j * N] += M[k + i * (N / 2)] * M[k + j * (N / 2)] / N;
+    auto AofTheta = [&](const Vecd &th) {
+      Vecd A(N * N);
+      for (PetscInt e = 0; e < N * N; ++e) A[e] = th[0] * Aq[e] + th[1] * Aq[N * N + e];
+      return A;
+    };
+    const Vecd            th0 = {1.0, 0.7};
+    AffineDiagonalization ad;
+    bool                  ok = false;
+    PetscCall(ad.Set(N, th0, Aq.data(), &ok));
+    CheckTrue(ok && ad.N() == N, "AffineDiagonalization::Set: ok");
+    // V' A(theta) V = diag(d(theta)) at theta0 and at other coefficients (plain triple loops)
+    double dd = 0;
+    for (const Vecd &th : {th0, Vecd{2.5, 0.1}, Vecd{0.3, 3.0}, Vecd{1.0, 0.0}}) {
+      const Vecd A = AofTheta(th), &V = ad.V();
+      Vecd       d(N), AV(N * N, 0.0);
+      ad.Diagonal(th, d.data());
+      for (PetscInt i = 0; i < N; ++i)
+        for (PetscInt j = 0; j < N; ++j)
+          for (PetscInt k = 0; k < N; ++k) AV[i + j * N] += A[i + k * N] * V[k + j * N];
+      double dmax = NormInf(d);
+      for (PetscInt i = 0; i < N; ++i)
+        for (PetscInt j = 0; j < N; ++j) {
+          double x = 0;
+          for (PetscInt k = 0; k < N; ++k) x += V[k + i * N] * AV[k + j * N];
+          dd = std::max(dd, std::abs(x - (i == j ? d[i] : 0.0)) / dmax);
+        }
+    }
+    Check(dd <= 1e-11, "V' A(theta) V = diag(d(theta)) at 4 coefficient pairs (relative to max d)", dd, 1e-11);
+    // the QP in z = diag(d)^{1/2} V^{-1} v (A = I): GT = D V diag(d)^{-1/2}, f_z = diag(d)^{-1/2} V' f, v = V diag(d)^{-1/2} z
+    ReducedQP fq, ref;
+    for (const Vecd &th : {Vecd{2.5, 0.1}, Vecd{0.3, 3.0}}) {
+      Problem q = p;
+      q.A       = AofTheta(th);
+      const Vecd &V = ad.V();
+      Vecd        d(N), sd(N), GT(R * N, 0.0), fz(N, 0.0), z(N), vz(N, 0.0), lz(R, 0.0), vr, lr(R, 0.0);
+      ad.Diagonal(th, d.data());
+      for (PetscInt i = 0; i < N; ++i) sd[i] = 1 / std::sqrt(d[i]);
+      for (PetscInt c = 0; c < N; ++c) {
+        for (PetscInt k = 0; k < N; ++k) {
+          fz[c] += V[k + c * N] * q.f[k];
+          for (PetscInt i = 0; i < R; ++i) GT[i + c * R] += q.D[i + k * R] * V[k + c * N];
+        }
+        fz[c] *= sd[c];
+        for (PetscInt i = 0; i < R; ++i) GT[i + c * R] *= sd[c];
+      }
+      fq.SetIdentityA(N);
+      CheckTrue(fq.HasIdentity(N) && fq.HasFactor(N), "SetIdentityA: HasIdentity(N), HasFactor(N)");
+      ReducedQPInfo zi;
+      PetscCall(fq.SolveFactored(N, R, fz.data(), GT.data(), q.c.data(), z.data(), lz.data(), &zi));
+      for (PetscInt i = 0; i < N; ++i)
+        for (PetscInt k = 0; k < N; ++k) vz[i] += V[i + k * N] * sd[k] * z[k];
+      PetscCall(Run(ref, q, &vr, &lr, &ia));
+      double dv = 0, dl = 0;
+      for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vz[i] - vr[i]));
+      for (PetscInt i = 0; i < R; ++i) dl = std::max(dl, std::abs(lz[i] - lr[i]));
+      dv /= NormInf(vr);
+      dl /= NormInf(lr);
+      std::printf(" N = %d R = %d%s, theta (%.1f, %.1f): %d active; v rel diff %.1e, lambda %.1e\n", (int)N, (int)R, sz.bad ? " (rows scaled)" : "", th[0], th[1], (int)zi.nactive, dv, dl);
+      CheckTrue(zi.status == ReducedQPStatus::Ok && zi.nactive == ia.nactive, "SolveFactored in z: ok, the same active count as Solve");
+      Check(dv <= 1e-10, "v = V diag(d)^{-1/2} z vs Solve with A(theta) (relative, inf norm)", dv, 1e-10);
+      Check(dl <= 1e-9, "lambda: in z vs Solve (relative, inf norm)", dl, 1e-9);
+      Check(WorstKKT(q, vz, lz) <= 1e-12, "in z: independently computed scaled KKT residuals of (v, lambda) with A(theta), D", WorstKKT(q, vz, lz), 1e-12);
+      fq.ResidualsFactored(N, R, nullptr, fz.data(), GT.data(), q.c.data(), z.data(), lz.data(), &zi);
+      Problem qz = q; // the same problem in z: A = I, f_z, D_z = GT
+      qz.A.assign(N * N, 0.0);
+      for (PetscInt i = 0; i < N; ++i) qz.A[i + i * N] = 1;
+      qz.f = fz;
+      qz.D = GT;
+      Check(std::abs(WorstKKT(qz, z, lz) - InfoWorst(zi)) <= 1e-3 * WorstKKT(qz, z, lz) + 1e-15, "ResidualsFactored(nullptr): the KKT residuals of the problem in z", std::abs(WorstKKT(qz, z, lz) - InfoWorst(zi)), 1e-3 * WorstKKT(qz, z, lz) + 1e-15);
+    }
+    // FactorA after SetIdentityA: the factor is A's again (no identity left behind), and SolveFactored agrees with Solve
+    ReducedQPInfo fi;
+    PetscCall(fq.FactorA(N, p.A.data(), &fi));
+    CheckTrue(fi.status == ReducedQPStatus::Ok && fq.HasFactor(N) && !fq.HasIdentity(N), "FactorA after SetIdentityA: HasFactor, not HasIdentity");
+    Vecd GT(R * N), vf(N), lf(R, 0.0), vr, lr(R, 0.0);
+    const PetscReal *L = fq.FactorL();
+    for (PetscInt k = 0; k < N; ++k)
+      for (PetscInt i = 0; i < R; ++i) {
+        double x = p.D[i + k * R];
+        for (PetscInt m = 0; m < k; ++m) x -= L[k + m * N] * GT[i + m * R];
+        GT[i + k * R] = x / L[k + k * N];
+      }
+    PetscCall(fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi));
+    PetscCall(Run(ref, p, &vr, &lr, &ia));
+    double dv = 0;
+    for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vf[i] - vr[i]));
+    Check(dv <= 1e-10 * NormInf(vr), "... SolveFactored vs Solve (relative)", dv / NormInf(vr), 1e-10);
+    fq.SetIdentityA(N);
+    Problem q2 = p;
+    PetscCall(fq.Solve(N, R, q2.A.data(), q2.f.data(), q2.D.data(), q2.c.data(), vf.data(), lf.data(), &fi));
+    dv = 0;
+    for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vf[i] - vr[i]));
+    CheckTrue(!fq.HasIdentity(N) && dv <= 1e-10 * NormInf(vr), "Solve with another A after SetIdentityA: not HasIdentity, the Solve answer");
+    // one term (theta_1 absent): lambda = 0, V' A_0 V = I; B not positive definite, three terms: not ok
+    PetscCall(ad.Set(N, {2.0}, Aq.data(), &ok));
+    double l1 = ok ? NormInf(ad.Lambda()) : 1;
+    Vecd   d1(N);
+    if (ok) ad.Diagonal({3.0}, d1.data());
+    CheckTrue(ok && l1 == 0 && std::abs(d1[0] - 1.5) <= 1e-15 && std::abs(d1[N - 1] - 1.5) <= 1e-15, "one term: ok, lambda = 0, d(theta) = theta / theta0");
+    Vecd Ab = Aq;
+    Ab[0]   = -10 * NormInf(p.A);
+    PetscCall(ad.Set(N, th0, Ab.data(), &ok));
+    CheckTrue(!ok && ad.Empty(), "A(theta0) not positive definite: not ok, empty");
+    PetscCall(ad.Set(N, {1.0, 0.5, 0.2}, Aq.data(), &ok));
+    CheckTrue(!ok && ad.Empty(), "three terms: not ok, empty");
   }
 
   PetscCall(as.Reset());

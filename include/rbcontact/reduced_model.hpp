@@ -18,6 +18,7 @@
 #include "rbcontact/eim.hpp"
 #include "rbcontact/fork_join.hpp"
 #include "rbcontact/reduced_contact.hpp"
+#include "rbcontact/affine_diagonalization.hpp"
 #include "rbcontact/reduced_qp.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/surface_outputs.hpp"
@@ -134,7 +135,7 @@ public:
   const std::vector<PetscInt> &Columns() const { return cols_; }
   // Reduced A^(mu) (N x N, column-major) and f^(mu).
   void Operators(const std::vector<PetscReal> &mu, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
-  // The same for the n columns cols of the stored basis (nullptr: the first n).
+  // The same for the n columns cols of the stored basis (nullptr: the first n); A nullptr: f^ only.
   void AffineAt(const std::vector<PetscReal> &mu, const PetscInt *cols, PetscInt n, std::vector<PetscReal> *A, std::vector<PetscReal> *f) const;
   // Reduced contact terms at (mu, v) in the current mode: K (R x N column-major), g (R). Returns the out-of-range count.
   PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g);
@@ -221,6 +222,15 @@ public:
   // rom.factor_a_once).
   PetscBool factorAOnce = PETSC_TRUE;
   bool AFactored() const { return aFactored_ && mode_ == ContactMode::Cubature; }
+  // -rom_diagonalize_a (default true): where A^(mu) = theta_0(mu) A_0 + theta_1(mu) A_1 (at most two affine terms, not
+  // all constant: a 3D dilation of one body, a modulus parameter) and the cubature sums by dofs or, in single precision,
+  // by points,
+  // Truncate solves the generalized eigenproblem of the two terms once (AffineDiagonalization): V' A^(mu) V =
+  // diag(d(mu)) for every mu. The sum gives K^ V from V-transformed basis rows, the QP solves in z = diag(d)^{1/2}
+  // V^{-1} v, where A^ is the identity (ReducedQP::SetIdentityA): no Cholesky of A^(mu) and no triangular solve of K^ per
+  // parameter (docs/online.md "A diagonalized once"). ADiagonalized(): in effect (report key rom.a_diagonalized).
+  PetscBool diagonalizeA = PETSC_TRUE;
+  bool ADiagonalized() const { return !adiag_.Empty() && mode_ == ContactMode::Cubature; }
   bool      recordIterates = false;
   // -rom_threads n (default 1): the cubature's contact terms on n threads (the patch's displacement, the points'
   // closest-point scans and kernels, and the points' sum split into n parts of the points; docs/online.md "Threads").
@@ -239,7 +249,7 @@ private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
   // The error estimate of a converged sol (ErrorEstimate), from the contact terms' last evaluation.
   PetscErrorCode EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol);
-  // ContactTerms; factored (AFactored() only): K holds K^ L^{-T}, summed from cThetaTw_
+  // ContactTerms; factored (AFactored() or ADiagonalized() only): K holds K^ L^{-T} (summed from cThetaTw_), or K^ V
   PetscInt ContactTerms(const std::vector<PetscReal> &mu, const PetscReal *v, PetscReal *K, PetscReal *g, bool factored);
   // [K g] of the cubature over the last point evaluation, rows PwT (padded to rp), nc columns (ContactTerms, EstimateError)
   void CubatureSum(PetscInt rp, const std::vector<PetscReal> &PwT, const std::vector<PetscReal> &ThetaT, const PetscInt *cols, PetscInt nc, std::vector<PetscReal> *Q, std::vector<PetscReal> *X, std::vector<PetscReal> *Kp);
@@ -275,6 +285,11 @@ private:
   std::vector<PetscReal> cThetaT_, cQ_, cCoef_;       // dofs sum: theta(:, cols)' (Na x nd), Q (nd x rp), coefficients
   std::vector<PetscReal> cThetaTw_;                   // factorAOnce: L^{-1} theta(:, cols)' (Na x nd), A^ = L L'
   bool                   aFactored_ = false;          // cThetaTw_ and qp's factor set for the current sizes (Truncate)
+  AffineDiagonalization  adiag_;                      // diagonalizeA: V, lambda of A^'s two terms (Truncate; empty: not in effect)
+  std::vector<float>     cThetaTsw_;                  // ... dofs sum in single precision: (theta(:, cols) V)' in float (cThetaTw_ holds it in double)
+  bool                   cRowsW_ = false;             // ... points' sum in single precision: cThetaFs_ holds theta(:, cols) V
+  std::vector<PetscReal> aVinv_;                      // ... and V^{-1} = V' A^(mu0) (Na x Na) for the nodal displacement from v
+  std::vector<PetscReal> dA_, sA_, fz_, zq_;          // ... per solve: d(mu), d^{-1/2}, f in z, the QP's z
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;
   std::vector<PetscReal> geomMu_; // parameter of the patch geometry in place

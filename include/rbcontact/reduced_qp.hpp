@@ -62,9 +62,14 @@ public:
   // FactorA). A Solve with another A (or Reset) replaces the factor: HasFactor(N) tells, SolveFactored refuses.
   PetscErrorCode FactorA(PetscInt N, const PetscReal *A, ReducedQPInfo *info);
   bool           HasFactor(PetscInt N) const { return factored_ && cN_ == N; }
+  // A = I (coordinates in which the caller's A is the identity: AffineDiagonalization): L = I, and SolveFactored,
+  // ResidualsFactored skip the triangular solves and products with it (GT = D). HasIdentity(N) tells.
+  void           SetIdentityA(PetscInt N);
+  bool           HasIdentity(PetscInt N) const { return HasFactor(N) && unit_; }
   const PetscReal *FactorL() const { return L_.data(); }
   PetscErrorCode SolveFactored(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *GT, const PetscReal *c, PetscReal *v, PetscReal *lambda, ReducedQPInfo *info);
   // The scaled KKT residuals (as Residuals) of (v, lambda) for the data of the last SolveFactored, D = GT L' formed here.
+  // A nullptr: the A of FactorA or SetIdentityA.
   void ResidualsFactored(PetscInt N, PetscInt R, const PetscReal *A, const PetscReal *f, const PetscReal *GT, const PetscReal *c, const PetscReal *v, const PetscReal *lambda, ReducedQPInfo *info);
 
   ReducedQPType type  = ReducedQPType::ActiveSet;
@@ -99,6 +104,7 @@ private:
   // cache of the last A, D (bitwise) and what depends only on them
   bool                   cachedA_ = false, cachedD_ = false;
   bool                   factored_ = false; // L_ is FactorA's factor of A (Ac_, N = cN_)
+  bool                   unit_     = false; // ... set by SetIdentityA: L_ = Ac_ = I
   PetscInt               cN_ = -1, cR_ = -1;
   std::vector<PetscReal> Ac_, Dc_;
   PetscReal              normA_ = 0, normD_ = 0; // ||A||_inf, ||D||_inf

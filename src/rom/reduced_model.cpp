@@ -214,6 +214,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["gemm"]           = m.GemmName();
   (*r)["factor_a_once"]  = m.AFactored(); // -rom_factor_a_once and in effect (A^ independent of mu, dofs sum in double)
+  (*r)["a_diagonalized"] = m.ADiagonalized(); // -rom_diagonalize_a and in effect (A^ with at most two affine terms, dofs sum)
   (*r)["threads"]        = (long long)m.threads; // -rom_threads
   (*r)["threads_cpus"]   = (long long)m.ThreadCpus();
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
@@ -461,6 +462,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsBool("-factor_a_once", "where A^ does not depend on mu (and the cubature sums by dofs in double precision): factor it once and sum K^ L^{-T} for the QP directly (docs/online.md \"A factored once\")", "", factorAOnce, &factorAOnce, NULL));
+  PetscCall(PetscOptionsBool("-diagonalize_a", "where A^ has two affine terms (or one that depends on mu) and the cubature sums by dofs: diagonalize A^(mu) for every mu at once (a generalized eigenproblem) and solve the QP where A^ is the identity (docs/online.md \"A diagonalized once\")", "", diagonalizeA, &diagonalizeA, NULL));
   PetscCall(PetscOptionsInt("-threads", "threads of the cubature's contact terms (the patch displacement, the points' scans and kernels, the points' sum; docs/online.md \"Threads\")", "", threads, &threads, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's: the offline stage's held-out choice, /online/dual_select, else all but the estimate's enrichment)", "", r, &r, NULL));
@@ -608,6 +610,44 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
       aFactored_ = true;
     }
   }
+  // A^ with at most two affine terms, not all constant (a constant A^ is -rom_factor_a_once's): V' A^(mu) V diagonal for
+  // every mu, and (theta(:, cols) V)' for the sum of K^ V
+  adiag_ = AffineDiagonalization();
+  cThetaTsw_.clear();
+  cRowsW_ = false;
+  aVinv_.clear();
+  if (!aFactored_ && diagonalizeA && (cDofs_ || cSingle_) && Na > 0 && !par.AConstant() && (par.thetaA.size() == 1 || par.thetaA.size() == 2) && aAct_.size() == par.thetaA.size() * (size_t)Na * Na) {
+    std::vector<PetscReal> mu0(par.params.size()), th0;
+    for (size_t i = 0; i < mu0.size(); ++i) mu0[i] = par.params[i].def;
+    par.ThetaA(mu0, &th0);
+    bool ok = false;
+    PetscCall(adiag_.Set(Na, th0, aAct_.data(), &ok));
+    const PetscBLASInt n = (PetscBLASInt)Na;
+    const PetscScalar  a1 = 1, b0 = 0;
+    if (ok && cDofs_) { // cThetaT_ read as the nd x Na column-major theta(:, cols), times V
+      std::vector<PetscReal> tw((size_t)cNd_ * Na);
+      const PetscBLASInt     m = (PetscBLASInt)cNd_;
+      if (cNd_ > 0) BLASgemm_("N", "N", &m, &n, &n, &a1, cThetaT_.data(), &m, adiag_.V().data(), &n, &b0, tw.data(), &m);
+      if (cSingle_) cThetaTsw_.assign(tw.begin(), tw.end());
+      else cThetaTw_ = std::move(tw);
+    } else if (ok) { // the points' sum in float: its rows theta(a, cols) replaced by theta(a, cols) V (the same storage), the
+      // nodal displacement from them and V^{-1} v = V' A^(mu0) v
+      const PetscInt         ldf = PaddedRows(Na, 8), nr = patch.nnode * patch.dim;
+      std::vector<PetscReal> T((size_t)nr * Na), W((size_t)nr * Na), B((size_t)Na * Na, 0.0);
+      for (PetscInt a = 0; a < nr; ++a)
+        for (PetscInt c = 0; c < Na; ++c) T[(size_t)a * Na + c] = patch.theta[(size_t)a * patch.N + cols_[c]];
+      const PetscBLASInt m = (PetscBLASInt)nr;
+      if (nr > 0) BLASgemm_("T", "N", &n, &m, &n, &a1, adiag_.V().data(), &n, T.data(), &n, &b0, W.data(), &n); // W(:, a) = V' theta(a, cols)'
+      for (PetscInt a = 0; a < nr; ++a)
+        for (PetscInt c = 0; c < Na; ++c) cThetaFs_[(size_t)a * ldf + c] = (float)W[(size_t)a * Na + c];
+      for (size_t q = 0; q < th0.size(); ++q)
+        for (size_t e = 0; e < B.size(); ++e) B[e] += th0[q] * aAct_[q * B.size() + e];
+      aVinv_.resize((size_t)Na * Na);
+      BLASgemm_("T", "N", &n, &n, &n, &a1, adiag_.V().data(), &n, B.data(), &n, &b0, aVinv_.data(), &n);
+      cRowsW_ = true;
+    } // (else the per-solve factorization, whose QP reports a matrix that is not positive definite)
+    if (ok) qp.SetIdentityA(Na);
+  }
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
     Pact_.assign(P_.begin(), P_.begin() + (size_t)r * Q);
@@ -654,18 +694,20 @@ void ReducedModel::AffineAt(const std::vector<PetscReal> &mu, const PetscInt *co
   par.ThetaA(mu, &thA);
   par.ThetaF(mu, &thF);
   auto col = [&](PetscInt i) { return cols ? cols[i] : i; };
-  A->assign((size_t)n * n, 0.0);
   f->assign(n, 0.0);
-  if (cols == cols_.data() && aAct_.size() == thA.size() * n * n) { // the active columns: Truncate's contiguous copy
-    PetscReal *a = A->data();
-    for (size_t q = 0; q < thA.size(); ++q) {
-      const PetscReal t = thA[q], *c = &aAct_[q * (size_t)n * n];
-      for (size_t e = 0; e < (size_t)n * n; ++e) a[e] += t * c[e];
-    }
-  } else
-    for (size_t q = 0; q < thA.size(); ++q)
-      for (PetscInt j = 0; j < n; ++j)
-        for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * j] += thA[q] * Aq[(q * Nfull + col(i)) * Nfull + col(j)];
+  if (A) { // (nullptr: f only)
+    A->assign((size_t)n * n, 0.0);
+    if (cols == cols_.data() && aAct_.size() == thA.size() * n * n) { // the active columns: Truncate's contiguous copy
+      PetscReal *a = A->data();
+      for (size_t q = 0; q < thA.size(); ++q) {
+        const PetscReal t = thA[q], *c = &aAct_[q * (size_t)n * n];
+        for (size_t e = 0; e < (size_t)n * n; ++e) a[e] += t * c[e];
+      }
+    } else
+      for (size_t q = 0; q < thA.size(); ++q)
+        for (PetscInt j = 0; j < n; ++j)
+          for (PetscInt i = 0; i < n; ++i) (*A)[i + (size_t)n * j] += thA[q] * Aq[(q * Nfull + col(i)) * Nfull + col(j)];
+  }
   for (size_t q = 0; q < thF.size(); ++q)
     for (PetscInt i = 0; i < n; ++i) (*f)[i] += thF[q] * fq[q * Nfull + col(i)];
 }
@@ -803,7 +845,15 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       thread_local std::vector<float>     vf;
       thread_local std::vector<PetscReal> U;
       vf.assign(ldf, 0.0f);
-      for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)v[i];
+      if (cRowsW_) { // the rows are theta(:, cols) V: U = uD + (theta V)(V^{-1} v)
+        thread_local std::vector<PetscReal> w;
+        w.resize(Na);
+        const PetscBLASInt n = (PetscBLASInt)Na, one = 1;
+        const PetscScalar  a1 = 1, b0 = 0;
+        BLASgemv_("N", &n, &n, &a1, aVinv_.data(), &n, v, &one, &b0, w.data(), &one);
+        for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)w[i];
+      } else
+        for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)v[i];
       U.resize((size_t)rows);
       // (pointers: a thread_local named inside the lambda would be the worker's own)
       const float *vfp = vf.data();
@@ -836,7 +886,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       if (cDofs_) {
         cQs_.assign((size_t)nd * rps, 0.0f);
         ScatterRowsSingle(M, rps, cNt_.data(), ContactPatch::MaxTerms, cRow_.data(), cCoef_.data(), cPwTs_.data(), cQs_.data());
-        SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), cThetaTs_.data(), cK_.data());
+        SumOfOuterProductsSingle(nd, rps, Na, cQs_.data(), factored && ADiagonalized() ? cThetaTsw_.data() : cThetaTs_.data(), cK_.data());
       } else { // the points' sum: kappa's used columns combined in float from theta's (cThetaFs_), then one sum
         // nth parts of the points, each summed into its own K (the first into cK_), then added in double
         const PetscInt ldf = PaddedRows(Na, 8);
@@ -867,6 +917,13 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         }
       }
       for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rps], &cK_[(size_t)c * rps] + r, K + (size_t)r * c);
+      if (cRowsW_ && !cDofs_ && !factored && r > 0) { // K^ V from the transformed rows: K^ = (K^ V) V^{-1}
+        thread_local std::vector<PetscReal> kw;
+        kw.assign(K, K + (size_t)r * Na);
+        const PetscBLASInt m = (PetscBLASInt)r, n = (PetscBLASInt)Na;
+        const PetscScalar  a1 = 1, b0 = 0;
+        BLASgemm_("N", "N", &m, &n, &n, &a1, kw.data(), &m, aVinv_.data(), &n, &b0, K, &m);
+      }
       if (cDofs_) {
         cX_.resize(rp);
         SumOfOuterProducts(M, rp, 1, cPwT_.data(), gam_.data(), cX_.data()); // g^ in double
@@ -875,7 +932,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
       event(ROM_CubSum, false);
       return out;
     }
-    CubatureSum(rp, cPwT_, factored && AFactored() ? cThetaTw_ : cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
+    CubatureSum(rp, cPwT_, factored && (AFactored() || ADiagonalized()) ? cThetaTw_ : cThetaT_, cols_.data(), Na, &cQ_, &cX_, &cK_);
     for (PetscInt c = 0; c < Na; ++c) std::copy(&cK_[(size_t)c * rp], &cK_[(size_t)c * rp] + r, K + (size_t)r * c);
     std::copy(&cK_[(size_t)Na * rp], &cK_[(size_t)Na * rp] + r, g);
     event(ROM_CubSum, false);
@@ -986,7 +1043,8 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     sol->message = o.str();
     PetscFunctionReturn(0);
   }
-  Operators(mu, &A_, &f_);
+  // (A^(mu) itself is not needed where it is diagonalized once)
+  AffineAt(mu, cols_.data(), Na, AFactored() || !ADiagonalized() ? &A_ : nullptr, &f_);
   // warm start: a combination of the stored reduced solutions of the training parameters (the bracketing
   // interpolation with one parameter, a quadratic or affine least-squares fit with several: warm_start.hpp); the
   // multipliers clipped to the cone
@@ -1012,6 +1070,38 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
       PetscFunctionReturn(0);
     }
   }
+  // A^ diagonalized once (Truncate): d(mu), and the QP in z = diag(d)^{1/2} V^{-1} v, where A^ is the identity and f is
+  // diag(d)^{-1/2} V' f; K^ V from the sum, its columns scaled by d^{-1/2}; v = V diag(d)^{-1/2} z
+  const bool diag = !factored && ADiagonalized();
+  if (diag) {
+    thread_local std::vector<PetscReal> thA;
+    par.ThetaA(mu, &thA);
+    dA_.resize(Na);
+    sA_.resize(Na);
+    fz_.resize(Na);
+    zq_.resize(Na);
+    adiag_.Diagonal(thA, dA_.data());
+    PetscReal dmax = 0;
+    PetscInt  imin = 0;
+    for (PetscInt i = 0; i < Na; ++i) {
+      dmax = std::max(dmax, std::abs(dA_[i]));
+      if (!(dA_[i] >= dA_[imin])) imin = i;
+    }
+    if (!(dA_[imin] > 64 * PETSC_MACHINE_EPSILON * dmax)) { // as the Cholesky of A^(mu) would report it
+      char buf[320];
+      std::snprintf(buf, sizeof buf, "reduced matrix A is not symmetric positive definite at this parameter (eigenvalue %g of A(mu) relative to A(mu0), the largest %g): the parameter leaves the range where the affine stiffness is positive definite", (double)dA_[imin], (double)dmax);
+      sol->qp.status  = ReducedQPStatus::NotSPD;
+      sol->qp.message = buf;
+      sol->message    = "reduced QP failed before the first Kacanov iteration (" + std::string(ReducedQPStatusName(sol->qp.status)) + "): " + sol->qp.message;
+      PetscFunctionReturn(0);
+    }
+    for (PetscInt i = 0; i < Na; ++i) sA_[i] = 1 / std::sqrt(dA_[i]);
+    const PetscBLASInt n = (PetscBLASInt)Na, one = 1;
+    const PetscScalar  a1 = 1, b0 = 0;
+    BLASgemv_("T", &n, &n, &a1, adiag_.V().data(), &n, f_.data(), &one, &b0, fz_.data(), &one);
+    for (PetscInt i = 0; i < Na; ++i) fz_[i] *= sA_[i];
+    qp.SetIdentityA(Na); // (a no-op unless another solve replaced it)
+  }
   loop.Begin(Na);
   vnext.resize(Na);
   for (PetscInt it = 1; it <= loop.maxIt; ++it) {
@@ -1019,12 +1109,22 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     lprev = sol->lambda;
     if (recordIterates) sol->iterates.insert(sol->iterates.end(), vprev.begin(), vprev.end());
     PetscCall(PetscLogEventBegin(ROM_Contact, 0, 0, 0, 0));
-    sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data(), factored); // factored: K_ is K^ L^{-T}
+    sol->outOfRange += ContactTerms(mu, vprev.data(), K_.data(), g_.data(), factored || diag); // factored: K_ is K^ L^{-T}; diag: K^ V
     PetscCall(PetscLogEventEnd(ROM_Contact, 0, 0, 0, 0));
     vnew.resize(Na);
     PetscCall(PetscLogEventBegin(ROM_QP, 0, 0, 0, 0));
     if (factored) PetscCall(qp.SolveFactored(Na, r, f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
-    else PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
+    else if (diag) {
+      for (PetscInt c = 0; c < Na; ++c)
+        for (PetscInt i = 0; i < r; ++i) K_[i + (size_t)r * c] *= sA_[c];
+      PetscCall(qp.SolveFactored(Na, r, fz_.data(), K_.data(), g_.data(), zq_.data(), sol->lambda.data(), &sol->qp));
+      thread_local std::vector<PetscReal> zs;
+      zs.resize(Na);
+      for (PetscInt i = 0; i < Na; ++i) zs[i] = sA_[i] * zq_[i];
+      const PetscBLASInt n = (PetscBLASInt)Na, one = 1;
+      const PetscScalar  a1 = 1, b0 = 0;
+      BLASgemv_("N", &n, &n, &a1, adiag_.V().data(), &n, zs.data(), &one, &b0, vnew.data(), &one);
+    } else PetscCall(qp.Solve(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), sol->lambda.data(), &sol->qp));
     PetscCall(PetscLogEventEnd(ROM_QP, 0, 0, 0, 0));
     sol->iterations = it;
     lnew            = sol->lambda;
@@ -1063,6 +1163,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     if (done) {
       // the KKT residuals of the last QP only (the loop's QPs skip them: -log_view 1-2 % of a solve)
       if (factored) qp.ResidualsFactored(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
+      else if (diag) qp.ResidualsFactored(Na, r, nullptr, fz_.data(), K_.data(), g_.data(), zq_.data(), lnew.data(), &sol->qp); // in z: A^ = I
       else qp.Residuals(Na, r, A_.data(), f_.data(), K_.data(), g_.data(), vnew.data(), lnew.data(), &sol->qp);
       ResultantForce(lnew, &sol->force);
       sol->converged = true;

@@ -94,7 +94,7 @@ PetscErrorCode ReducedQP::Reset()
   PetscCall(VecDestroy(&lo_));
   PetscCall(VecDestroy(&hi_));
   taoR_   = -1;
-  cachedA_ = cachedD_ = factored_ = false;
+  cachedA_ = cachedD_ = factored_ = unit_ = false;
   PetscFunctionReturn(0);
 }
 
@@ -143,7 +143,7 @@ PetscErrorCode ReducedQP::FactorInto(PetscInt N, const PetscReal *A, ReducedQPIn
   const PetscBLASInt n = B(N), ldn = B(std::max<PetscInt>(N, 1));
 
   PetscFunctionBeginUser;
-  factored_ = false;
+  factored_ = unit_ = false;
   PetscCheck(MaxRowSum(N, N, A, tN_.data(), &normA_), PETSC_COMM_SELF, PETSC_ERR_FP, "ReducedQP: non-finite entry in A (or a row sum overflows)");
   PetscReal amax = 0;
   std::copy_n(A, N * N, L_.data());
@@ -185,7 +185,7 @@ void ReducedQP::DualHessian(PetscInt N, PetscInt R)
 void ReducedQP::RightHandSide(PetscInt N, PetscInt R, const PetscReal *f, const PetscReal *c)
 {
   std::copy_n(f, N, y_.data());
-  ForwardSolve(N, L_.data(), y_.data());
+  if (!unit_) ForwardSolve(N, L_.data(), y_.data());
   for (PetscInt i = 0; i < R; ++i) b_[i] = -s_[i] * c[i];
   for (PetscInt k = 0; k < N; ++k) {
     const PetscReal yk = y_[k], *g = &G_[(size_t)k * R];
@@ -246,6 +246,21 @@ PetscErrorCode ReducedQP::FactorA(PetscInt N, const PetscReal *A, ReducedQPInfo 
   cN_       = N;
   factored_ = true;
   PetscFunctionReturn(0);
+}
+
+void ReducedQP::SetIdentityA(PetscInt N)
+{
+  if (HasIdentity(N)) return;
+  N = std::max<PetscInt>(N, 0);
+  if (N > nCap_ || !nCap_) Reserve(N, std::max<PetscInt>(rCap_, 1));
+  std::fill(Ac_.begin(), Ac_.begin() + (size_t)N * N, 0.0);
+  std::fill(L_.begin(), L_.begin() + (size_t)N * N, 0.0);
+  for (PetscInt i = 0; i < N; ++i) Ac_[i + (size_t)i * N] = L_[i + (size_t)i * N] = 1;
+  normA_    = N > 0 ? 1 : 0;
+  cachedA_  = reuseFactorization;
+  cachedD_  = false;
+  cN_       = N;
+  factored_ = unit_ = true;
 }
 
 // Appends constraint j as row k of the Cholesky factor Lf_ of S_PP (P = P_[0..k-1]). Returns false
@@ -456,7 +471,7 @@ void ReducedQP::Recover(PetscInt N, PetscInt R, const PetscReal *l, PetscReal *v
       const PetscReal li = l[i], *g = &G_[i];
       for (PetscInt k = 0; k < N; ++k) v[k] -= g[(size_t)k * R] * li;
     }
-  BackwardSolveT(N, L_.data(), v);
+  if (!unit_) BackwardSolveT(N, L_.data(), v);
 }
 
 // Scaled KKT residuals of (v, lambda) with the caller's A, f, D, c (one pass over A and one over D).
@@ -656,7 +671,9 @@ void ReducedQP::ResidualsFactored(PetscInt N, PetscInt R, const PetscReal *A, co
   // D = GT L' into the D cache's storage, then the residuals with D
   cachedD_     = false;
   PetscReal *D = Dc_.data();
-  RightMulLT(R, N, L_.data(), GT, D);
+  if (!A) A = Ac_.data();
+  if (unit_) std::copy_n(GT, (size_t)R * N, D);
+  else RightMulLT(R, N, L_.data(), GT, D);
   (void)MaxRowSum(R, N, D, tR_.data(), &normD_);
   KKT(N, R, A, f, D, c, v, lambda, info);
 }
