@@ -57,6 +57,14 @@ static double NormInf(const Vecd &x)
   return m;
 }
 
+// max |a - b| / max |b|
+static double RelDiff(const Vecd &a, const Vecd &b)
+{
+  double d = 0;
+  for (size_t i = 0; i < b.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d / NormInf(b);
+}
+
 // Independent KKT check (same scaling as ReducedQPInfo), plain loops.
 static double WorstKKT(const Problem &p, const Vecd &v, const Vecd &l)
 {
@@ -461,11 +469,7 @@ int main(int argc, char **argv)
     Vecd vf(N), lf(R, 0.0), vr, lr(R, 0.0);
     PetscCall(fq.SolveFactored(N, R, p.f.data(), GT.data(), p.c.data(), vf.data(), lf.data(), &fi));
     PetscCall(Run(ref, p, &vr, &lr, &ia));
-    double dv = 0, dl = 0;
-    for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vf[i] - vr[i]));
-    for (PetscInt i = 0; i < R; ++i) dl = std::max(dl, std::abs(lf[i] - lr[i]));
-    dv /= NormInf(vr);
-    dl /= NormInf(lr);
+    const double dv = RelDiff(vf, vr), dl = RelDiff(lf, lr);
     std::printf(" N = %d R = %d%s: ||L L' - A|| %.1e, factored %d its, %d active; v rel diff %.1e, lambda %.1e\n", (int)N, (int)R, sz.bad ? " (rows scaled)" : "", dA, (int)fi.iterations, (int)fi.nactive, dv, dl);
     Check(dA <= 1e-13 * NormInf(p.A), "FactorL(): L L' = A", dA, 1e-13 * NormInf(p.A));
     CheckTrue(fi.status == ReducedQPStatus::Ok && fi.nactive == ia.nactive, "SolveFactored: ok, the same active count as Solve");
@@ -577,11 +581,7 @@ int main(int argc, char **argv)
       for (PetscInt i = 0; i < N; ++i)
         for (PetscInt k = 0; k < N; ++k) vz[i] += V[i + k * N] * sd[k] * z[k];
       PetscCall(Run(ref, q, &vr, &lr, &ia));
-      double dv = 0, dl = 0;
-      for (PetscInt i = 0; i < N; ++i) dv = std::max(dv, std::abs(vz[i] - vr[i]));
-      for (PetscInt i = 0; i < R; ++i) dl = std::max(dl, std::abs(lz[i] - lr[i]));
-      dv /= NormInf(vr);
-      dl /= NormInf(lr);
+      const double dv = RelDiff(vz, vr), dl = RelDiff(lz, lr);
       std::printf(" N = %d R = %d%s, theta (%.1f, %.1f): %d active; v rel diff %.1e, lambda %.1e\n", (int)N, (int)R, sz.bad ? " (rows scaled)" : "", th[0], th[1], (int)zi.nactive, dv, dl);
       CheckTrue(zi.status == ReducedQPStatus::Ok && zi.nactive == ia.nactive, "SolveFactored in z: ok, the same active count as Solve");
       Check(dv <= 1e-10, "v = V diag(d)^{-1/2} z vs Solve with A(theta) (relative, inf norm)", dv, 1e-10);
