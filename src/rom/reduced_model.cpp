@@ -214,7 +214,7 @@ void ReportSizes(const ReducedModel &m, JsonValue *r)
   (*r)["ecsw_precision"] = m.EcswSingle() ? "single" : "double";
   (*r)["gemm"]           = m.GemmName();
   (*r)["factor_a_once"]  = m.AFactored(); // -rom_factor_a_once and in effect (A^ independent of mu, dofs sum in double)
-  (*r)["a_diagonalized"] = m.ADiagonalized(); // -rom_diagonalize_a and in effect (A^ with at most two affine terms, dofs sum)
+  (*r)["a_diagonalized"] = m.ADiagonalized(); // -rom_diagonalize_a and in effect (A^ with at most two affine terms; dofs sum, or points' sum in float)
   (*r)["threads"]        = (long long)m.threads; // -rom_threads
   (*r)["threads_cpus"]   = (long long)m.ThreadCpus();
   (*r)["kacanov_rtol_primal"] = (double)m.loop.rtolPrimal;
@@ -462,7 +462,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   }
   PetscCall(PetscOptionsEList("-ecsw_precision", "arithmetic of the cubature's sum of K^ (by dofs or by points; g^ stays double): double or single, which leaves a noise floor near 1e-6 (u) / 1e-5 (lambda) on the Kacanov changes: for loose tolerances only (docs/online.md)", "", precisions, 2, precisions[prec], &prec, NULL));
   PetscCall(PetscOptionsBool("-factor_a_once", "where A^ does not depend on mu (and the cubature sums by dofs in double precision): factor it once and sum K^ L^{-T} for the QP directly (docs/online.md \"A factored once\")", "", factorAOnce, &factorAOnce, NULL));
-  PetscCall(PetscOptionsBool("-diagonalize_a", "where A^ has two affine terms (or one that depends on mu) and the cubature sums by dofs: diagonalize A^(mu) for every mu at once (a generalized eigenproblem) and solve the QP where A^ is the identity (docs/online.md \"A diagonalized once\")", "", diagonalizeA, &diagonalizeA, NULL));
+  PetscCall(PetscOptionsBool("-diagonalize_a", "where A^ has two affine terms (or one that depends on mu) and the cubature sums by dofs (or by points in single precision): diagonalize A^(mu) for every mu at once (a generalized eigenproblem) and solve the QP where A^ is the identity (docs/online.md \"A diagonalized once\")", "", diagonalizeA, &diagonalizeA, NULL));
   PetscCall(PetscOptionsInt("-threads", "threads of the cubature's contact terms (the patch displacement, the points' scans and kernels, the points' sum; docs/online.md \"Threads\")", "", threads, &threads, NULL));
   PetscCall(PetscOptionsInt("-N", "POD modes used (default: the answer's, all but the estimate's enrichment)", "", n, &n, NULL));
   PetscCall(PetscOptionsInt("-R", "dual vectors used, with their supremizers (default: the answer's: the offline stage's held-out choice, /online/dual_select, else all but the estimate's enrichment)", "", r, &r, NULL));
