@@ -604,6 +604,12 @@ def sphere_block3d(args):
                   and sa["converged"] and sa["kacanov_iterations"] == sn["kacanov_iterations"] and du <= bu and df <= bu and (bl is None or dl <= bl) and ka <= 1e-12,
                   "mu %s, %s: A^ diagonalized once vs factored per parameter: u_hat rel diff %.1e, force %.1e <= %.0e, lambda_hat %.1e%s, KKT %.1e <= 1e-12"
                   % (mu, prec, du, df, bu, dl, " <= %.0e" % bl if bl else " (not bounded: float noise)", ka))
+    # the public ContactTerms of the diagonalized model with the points' sum in float (rows theta V, K^ = (K^ V) V^{-1}) against
+    # the model without: tests/test_rom_contact_terms.cpp, on 1 rank
+    if args.contact_terms_exe:
+        p = subprocess.run(["mpirun", "-n", "1", args.contact_terms_exe, "-rom", rom, "-mu", "0.9,0.04"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        print(p.stdout.rstrip())
+        check(p.returncode == 0 and "PASSED" in p.stdout, "test_rom_contact_terms on the ROM: exit %d" % p.returncode)
     # the points' sum has a single-precision path too (since 2026-11-26; it ran in double before), and the outer products
     # are summed by the BLAS's gemm or by the built-in kernels (-rom_gemm): the same reduced solution to the float sum's
     # noise (about 1e-6 on u: bound 1e-5; a misplaced row or column moves it by O(1))
@@ -1061,6 +1067,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit"])
     ap.add_argument("--exe", required=True)
+    ap.add_argument("--contact-terms-exe", help="tests/test_rom_contact_terms (sphere_block3d runs it on its ROM)")
     args = ap.parse_args()
     globals()[args.check](args)
     if FAILED:

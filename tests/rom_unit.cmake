@@ -48,3 +48,6 @@ rbc_add_mpi_test(NAME test_dual_selection RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FI
 #                          regions, late workers, Part's ranges, and the CPUs (the caller's mask, the workers' SetCpus)
 rbc_test_exe(test_fork_join)
 rbc_add_mpi_test(NAME test_fork_join RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:test_fork_join> LABELS rom)
+#   test_rom_contact_terms the public ContactTerms with A^ diagonalized once and the points' sum in float (its rows
+#                          theta V) against the same model without: run by rom_checks.py sphere_block3d on its ROM
+rbc_test_exe(test_rom_contact_terms)
