@@ -28,11 +28,13 @@ public:
   // V (N x N, column-major): V' B V = I, V' C V = diag(lam)
   const std::vector<PetscReal> &V() const { return V_; }
   const std::vector<PetscReal> &Lambda() const { return lam_; }
+  // V^{-1} = V' B (N x N, column-major): reduced coordinates v to V's, w = V^{-1} v
+  const std::vector<PetscReal> &VInverse() const { return Vinv_; }
 
 private:
   PetscInt               n_ = -1;
   std::vector<PetscReal> t0_, t1_; // theta(mu0) / |theta(mu0)|^2 and the unit vector orthogonal to it (QA = 2; else empty)
-  std::vector<PetscReal> V_, lam_;
+  std::vector<PetscReal> V_, lam_, Vinv_;
 };
 
 } // namespace rbc

@@ -287,8 +287,7 @@ private:
   bool                   aFactored_ = false;          // cThetaTw_ and qp's factor set for the current sizes (Truncate)
   AffineDiagonalization  adiag_;                      // diagonalizeA: V, lambda of A^'s two terms (Truncate; empty: not in effect)
   std::vector<float>     cThetaTsw_;                  // ... dofs sum in single precision: (theta(:, cols) V)' in float (cThetaTw_ holds it in double)
-  bool                   cRowsW_ = false;             // ... points' sum in single precision: cThetaFs_ holds theta(:, cols) V
-  std::vector<PetscReal> aVinv_;                      // ... and V^{-1} = V' A^(mu0) (Na x Na) for the nodal displacement from v
+  bool                   cRowsW_ = false;             // ... points' sum in single precision: cThetaFs_ holds theta(:, cols) V (displacement from V^{-1} v)
   std::vector<PetscReal> dA_, sA_, fz_, zq_;          // ... per solve: d(mu), d^{-1/2}, f in z, the QP's z
   std::vector<PetscInt>  cNt_, cRow_;                 // dofs sum: terms per point, their patch dofs
   std::vector<PetscInt>  allPoints_;

@@ -17,6 +17,7 @@ PetscErrorCode AffineDiagonalization::Set(PetscInt N, const std::vector<PetscRea
   t1_.clear();
   V_.clear();
   lam_.clear();
+  Vinv_.clear();
   if (N < 1 || qa < 1 || qa > 2) PetscFunctionReturn(0);
   PetscReal n2 = 0;
   for (PetscReal t : theta0) n2 += t * t;
@@ -37,6 +38,7 @@ PetscErrorCode AffineDiagonalization::Set(PetscInt N, const std::vector<PetscRea
     }
   for (PetscReal x : Bm)
     if (!std::isfinite(x)) PetscFunctionReturn(0);
+  const std::vector<PetscReal> B0 = Bm; // (sygv overwrites Bm with its Cholesky factor)
   // sygv: C x = lam B x, eigenvectors in Cm normalized x' B x = 1 (workspace query first)
   PetscBLASInt itype = 1, n = (PetscBLASInt)N, lwork = -1, info = 0;
   PetscReal    wq    = 0;
@@ -47,6 +49,9 @@ PetscErrorCode AffineDiagonalization::Set(PetscInt N, const std::vector<PetscRea
   LAPACKsygv_(&itype, "V", "L", &n, Cm.data(), &n, Bm.data(), &n, w.data(), work.data(), &lwork, &info);
   PetscCheck(info >= 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "LAPACK sygv: argument %d invalid", (int)-info);
   if (info > 0) PetscFunctionReturn(0); // B not positive definite (info > N) or no convergence (info <= N)
+  const PetscScalar a1 = 1, b0 = 0;
+  Vinv_.resize(nn);
+  BLASgemm_("T", "N", &n, &n, &n, &a1, Cm.data(), &n, B0.data(), &n, &b0, Vinv_.data(), &n); // V' B
   n_   = N;
   t0_  = t0;
   t1_  = qa == 2 ? t1 : std::vector<PetscReal>();

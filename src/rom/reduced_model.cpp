@@ -615,7 +615,6 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   adiag_ = AffineDiagonalization();
   cThetaTsw_.clear();
   cRowsW_ = false;
-  aVinv_.clear();
   if (!aFactored_ && diagonalizeA && (cDofs_ || cSingle_) && Na > 0 && !par.AConstant() && (par.thetaA.size() == 1 || par.thetaA.size() == 2) && aAct_.size() == par.thetaA.size() * (size_t)Na * Na) {
     std::vector<PetscReal> mu0(par.params.size()), th0;
     for (size_t i = 0; i < mu0.size(); ++i) mu0[i] = par.params[i].def;
@@ -633,20 +632,15 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
     } else if (ok) { // the points' sum in float: its rows theta(a, cols) replaced by theta(a, cols) V (the same storage), the
       // nodal displacement from them and V^{-1} v = V' A^(mu0) v
       const PetscInt         ldf = PaddedRows(Na, 8), nr = patch.nnode * patch.dim;
-      std::vector<PetscReal> T((size_t)nr * Na), W((size_t)nr * Na), B((size_t)Na * Na, 0.0);
+      std::vector<PetscReal> T((size_t)nr * Na), W((size_t)nr * Na);
       for (PetscInt a = 0; a < nr; ++a)
         for (PetscInt c = 0; c < Na; ++c) T[(size_t)a * Na + c] = patch.theta[(size_t)a * patch.N + cols_[c]];
       const PetscBLASInt m = (PetscBLASInt)nr;
       if (nr > 0) BLASgemm_("T", "N", &n, &m, &n, &a1, adiag_.V().data(), &n, T.data(), &n, &b0, W.data(), &n); // W(:, a) = V' theta(a, cols)'
       for (PetscInt a = 0; a < nr; ++a)
         for (PetscInt c = 0; c < Na; ++c) cThetaFs_[(size_t)a * ldf + c] = (float)W[(size_t)a * Na + c];
-      for (size_t q = 0; q < th0.size(); ++q)
-        for (size_t e = 0; e < B.size(); ++e) B[e] += th0[q] * aAct_[q * B.size() + e];
-      aVinv_.resize((size_t)Na * Na);
-      BLASgemm_("T", "N", &n, &n, &n, &a1, adiag_.V().data(), &n, B.data(), &n, &b0, aVinv_.data(), &n);
       cRowsW_ = true;
     } // (else the per-solve factorization, whose QP reports a matrix that is not positive definite)
-    if (ok) qp.SetIdentityA(Na);
   }
   if (!P_.empty()) {
     const size_t Q = P_.size() / Rfull;
@@ -850,7 +844,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         w.resize(Na);
         const PetscBLASInt n = (PetscBLASInt)Na, one = 1;
         const PetscScalar  a1 = 1, b0 = 0;
-        BLASgemv_("N", &n, &n, &a1, aVinv_.data(), &n, v, &one, &b0, w.data(), &one);
+        BLASgemv_("N", &n, &n, &a1, adiag_.VInverse().data(), &n, v, &one, &b0, w.data(), &one);
         for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)w[i];
       } else
         for (PetscInt i = 0; i < Na; ++i) vf[i] = (float)v[i];
@@ -922,7 +916,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
         kw.assign(K, K + (size_t)r * Na);
         const PetscBLASInt m = (PetscBLASInt)r, n = (PetscBLASInt)Na;
         const PetscScalar  a1 = 1, b0 = 0;
-        BLASgemm_("N", "N", &m, &n, &n, &a1, kw.data(), &m, aVinv_.data(), &n, &b0, K, &m);
+        BLASgemm_("N", "N", &m, &n, &n, &a1, kw.data(), &m, adiag_.VInverse().data(), &n, &b0, K, &m);
       }
       if (cDofs_) {
         cX_.resize(rp);
@@ -1044,7 +1038,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     PetscFunctionReturn(0);
   }
   // (A^(mu) itself is not needed where it is diagonalized once)
-  AffineAt(mu, cols_.data(), Na, AFactored() || !ADiagonalized() ? &A_ : nullptr, &f_);
+  AffineAt(mu, cols_.data(), Na, ADiagonalized() ? nullptr : &A_, &f_);
   // warm start: a combination of the stored reduced solutions of the training parameters (the bracketing
   // interpolation with one parameter, a quadratic or affine least-squares fit with several: warm_start.hpp); the
   // multipliers clipped to the cone
@@ -1072,7 +1066,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
   }
   // A^ diagonalized once (Truncate): d(mu), and the QP in z = diag(d)^{1/2} V^{-1} v, where A^ is the identity and f is
   // diag(d)^{-1/2} V' f; K^ V from the sum, its columns scaled by d^{-1/2}; v = V diag(d)^{-1/2} z
-  const bool diag = !factored && ADiagonalized();
+  const bool diag = ADiagonalized(); // (never with factored: Truncate sets one or the other)
   if (diag) {
     thread_local std::vector<PetscReal> thA;
     par.ThetaA(mu, &thA);
@@ -1100,7 +1094,7 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     const PetscScalar  a1 = 1, b0 = 0;
     BLASgemv_("T", &n, &n, &a1, adiag_.V().data(), &n, f_.data(), &one, &b0, fz_.data(), &one);
     for (PetscInt i = 0; i < Na; ++i) fz_[i] *= sA_[i];
-    qp.SetIdentityA(Na); // (a no-op unless another solve replaced it)
+    qp.SetIdentityA(Na); // (a no-op unless this is the first solve or another solve replaced it)
   }
   loop.Begin(Na);
   vnext.resize(Na);
