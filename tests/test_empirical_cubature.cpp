@@ -12,6 +12,9 @@
 //     decreases to it, and fewer points than Q are used; the incremental Cholesky factor gives the same fit; the hierarchical fit (4 groups, -ecsw_group_points):
 //     every group within its tolerance, the residual against the exact terms over all points <= tol; the Gram
 //     system on candidates (H_CC, b_C, c) against the explicit rows (1b).
+//  4. The elimination after the fit (the default): on 3.'s terms, fewer points than the plain fit, a subset of the longer
+//     fit it thins, weights > 0 and equal to the least-squares weights on the support (Gaussian elimination), the residual
+//     recomputed from the terms <= tol; with no slack (eliminateFrom 1), the plain fit bit for bit or fewer points.
 #include "rbcontact/empirical_cubature.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -472,7 +475,8 @@ int main(int argc, char **argv)
     }
     CubatureGram(P, R, Q, N, Sk, Sg, 1, &H);
     CubatureOptions opt;
-    opt.tol = 1e-9;
+    opt.tol       = 1e-9;
+    opt.eliminate = false; // Lawson-Hanson's own result (the elimination: 4.)
     CubatureResult res;
     PetscCall(EmpiricalCubature(H, Q, opt, &res));
     PetscReal wmin = PETSC_MAX_REAL;
@@ -503,7 +507,8 @@ int main(int argc, char **argv)
       }
     CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
     CubatureOptions opt;
-    opt.tol = 1e-5;
+    opt.tol       = 1e-5;
+    opt.eliminate = false; // Lawson-Hanson's own result (the elimination: 4.)
     CubatureResult res;
     PetscCall(EmpiricalCubature(H, Q, opt, &res));
     std::vector<PetscReal> xi(Q, 0.0);
@@ -570,6 +575,85 @@ int main(int argc, char **argv)
     oh.groupPoints = 80; // one group: the plain fit
     PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &r1, &hi));
     Check(hi.groups == 1 && r1.points == res.points && r1.weights == res.weights, "hierarchical with one group = the plain fit (groups)", (double)hi.groups, 1);
+
+  }
+
+  { // 4. the elimination (-ecsw_eliminate, the default): a fit to eliminateFrom x tol thinned back to tol. Against the plain
+    // fit and independent references: fewer points, a subset of the fit it started from, every weight > 0 and the
+    // least-squares weights on its support (H(S, S) w = (H 1)(S) by Gaussian elimination, not the library's Cholesky),
+    // the residual recomputed from the fitted terms state by state <= tol.
+    const PetscInt         R = 6, N = 4, ms = 20, Q = 240;
+    std::vector<PetscReal> P((size_t)R * Q), Sk((size_t)ms * Q * N), Sg((size_t)ms * Q), H;
+    for (PetscInt r = 0; r < R; ++r)
+      for (PetscInt p = 0; p < Q; ++p) P[(size_t)r * Q + p] = std::exp(-PetscSqr((p / (PetscReal)Q - 0.18 * r - 0.05) / 0.12));
+    for (PetscInt s = 0; s < ms; ++s)
+      for (PetscInt p = 0; p < Q; ++p) {
+        // contact-like: terms that vanish beyond a contact edge moving with the state (kinks the points must resolve)
+        const PetscReal x = p / (PetscReal)Q, edge = 0.3 + 0.03 * s, act = x < edge ? 1.0 : 0.0;
+        for (PetscInt n = 0; n < N; ++n) Sk[((size_t)s * Q + p) * N + n] = act * std::cos((n + 1) * x + 0.1 * s);
+        Sg[(size_t)s * Q + p] = act * (edge - x) * (1 + x);
+      }
+    CubatureGram(P, R, Q, N, Sk, Sg, ms, &H);
+    CubatureOptions opt;
+    opt.tol       = 1e-4;
+    opt.eliminate = false;
+    CubatureResult res;
+    PetscCall(EmpiricalCubature(H, Q, opt, &res));
+    std::vector<PetscReal> b1(Q, 0.0); // H 1
+    for (PetscInt p = 0; p < Q; ++p)
+      for (PetscInt q = 0; q < Q; ++q) b1[p] += H[(size_t)p * Q + q];
+    // max rel diff of r's weights from the least-squares weights on r's support, and the rounding bound 10 cond(H(S, S)) eps
+    auto lsWeightsDiff = [&](const CubatureResult &r, PetscReal *bound) {
+      const PetscInt         k = (PetscInt)r.points.size();
+      std::vector<PetscReal> A((size_t)k * k), rhs(k), ev(k), work(8 * k + 8);
+      for (PetscInt i = 0; i < k; ++i) {
+        rhs[i] = b1[r.points[i]];
+        for (PetscInt j = 0; j < k; ++j) A[(size_t)i * k + j] = H[(size_t)r.points[i] * Q + r.points[j]];
+      }
+      const std::vector<PetscReal> w = SolveDense(k, A, rhs);
+      PetscReal                    d = 0;
+      for (PetscInt i = 0; i < k; ++i) d = std::max(d, std::abs(w[i] - r.weights[i]) / std::abs(w[i]));
+      PetscBLASInt n = (PetscBLASInt)k, lw = (PetscBLASInt)work.size(), info = 0;
+      LAPACKsyev_("N", "L", &n, A.data(), &n, ev.data(), work.data(), &lw, &info);
+      *bound = info == 0 && ev[0] > 0 ? 10 * (ev[k - 1] / ev[0]) * PETSC_MACHINE_EPSILON : 1;
+      return d;
+    };
+    for (const PetscReal from : {0.5, 0.3}) {
+      CubatureOptions oe = opt;
+      oe.eliminate       = true;
+      oe.eliminateFrom   = from;
+      CubatureResult re;
+      PetscCall(EmpiricalCubature(H, Q, oe, &re));
+      // the longer fit it started from: the plain fit to from x tol
+      CubatureOptions of = opt;
+      of.tol             = from * opt.tol;
+      CubatureResult rf;
+      PetscCall(EmpiricalCubature(H, Q, of, &rf));
+      std::vector<PetscReal> xe(Q, 0.0);
+      bool                   pos = !re.points.empty(), subset = true;
+      for (size_t j = 0; j < re.points.size(); ++j) {
+        pos = pos && re.weights[j] > 0;
+        xe[re.points[j]] = re.weights[j];
+        subset = subset && std::find(rf.points.begin(), rf.points.end(), re.points[j]) != rf.points.end();
+      }
+      PetscReal       bound;
+      const PetscReal rece = TermsFitResidual(P, R, Q, N, Sk, Sg, ms, xe), dls = lsWeightsDiff(re, &bound);
+      char            what[160];
+      std::snprintf(what, sizeof what, "elimination from %.1f tol: %zu -> %zu points (eliminated), the plain fit %zu", (double)from, rf.points.size(), re.points.size(), res.points.size());
+      Check(re.eliminated > 0 && re.points.size() < res.points.size() && re.plainPoints == (PetscInt)res.points.size() && re.points.size() + re.eliminated == rf.points.size(), what, (double)re.eliminated, 1);
+      Check(pos && subset, "elimination: every weight > 0, the points a subset of the fit it started from (points)", (double)re.points.size(), (double)rf.points.size());
+      Check(dls <= bound, "elimination: the least-squares weights on the support (Gaussian elimination; max rel diff, bound 10 cond eps)", dls, bound);
+      Check(rece <= opt.tol && std::abs(rece - re.residual) <= 1e-6 * opt.tol + 1e-3 * re.residual && re.history.back() == re.residual,
+            "elimination: residual recomputed from the fitted terms <= tol (recomputed)", rece, opt.tol);
+    }
+    // no slack (the fit stopped at tol, eliminateFrom 1): the plain fit's result unless fewer points reach tol
+    CubatureOptions o1 = opt;
+    o1.eliminate       = true;
+    o1.eliminateFrom   = 1;
+    CubatureResult re1;
+    PetscCall(EmpiricalCubature(H, Q, o1, &re1));
+    const bool same = re1.points == res.points && re1.weights == res.weights && re1.history == res.history && re1.eliminated == 0;
+    Check(same || (re1.points.size() < res.points.size() && re1.residual <= opt.tol), same ? "elimination from tol: nothing removed, the plain fit bit for bit (points)" : "elimination from tol: fewer points within tol (points)", (double)re1.points.size(), (double)res.points.size());
   }
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, failures ? "test_empirical_cubature FAILED (%d failure(s))\n" : "test_empirical_cubature passed\n", failures));
   PetscCall(PetscFinalize());

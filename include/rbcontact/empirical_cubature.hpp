@@ -43,6 +43,10 @@ struct CubatureOptions {
                                  // fit keeps the refactoring (its points and weights as before, bit for bit)
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
+  bool      eliminate = true;  // -ecsw_eliminate: the fit goes on to eliminateFrom x tol, then points are removed one at a
+                               // time while the others, refitted, still reach tol (EliminateCubaturePoints); the plain fit's
+                               // result if that ends with no fewer points (docs/hyper_reduction.md "Points eliminated")
+  PetscReal eliminateFrom = 0.5; // -ecsw_eliminate_from, in (0, 1]
   bool      lambdaForce = true; // -ecsw_fit_lambda_force: with -ecsw_fit lambda, also the multiplier error that the
                                 // forces' error causes through the displacement (CubatureLambdaMetric::forceFactor)
 };
@@ -50,9 +54,12 @@ struct CubatureOptions {
 struct CubatureResult {
   std::vector<PetscInt>  points;   // selected point indices (into 0..Q-1), in the order of selection
   std::vector<PetscReal> weights;  // their weights xi_p > 0
-  std::vector<PetscReal> history;  // relative residual after each added point (history[0] = 1: no point)
+  std::vector<PetscReal> history;  // relative residual after each added point (history[0] = 1: no point; with the elimination
+                                   // it runs on to eliminateFrom x tol, and its last entry is the residual after the elimination)
   PetscReal              residual = 1; // final relative residual ||G (xi - 1)|| / ||G 1||
   PetscInt               iterations = 0; // Lawson-Hanson steps (inner removals included)
+  PetscInt               eliminated = 0;  // points removed after the fit (CubatureOptions::eliminate)
+  PetscInt               plainPoints = 0; // the points of the fit stopped on first reaching tol (without the elimination)
 };
 
 // The fit restricted to candidate points C (a subset of the Q points): the Gram matrix on C only (|C| x |C|) and the
@@ -147,7 +154,17 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
 // before the gradient vanishes -> result returned with its residual (the caller decides).
 // With cand (points nonempty): H is the candidates' Gram matrix, b and c come from cand, the selected points are
 // returned as indices into 0..Q-1.
+// With opt.eliminate, the fit that reached opt.tol is then thinned by EliminateCubaturePoints.
 PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand = nullptr);
+
+// Backward elimination after a fit (the point-removal step of Hernandez et al.'s continuous ECM, CMAME 2024, on the
+// fixed points): S and its weights x (x[p] for p in S; x = H(S, S)^{-1} b(S) > 0, as Lawson-Hanson ends) lose, one at a
+// time, the point whose removal raises the residual least, z_j^2 / (H(S, S)^{-1})_jj, among those after which the others'
+// least-squares weights stay positive and the relative residual stays <= tol; the inverse is updated by rank one. The
+// result is checked on the exact system: the weights solved afresh on the final support must be positive and reach tol,
+// else nothing is removed. H is the Gram matrix on the Q points (row-major), b and c the target (b = (H 1) over every
+// point, c = 1'H1). Returns the number of points removed; S keeps the order of the points that stay.
+PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscReal> &b, PetscReal c, PetscReal tol, std::vector<PetscInt> *S, std::vector<PetscReal> *x, PetscReal *rel);
 // The Gram matrices' Hadamard products are accumulated a block of columns at a time (at most this many columns; 0, the
 // default: n / 8 of n, at least 64; the candidates' states are also gathered up to this many columns, or n^2 / 8 entries, before each
 // product). For tests, which exercise the blocks on small sizes; the result changes by rounding only.

@@ -705,6 +705,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
     c["history"]      = cr.history;
     c["iterations"]   = (long long)cr.iterations;
+    c["eliminated"]   = (long long)cr.eliminated; // points removed after the fit (-ecsw_eliminate)
+    c["M_without_elimination"] = (long long)cr.plainPoints; // the fit stopped on first reaching -ecsw_tol
+    c["eliminate"]    = co.eliminate;
+    c["eliminate_from"] = (double)co.eliminateFrom;
     c["weights"]      = cr.weights;
     c["states"]       = (long long)msAll;
     c["states_distributed"] = distribute; // the states' evaluations split over the ranks (-ecsw_distribute_states)

@@ -38,7 +38,12 @@ PetscErrorCode CubatureOptionsFromOptions(MPI_Comm comm, const char *pre, Cubatu
   flg = opt->shareGroups ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscOptionsBool("-share_groups", "with groups (-group_points): each group fitted by one rank, in turn, its points broadcast (false: every rank fits every group; the same result)", "", flg, &flg, NULL));
   opt->shareGroups = flg;
+  flg = opt->eliminate ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-eliminate", "after the fit, remove points one at a time while the others, refitted, still reach -tol (fewer points online)", "", flg, &flg, NULL));
+  opt->eliminate = flg;
+  PetscCall(PetscOptionsReal("-eliminate_from", "with -eliminate: the fit goes on to this fraction of -tol, then the elimination thins it back to -tol", "", opt->eliminateFrom, &opt->eliminateFrom, NULL));
   PetscOptionsEnd();
+  PetscCheck(opt->eliminateFrom > 0 && opt->eliminateFrom <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%seliminate_from %g must lie in (0, 1]", pre, (double)opt->eliminateFrom);
   PetscCheck(opt->tol > 0 && opt->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%stol %g must lie in (0, 1)", pre, (double)opt->tol);
   PetscCheck(opt->maxPoints >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%smax_points %" PetscInt_FMT " must be >= 1", pre, opt->maxPoints);
   PetscCheck(opt->groupPoints == 0 || opt->groupPoints >= 100, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sgroup_points %" PetscInt_FMT " must be 0 (one group) or >= 100", pre, opt->groupPoints);
@@ -619,7 +624,97 @@ private:
   std::vector<PetscReal> L_;
   PetscReal              dmax_ = 0;
 };
+
+// (z - 1)' H (z - 1) / c for weights z on the support S (zero elsewhere), evaluated as z'H(S, S)z - 2 b(S)'z + c: an error
+// in z enters at second order (the weights' least-squares residual from c - b(S)'z loses it to cancellation)
+PetscReal RelResidual2(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S, const std::vector<PetscReal> &z, const std::vector<PetscReal> &b, PetscReal c)
+{
+  PetscReal xHx = 0, bx = 0;
+  for (size_t i = 0; i < S.size(); ++i) {
+    PetscReal t = 0;
+    for (size_t j = 0; j < S.size(); ++j) t += H[(size_t)S[i] * Q + S[j]] * z[j];
+    xHx += z[i] * t;
+    bx += b[S[i]] * z[i];
+  }
+  return std::max<PetscReal>(xHx - 2 * bx + c, 0) / c;
+}
 } // namespace
+
+PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscReal> &b, PetscReal c, PetscReal tol, std::vector<PetscInt> *S, std::vector<PetscReal> *x, PetscReal *rel)
+{
+  if (S->size() < 2 || !(c > 0)) return 0;
+  std::vector<PetscInt>  cur = *S, S2, order;
+  std::vector<PetscReal> z, z2, G, delta, gj;
+  SupportCholesky        chol, trial;
+  if (!chol.Update(H, Q, cur)) return 0;
+  chol.Solve(b, &z);
+  PetscInt removed = 0, sinceInverse = 0;
+  // G = H(S, S)^{-1} (column-major): the order of the trials. Formed afresh every 64 removals and updated by rank one
+  // in between; its rounding grows with H(S, S)'s condition, which only changes the order: every removal is solved
+  // (Cholesky factor updated by the deletion) and its weights and residual checked exactly.
+  auto inverse = [&]() {
+    const PetscInt k = (PetscInt)cur.size();
+    G.assign((size_t)k * k, 0.0);
+    for (PetscInt j = 0; j < k; ++j)
+      for (PetscInt i = 0; i < k; ++i) G[i + (size_t)k * j] = H[(size_t)cur[i] * Q + cur[j]];
+    PetscBLASInt n = (PetscBLASInt)k, info = 0;
+    LAPACKpotrf_("L", &n, G.data(), &n, &info);
+    if (info == 0) LAPACKpotri_("L", &n, G.data(), &n, &info);
+    for (PetscInt j = 0; j < k; ++j)
+      for (PetscInt i = 0; i < j; ++i) G[i + (size_t)k * j] = G[j + (size_t)k * i];
+    sinceInverse = 0;
+    return info == 0;
+  };
+  if (!inverse()) return 0;
+  for (;;) {
+    const PetscInt k = (PetscInt)cur.size();
+    if (k < 2) break;
+    delta.resize(k); // the least-squares rise without point j: z_j^2 / (H(S, S)^{-1})_jj
+    order.resize(k);
+    for (PetscInt j = 0; j < k; ++j) {
+      delta[j] = z[j] * z[j] / G[j + (size_t)k * j];
+      order[j] = j;
+    }
+    std::sort(order.begin(), order.end(), [&](PetscInt a, PetscInt q) { return delta[a] < delta[q] || (delta[a] == delta[q] && a < q); });
+    PetscInt pick = -1;
+    for (PetscInt t = 0; t < std::min<PetscInt>(k, 8) && pick < 0; ++t) {
+      const PetscInt j = order[t];
+      S2 = cur;
+      S2.erase(S2.begin() + j);
+      trial = chol;
+      if (!trial.Update(H, Q, S2)) continue;
+      trial.Solve(b, &z2);
+      bool pos = true;
+      for (PetscReal v : z2) pos = pos && v > 0;
+      if (pos && RelResidual2(H, Q, S2, z2, b, c) <= tol * tol) pick = j;
+    }
+    if (pick < 0) break;
+    // accepted: the support, its factor and weights; G without row and column pick (rank one, then compacted)
+    cur.swap(S2);
+    std::swap(chol, trial);
+    z.swap(z2);
+    ++removed;
+    if (++sinceInverse >= 64) {
+      if (!inverse()) break;
+      continue;
+    }
+    const PetscInt  j = pick;
+    const PetscReal gjj = G[j + (size_t)k * j];
+    gj.assign(G.begin() + (size_t)k * j, G.begin() + (size_t)k * (j + 1));
+    size_t w = 0;
+    for (PetscInt q = 0; q < k; ++q)
+      if (q != j)
+        for (PetscInt i = 0; i < k; ++i)
+          if (i != j) G[w++] = G[i + (size_t)k * q] - gj[i] * gj[q] / gjj; // in place: w never passes i + k q
+    G.resize(w);
+  }
+  if (!removed) return 0;
+  for (PetscInt p : *S) (*x)[p] = 0;
+  for (size_t i = 0; i < cur.size(); ++i) (*x)[cur[i]] = z[i];
+  *S   = cur;
+  *rel = std::sqrt(RelResidual2(H, Q, cur, z, b, c));
+  return removed;
+}
 
 PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand)
 {
@@ -661,7 +756,15 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
     }
     return std::sqrt(std::max<PetscReal>(xHx - 2 * bx + c, 0) / c);
   };
-  while (rel > opt.tol && (PetscInt)S.size() < opt.maxPoints) {
+  // with opt.eliminate the fit goes on to eliminateFrom x tol, then EliminateCubaturePoints thins it back to tol; the fit
+  // as it stood on first reaching tol (the plain fit's result) is kept, and returned if the elimination does not end
+  // with fewer points
+  const PetscReal        tolFit = opt.eliminate ? opt.tol * opt.eliminateFrom : opt.tol;
+  std::vector<PetscInt>  plainS;
+  std::vector<PetscReal> plainX;
+  PetscReal              plainRel = -1;
+  size_t                 plainHistory = 0;
+  while (rel > tolFit && (PetscInt)S.size() < opt.maxPoints) {
     PetscInt  j = -1;
     PetscReal gmax = gtiny;
     for (PetscInt p = 0; p < Q; ++p)
@@ -718,6 +821,26 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
     rel = residual();
     res->history.push_back(rel);
     if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature M = %3zu  rel residual = %.3e\n", S.size(), (double)rel));
+    if (opt.eliminate && plainRel < 0 && rel <= opt.tol) {
+      plainS   = S;
+      plainRel = rel;
+      plainHistory = res->history.size();
+      for (PetscInt p : S) plainX.push_back(x[p]);
+    }
+  }
+  res->plainPoints = (PetscInt)(plainRel < 0 ? S.size() : plainS.size());
+  if (plainRel >= 0) {
+    res->eliminated = EliminateCubaturePoints(H, Q, b, c, opt.tol, &S, &x, &rel);
+    if (S.size() >= plainS.size()) { // no fewer points than the plain fit: its result
+      std::fill(x.begin(), x.end(), 0.0);
+      for (size_t i = 0; i < plainS.size(); ++i) x[plainS[i]] = plainX[i];
+      S   = plainS;
+      rel = plainRel;
+      res->history.resize(plainHistory);
+      res->eliminated = 0;
+    } else
+      res->history.push_back(rel); // the last entry: after the elimination
+    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e\n", res->eliminated ? S.size() + res->eliminated : plainS.size(), (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel));
   }
   res->residual = rel;
   res->points   = S;
@@ -780,6 +903,7 @@ PetscErrorCode HierarchicalCubature(MPI_Comm comm, PetscInt Q, const CubatureOpt
   og.monitor         = false;
   og.groupPoints     = 0;
   og.incremental     = true; // thousands of points per group: O(k^2) steps
+  og.eliminate       = false; // the union's fit below thins the result
   PetscCheck(og.tol > 0, comm, PETSC_ERR_PLIB, "HierarchicalCubature: group tolerance %g", (double)og.tol);
   // the groups in batches of `share` (the ranks, or 1): every rank forms each group's Gram matrix when gram is
   // collective (else only its own), group b + j is fitted by rank j, which keeps that matrix; then the batch's points
