@@ -625,18 +625,36 @@ private:
   PetscReal              dmax_ = 0;
 };
 
-// (z - 1)' H (z - 1) / c for weights z on the support S (zero elsewhere), evaluated as z'H(S, S)z - 2 b(S)'z + c: an error
-// in z enters at second order (the weights' least-squares residual from c - b(S)'z loses it to cancellation)
-PetscReal RelResidual2(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S, const std::vector<PetscReal> &z, const std::vector<PetscReal> &b, PetscReal c)
+// (z - 1)' H (z - 1) / c for weights z on a support whose Gram matrix Hs = H(S, S) (k x k, column-major) and target bs =
+// b(S) are given, leaving out its place `skip` (-1: none; z then has k - 1 entries), evaluated as z'Hs z - 2 bs'z + c: an
+// error in z enters at second order (the least-squares residual's form c - bs'z loses it to cancellation)
+PetscReal RelResidual2(PetscInt k, const std::vector<PetscReal> &Hs, const std::vector<PetscReal> &bs, PetscInt skip, const std::vector<PetscReal> &z, PetscReal c)
 {
   PetscReal xHx = 0, bx = 0;
-  for (size_t i = 0; i < S.size(); ++i) {
-    PetscReal t = 0;
-    for (size_t j = 0; j < S.size(); ++j) t += H[(size_t)S[i] * Q + S[j]] * z[j];
-    xHx += z[i] * t;
-    bx += b[S[i]] * z[i];
+  for (PetscInt j = 0, jz = 0; j < k; ++j) {
+    if (j == skip) continue;
+    const PetscReal *col = &Hs[(size_t)k * j];
+    PetscReal        t   = 0;
+    for (PetscInt i = 0, iz = 0; i < k; ++i) {
+      if (i == skip) continue;
+      t += col[i] * z[iz++];
+    }
+    xHx += z[jz] * t;
+    bx += bs[j] * z[jz];
+    ++jz;
   }
   return std::max<PetscReal>(xHx - 2 * bx + c, 0) / c;
+}
+
+// a k x k column-major matrix without row and column j, in place (k - 1 x k - 1)
+void DropRowColumn(PetscInt k, PetscInt j, std::vector<PetscReal> *A)
+{
+  size_t w = 0;
+  for (PetscInt q = 0; q < k; ++q)
+    if (q != j)
+      for (PetscInt i = 0; i < k; ++i)
+        if (i != j) (*A)[w++] = (*A)[i + (size_t)k * q]; // w never passes i + k q: nothing unread is overwritten
+  A->resize(w);
 }
 } // namespace
 
@@ -644,19 +662,23 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
 {
   if (S->size() < 2 || !(c > 0)) return 0;
   std::vector<PetscInt>  cur = *S, S2, order;
-  std::vector<PetscReal> z, z2, G, delta, gj;
+  std::vector<PetscReal> Hs, bs, z, z2, G, delta, gj;
   SupportCholesky        chol, trial;
   if (!chol.Update(H, Q, cur)) return 0;
   chol.Solve(b, &z);
-  PetscInt removed = 0, sinceInverse = 0;
-  // G = H(S, S)^{-1} (column-major): the order of the trials. Formed afresh every 64 removals and updated by rank one
-  // in between; its rounding grows with H(S, S)'s condition, which only changes the order: every removal is solved
-  // (Cholesky factor updated by the deletion) and its weights and residual checked exactly.
+  PetscInt k = (PetscInt)cur.size();
+  Hs.resize((size_t)k * k); // H(S, S) and b(S), kept compact as points leave
+  for (PetscInt j = 0; j < k; ++j)
+    for (PetscInt i = 0; i < k; ++i) Hs[i + (size_t)k * j] = H[(size_t)cur[i] * Q + cur[j]];
+  for (PetscInt i = 0; i < k; ++i) bs.push_back(b[cur[i]]);
+  const PetscReal budget = tol * tol;
+  PetscReal       obj    = RelResidual2(k, Hs, bs, -1, z, c);
+  PetscInt        removed = 0, sinceInverse = 0;
+  // G = H(S, S)^{-1}: the predictions that order and screen the trials. Formed afresh after every max(64, k / 8)
+  // removals and updated by rank one in between; its rounding grows with H(S, S)'s condition, which only changes the
+  // predictions: every removal taken is solved (the Cholesky factor updated by the deletion) and checked exactly.
   auto inverse = [&]() {
-    const PetscInt k = (PetscInt)cur.size();
-    G.assign((size_t)k * k, 0.0);
-    for (PetscInt j = 0; j < k; ++j)
-      for (PetscInt i = 0; i < k; ++i) G[i + (size_t)k * j] = H[(size_t)cur[i] * Q + cur[j]];
+    G = Hs;
     PetscBLASInt n = (PetscBLASInt)k, info = 0;
     LAPACKpotrf_("L", &n, G.data(), &n, &info);
     if (info == 0) LAPACKpotri_("L", &n, G.data(), &n, &info);
@@ -666,19 +688,24 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
     return info == 0;
   };
   if (!inverse()) return 0;
-  for (;;) {
-    const PetscInt k = (PetscInt)cur.size();
-    if (k < 2) break;
-    delta.resize(k); // the least-squares rise without point j: z_j^2 / (H(S, S)^{-1})_jj
-    order.resize(k);
+  while (k >= 2) {
+    // predicted: the squared residual's rise without point j, z_j^2 / G_jj, and the others' weights z - (z_j / G_jj) G(:, j)
+    delta.resize(k);
+    order.clear();
     for (PetscInt j = 0; j < k; ++j) {
-      delta[j] = z[j] * z[j] / G[j + (size_t)k * j];
-      order[j] = j;
+      delta[j] = z[j] * z[j] / G[j + (size_t)k * j] / c;
+      if (obj + delta[j] <= budget) order.push_back(j);
     }
     std::sort(order.begin(), order.end(), [&](PetscInt a, PetscInt q) { return delta[a] < delta[q] || (delta[a] == delta[q] && a < q); });
-    PetscInt pick = -1;
-    for (PetscInt t = 0; t < std::min<PetscInt>(k, 8) && pick < 0; ++t) {
-      const PetscInt j = order[t];
+    PetscInt pick = -1, exact = 0;
+    for (size_t t = 0; t < order.size() && pick < 0 && exact < 8; ++t) {
+      const PetscInt  j  = order[t];
+      const PetscReal f  = z[j] / G[j + (size_t)k * j];
+      bool            ok = true;
+      for (PetscInt i = 0; i < k && ok; ++i)
+        if (i != j) ok = z[i] - f * G[i + (size_t)k * j] > 0;
+      if (!ok) continue; // predicted to make a weight negative (in exact arithmetic never the cheapest: docs)
+      ++exact;
       S2 = cur;
       S2.erase(S2.begin() + j);
       trial = chol;
@@ -686,33 +713,39 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
       trial.Solve(b, &z2);
       bool pos = true;
       for (PetscReal v : z2) pos = pos && v > 0;
-      if (pos && RelResidual2(H, Q, S2, z2, b, c) <= tol * tol) pick = j;
+      if (!pos) continue;
+      const PetscReal obj2 = RelResidual2(k, Hs, bs, j, z2, c);
+      if (obj2 <= budget) {
+        pick = j;
+        obj  = obj2;
+      }
     }
     if (pick < 0) break;
-    // accepted: the support, its factor and weights; G without row and column pick (rank one, then compacted)
+    // accepted: the support, its factor, weights, H(S, S), b(S); G without row and column pick (rank one, then compacted)
+    const PetscInt j = pick;
     cur.swap(S2);
     std::swap(chol, trial);
     z.swap(z2);
+    DropRowColumn(k, j, &Hs);
+    bs.erase(bs.begin() + j);
     ++removed;
-    if (++sinceInverse >= 64) {
+    if (++sinceInverse >= std::max<PetscInt>(64, k / 8)) {
+      --k;
       if (!inverse()) break;
       continue;
     }
-    const PetscInt  j = pick;
     const PetscReal gjj = G[j + (size_t)k * j];
     gj.assign(G.begin() + (size_t)k * j, G.begin() + (size_t)k * (j + 1));
-    size_t w = 0;
     for (PetscInt q = 0; q < k; ++q)
-      if (q != j)
-        for (PetscInt i = 0; i < k; ++i)
-          if (i != j) G[w++] = G[i + (size_t)k * q] - gj[i] * gj[q] / gjj; // in place: w never passes i + k q
-    G.resize(w);
+      for (PetscInt i = 0; i < k; ++i) G[i + (size_t)k * q] -= gj[i] * gj[q] / gjj;
+    DropRowColumn(k, j, &G);
+    --k;
   }
   if (!removed) return 0;
   for (PetscInt p : *S) (*x)[p] = 0;
   for (size_t i = 0; i < cur.size(); ++i) (*x)[cur[i]] = z[i];
   *S   = cur;
-  *rel = std::sqrt(RelResidual2(H, Q, cur, z, b, c));
+  *rel = std::sqrt(obj);
   return removed;
 }
 
