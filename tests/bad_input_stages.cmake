@@ -13,6 +13,7 @@ rbc_bad_stage(kacanov_not_converged "Kacanov iterations did not converge in 2 it
 rbc_bad_stage(offline_stop "-offline_stop eim: unknown step" offline -options_file runs/ring_on_block.opts -offline_stop eim -snapshots /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_fit "Unknown option action2 for -ecsw_fit. Available options: terms action" offline -options_file runs/ring_on_block.opts -ecsw_fit action2 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_group_points "-ecsw_group_points 50 must be 0 .one group. or >= 100" offline -options_file runs/ring_on_block.opts -ecsw_group_points 50 -rom /tmp/rbc_never.h5)
+rbc_bad_stage(ecsw_eliminate_from "-ecsw_eliminate_from 1[.]5 must lie in [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -ecsw_eliminate_from 1.5 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_group_max_points "empirical cubature: group 0 of 3 reaches .* > its tolerance .* with 5 points .-ecsw_max_points 5; larger -ecsw_group_points" offline -options_file runs/ring_on_block.opts -ecsw_group_points 100 -ecsw_max_points 5 -snapshots_restart false -snapshots /tmp/rbc_group_max_points.snapshots.h5 -rom /tmp/rbc_group_max_points.h5)
 rbc_bad_stage(supremizers_infsup "-pod_supremizers_infsup 1.5 out of range [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -pod_supremizers_infsup 1.5 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_tol "-greedy_tol 0 must be > 0" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_tol 0 -rom /tmp/rbc_never.h5)

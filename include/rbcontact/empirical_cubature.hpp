@@ -158,12 +158,12 @@ void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q
 PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Q, const CubatureOptions &opt, CubatureResult *res, const CubatureCandidates *cand = nullptr);
 
 // Backward elimination after a fit (the point-removal step of Hernandez et al.'s continuous ECM, CMAME 2024, on the
-// fixed points): S and its weights x (x[p] for p in S; x = H(S, S)^{-1} b(S) > 0, as Lawson-Hanson ends) lose, one at a
-// time, the point whose removal raises the residual least, z_j^2 / (H(S, S)^{-1})_jj, among those after which the others'
-// least-squares weights stay positive and the relative residual stays <= tol; the inverse is updated by rank one. The
-// result is checked on the exact system: the weights solved afresh on the final support must be positive and reach tol,
-// else nothing is removed. H is the Gram matrix on the Q points (row-major), b and c the target (b = (H 1) over every
-// point, c = 1'H1). Returns the number of points removed; S keeps the order of the points that stay.
+// fixed points): the support S (its least-squares weights positive, as Lawson-Hanson ends) loses, one at a time, the
+// point whose removal raises the residual least, z_j^2 / (H(S, S)^{-1})_jj, among those after which the others'
+// least-squares weights stay positive and the relative residual stays <= tol. The inverse (updated by rank one) only
+// predicts; each removal is solved with the Cholesky factor updated by the deletion and checked exactly. H is the Gram
+// matrix on the Q points (row-major), b and c the target (b = (H 1) over every point, c = 1'H1); x (Q entries) gets
+// the new weights, rel the relative residual. Returns the number of points removed; S keeps the order of those that stay.
 PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscReal> &b, PetscReal c, PetscReal tol, std::vector<PetscInt> *S, std::vector<PetscReal> *x, PetscReal *rel);
 // The Gram matrices' Hadamard products are accumulated a block of columns at a time (at most this many columns; 0, the
 // default: n / 8 of n, at least 64; the candidates' states are also gathered up to this many columns, or n^2 / 8 entries, before each

@@ -863,7 +863,8 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   }
   res->plainPoints = (PetscInt)(plainRel < 0 ? S.size() : plainS.size());
   if (plainRel >= 0) {
-    res->eliminated = EliminateCubaturePoints(H, Q, b, c, opt.tol, &S, &x, &rel);
+    const size_t longer = S.size();
+    res->eliminated     = EliminateCubaturePoints(H, Q, b, c, opt.tol, &S, &x, &rel);
     if (S.size() >= plainS.size()) { // no fewer points than the plain fit: its result
       std::fill(x.begin(), x.end(), 0.0);
       for (size_t i = 0; i < plainS.size(); ++i) x[plainS[i]] = plainX[i];
@@ -873,7 +874,7 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
       res->eliminated = 0;
     } else
       res->history.push_back(rel); // the last entry: after the elimination
-    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e\n", res->eliminated ? S.size() + res->eliminated : plainS.size(), (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel));
+    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e\n", longer, (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel));
   }
   res->residual = rel;
   res->points   = S;
