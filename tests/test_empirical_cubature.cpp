@@ -14,7 +14,8 @@
 //     system on candidates (H_CC, b_C, c) against the explicit rows (1b).
 //  4. The elimination after the fit (the default): on 3.'s terms, fewer points than the plain fit, a subset of the longer
 //     fit it thins, weights > 0 and equal to the least-squares weights on the support (Gaussian elimination), the residual
-//     recomputed from the terms <= tol; with no slack (eliminateFrom 1), the plain fit bit for bit or fewer points.
+//     recomputed from the terms <= tol; with no slack (eliminateFrom 1), the plain fit bit for bit or fewer points; the
+//     same with the inverse formed afresh every 2 removals, and on the hierarchical fit's union (4 groups).
 #include "rbcontact/empirical_cubature.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
@@ -654,6 +655,37 @@ int main(int argc, char **argv)
     PetscCall(EmpiricalCubature(H, Q, o1, &re1));
     const bool same = re1.points == res.points && re1.weights == res.weights && re1.history == res.history && re1.eliminated == 0;
     Check(same || (re1.points.size() < res.points.size() && re1.residual <= opt.tol), same ? "elimination from tol: nothing removed, the plain fit bit for bit (points)" : "elimination from tol: fewer points within tol (points)", (double)re1.points.size(), (double)res.points.size());
+
+    // the inverse formed afresh after every 2 removals (the refresh path; by default after max(64, k / 8)): the same checks
+    auto valid = [&](const CubatureResult &r, const char *what, PetscInt plain) {
+      std::vector<PetscReal> xr(Q, 0.0);
+      bool                   pos = !r.points.empty();
+      for (size_t j = 0; j < r.points.size(); ++j) {
+        pos = pos && r.weights[j] > 0 && r.points[j] >= 0 && r.points[j] < Q;
+        xr[r.points[j]] = r.weights[j];
+      }
+      const PetscReal rr = TermsFitResidual(P, R, Q, N, Sk, Sg, ms, xr);
+      Check(pos && r.eliminated > 0 && (PetscInt)r.points.size() < plain && rr <= opt.tol && r.history.back() == r.residual, what, rr, opt.tol);
+    };
+    SetCubatureEliminationRefresh(2);
+    CubatureOptions o3 = opt;
+    o3.eliminate       = true;
+    o3.eliminateFrom   = 0.3;
+    CubatureResult rr2;
+    PetscCall(EmpiricalCubature(H, Q, o3, &rr2));
+    SetCubatureEliminationRefresh(0);
+    valid(rr2, "elimination, inverse afresh every 2 removals: weights > 0, fewer points than the plain fit, residual recomputed <= tol", (PetscInt)res.points.size());
+
+    // the hierarchical fit (4 groups of 60 points): the union's fit thinned (on candidates: indices mapped back to all points)
+    CubatureOptions oh = opt;
+    oh.groupPoints     = 60;
+    CubatureResult    rh, rhe;
+    CubatureHierarchy hi;
+    auto              gram = [&](CubatureCandidates *cc, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, cc); };
+    PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, gram, &rh, &hi));
+    oh.eliminate = true;
+    PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, gram, &rhe, &hi));
+    valid(rhe, "hierarchical (4 groups of 60) with the elimination: weights > 0, fewer points than without, residual over all points <= tol", (PetscInt)rh.points.size());
   }
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, failures ? "test_empirical_cubature FAILED (%d failure(s))\n" : "test_empirical_cubature passed\n", failures));
   PetscCall(PetscFinalize());

@@ -43,7 +43,8 @@ struct CubatureOptions {
                                  // fit keeps the refactoring (its points and weights as before, bit for bit)
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
-  bool      eliminate = true;  // -ecsw_eliminate: the fit goes on to eliminateFrom x tol, then points are removed one at a
+  bool      eliminate = true;  // -ecsw_eliminate: the fit goes on to eliminateFrom x tol (at most twice the points that first
+                               // reached tol), then points are removed one at a
                                // time while the others, refitted, still reach tol (EliminateCubaturePoints); the plain fit's
                                // result if that ends with no fewer points (docs/hyper_reduction.md "Points eliminated")
   PetscReal eliminateFrom = 0.5; // -ecsw_eliminate_from, in (0, 1]
@@ -55,7 +56,8 @@ struct CubatureResult {
   std::vector<PetscInt>  points;   // selected point indices (into 0..Q-1), in the order of selection
   std::vector<PetscReal> weights;  // their weights xi_p > 0
   std::vector<PetscReal> history;  // relative residual after each added point (history[0] = 1: no point; with the elimination
-                                   // it runs on to eliminateFrom x tol, and its last entry is the residual after the elimination)
+                                   // it runs on to eliminateFrom x tol, and its last entry is the residual after the elimination;
+                                   // when the plain fit's result is returned, its history)
   PetscReal              residual = 1; // final relative residual ||G (xi - 1)|| / ||G 1||
   PetscInt               iterations = 0; // Lawson-Hanson steps (inner removals included)
   PetscInt               eliminated = 0;  // points removed after the fit (CubatureOptions::eliminate)
@@ -169,6 +171,9 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
 // default: n / 8 of n, at least 64; the candidates' states are also gathered up to this many columns, or n^2 / 8 entries, before each
 // product). For tests, which exercise the blocks on small sizes; the result changes by rounding only.
 void SetCubatureGramColumnBlock(PetscInt columns);
+// The elimination's inverse formed afresh after this many removals (0, the default: max(64, k / 8) of k points). For
+// tests, which reach the refresh on small sizes; the result changes only where the predictions order the trials differently.
+void SetCubatureEliminationRefresh(PetscInt removals);
 
 // The Gram system of the fit on candidates (nullptr: every point, H Q x Q): CubatureGram or CubatureActionGram bound to
 // their data.

@@ -317,6 +317,9 @@ void ResetGram(PetscInt Q, std::vector<PetscReal> *H, CubatureCandidates *cand)
 
 void SetCubatureGramColumnBlock(PetscInt columns) { gramColumnBlock = std::max<PetscInt>(columns, 0); }
 
+static PetscInt eliminationRefresh = 0; // SetCubatureEliminationRefresh (tests); 0: max(64, k / 8)
+void SetCubatureEliminationRefresh(PetscInt removals) { eliminationRefresh = std::max<PetscInt>(removals, 0); }
+
 void CubatureStateErrors(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q, PetscInt N, const KappaBlocks &Sk, const std::vector<PetscReal> &Sg, PetscInt ms, const CubatureResult &res, std::vector<PetscReal> *errK, std::vector<PetscReal> *errG)
 {
   std::vector<PetscReal> Ke, ge, Kc, gc;
@@ -675,8 +678,9 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
   PetscReal       obj    = RelResidual2(k, Hs, bs, -1, z, c);
   PetscInt        removed = 0, sinceInverse = 0;
   // G = H(S, S)^{-1}: the predictions that order and screen the trials. Formed afresh after every max(64, k / 8)
-  // removals and updated by rank one in between; its rounding grows with H(S, S)'s condition, which only changes the
-  // predictions: every removal taken is solved (the Cholesky factor updated by the deletion) and checked exactly.
+  // removals, and before stopping when an updated one found no removal; updated by rank one in between. Its rounding
+  // grows with H(S, S)'s condition, which only changes the predictions: every removal taken is solved (the Cholesky
+  // factor updated by the deletion) and checked exactly.
   auto inverse = [&]() {
     G = Hs;
     PetscBLASInt n = (PetscBLASInt)k, info = 0;
@@ -720,6 +724,10 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
         obj  = obj2;
       }
     }
+    if (pick < 0 && sinceInverse > 0) { // the updated inverse's predictions may have screened out a feasible removal:
+      if (!inverse()) break;             // once more with a fresh one before stopping
+      continue;
+    }
     if (pick < 0) break;
     // accepted: the support, its factor, weights, H(S, S), b(S); G without row and column pick (rank one, then compacted)
     const PetscInt j = pick;
@@ -729,7 +737,7 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
     DropRowColumn(k, j, &Hs);
     bs.erase(bs.begin() + j);
     ++removed;
-    if (++sinceInverse >= std::max<PetscInt>(64, k / 8)) {
+    if (++sinceInverse >= (eliminationRefresh > 0 ? eliminationRefresh : std::max<PetscInt>(64, k / 8))) {
       --k;
       if (!inverse()) break;
       continue;
@@ -797,7 +805,9 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   std::vector<PetscReal> plainX;
   PetscReal              plainRel = -1;
   size_t                 plainHistory = 0;
-  while (rel > tolFit && (PetscInt)S.size() < opt.maxPoints) {
+  // (the longer fit stops at twice the plain fit's points: in the hierarchical fit's union f x tol may be out of reach,
+  // and Lawson-Hanson would otherwise run on to the gradient's end or maxPoints)
+  while (rel > tolFit && (PetscInt)S.size() < opt.maxPoints && !(plainRel >= 0 && S.size() >= 2 * plainS.size())) {
     PetscInt  j = -1;
     PetscReal gmax = gtiny;
     for (PetscInt p = 0; p < Q; ++p)
@@ -872,7 +882,7 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
       rel = plainRel;
       res->history.resize(plainHistory);
       res->eliminated = 0;
-    } else
+    } else if (res->eliminated > 0)
       res->history.push_back(rel); // the last entry: after the elimination
     if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e\n", longer, (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel));
   }
