@@ -12,7 +12,7 @@
 //     decreases to it, and fewer points than Q are used; the incremental Cholesky factor gives the same fit; the hierarchical fit (4 groups, -ecsw_group_points):
 //     every group within its tolerance, the residual against the exact terms over all points <= tol; the Gram
 //     system on candidates (H_CC, b_C, c) against the explicit rows (1b).
-//  4. The elimination after the fit (the default): on 3.'s terms, fewer points than the plain fit, a subset of the longer
+//  4. The elimination after the fit (the default): on contact-like terms (vanishing beyond a moving edge), fewer points than the plain fit, a subset of the longer
 //     fit it thins, weights > 0 and equal to the least-squares weights on the support (Gaussian elimination), the residual
 //     recomputed from the terms <= tol; with no slack (eliminateFrom 1), the plain fit bit for bit or fewer points; the
 //     same with the inverse formed afresh every 2 removals, and on the hierarchical fit's union (4 groups).
@@ -576,7 +576,6 @@ int main(int argc, char **argv)
     oh.groupPoints = 80; // one group: the plain fit
     PetscCall(HierarchicalCubature(PETSC_COMM_SELF, Q, oh, [&](CubatureCandidates *c, std::vector<PetscReal> *Hc) { CubatureGram(P, R, Q, N, Sk, Sg, ms, Hc, c); }, &r1, &hi));
     Check(hi.groups == 1 && r1.points == res.points && r1.weights == res.weights, "hierarchical with one group = the plain fit (groups)", (double)hi.groups, 1);
-
   }
 
   { // 4. the elimination (-ecsw_eliminate, the default): a fit to eliminateFrom x tol thinned back to tol. Against the plain
