@@ -514,13 +514,20 @@ void CubatureActionGram(const std::vector<PetscReal> &P, PetscInt R, PetscInt Q,
 
 namespace {
 // Cholesky solve of H(S, S) z = b(S); false if H(S, S) is not (numerically) positive definite.
+// H(S, S) (k x k, column-major) gathered from H (Q x Q, row-major)
+void GatherSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S, std::vector<PetscReal> *A)
+{
+  const PetscInt k = (PetscInt)S.size();
+  A->resize((size_t)k * k);
+  for (PetscInt j = 0; j < k; ++j)
+    for (PetscInt i = 0; i < k; ++i) (*A)[i + (size_t)k * j] = H[(size_t)S[i] * Q + S[j]];
+}
 bool SolveOnSupport(const std::vector<PetscReal> &H, PetscInt Q, const std::vector<PetscInt> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *z)
 {
   const PetscInt         k = (PetscInt)S.size();
-  std::vector<PetscReal> A((size_t)k * k);
+  std::vector<PetscReal> A;
   PetscReal              dmax = 0;
-  for (PetscInt j = 0; j < k; ++j)
-    for (PetscInt i = 0; i < k; ++i) A[i + (size_t)k * j] = H[(size_t)S[i] * Q + S[j]];
+  GatherSupport(H, Q, S, &A);
   for (PetscInt i = 0; i < k; ++i) dmax = std::max(dmax, A[i + (size_t)k * i]);
   z->resize(k);
   for (PetscInt i = 0; i < k; ++i) (*z)[i] = b[S[i]];
@@ -670,9 +677,7 @@ PetscInt EliminateCubaturePoints(const std::vector<PetscReal> &H, PetscInt Q, co
   if (!chol.Update(H, Q, cur)) return 0;
   chol.Solve(b, &z);
   PetscInt k = (PetscInt)cur.size();
-  Hs.resize((size_t)k * k); // H(S, S) and b(S), kept compact as points leave
-  for (PetscInt j = 0; j < k; ++j)
-    for (PetscInt i = 0; i < k; ++i) Hs[i + (size_t)k * j] = H[(size_t)cur[i] * Q + cur[j]];
+  GatherSupport(H, Q, cur, &Hs); // H(S, S) and b(S), kept compact as points leave
   for (PetscInt i = 0; i < k; ++i) bs.push_back(b[cur[i]]);
   const PetscReal budget = tol * tol;
   PetscReal       obj    = RelResidual2(k, Hs, bs, -1, z, c);
