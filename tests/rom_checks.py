@@ -109,6 +109,11 @@ def pipeline(args):
     check(min(c["weights"]) > 0, "cubature weights > 0 (min %.3e)" % min(c["weights"]))
     check(c["residual"] <= c["tol"] and len(eK) == c["states"], "cubature residual %.2e <= tol %.0e on %d training states" % (c["residual"], c["tol"], c["states"]))
     check(c["fit"] == "action", "the scene's -ecsw_fit action is the fit used")
+    # the elimination (the default): fewer points than the fit stopped at tol, taken from the longer fit; its phases timed
+    ft = c["fit_time_s"]
+    check(c["eliminate"] and c["M"] < c["M_without_elimination"] < c["M"] + c["eliminated"] and ft["fit"] > 0 and ft["longer_fit"] > 0 and ft["eliminate"] > 0,
+          "cubature thinned: %d points, %d without the elimination, %d eliminated from the longer fit; fit %.3f s, longer fit %.3f s, elimination %.3f s"
+          % (c["M"], c["M_without_elimination"], c["eliminated"], ft["fit"], ft["longer_fit"], ft["eliminate"]))
     # the supremizer enrichment (default -pod_supremizers_infsup 1): every compressed direction kept, the
     # inf-sup constant over the training snapshots positive and growing with the kept directions
     se = off["pod"]["supremizer_enrichment"]

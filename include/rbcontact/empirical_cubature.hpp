@@ -40,7 +40,8 @@ struct CubatureOptions {
                                 // group (the same points and weights, bit for bit; for the test that says so)
   bool      incremental = false; // the Cholesky factor of H(S, S) updated as points enter (O(k^2) a step) instead of
                                  // refactored (O(k^3)); the hierarchical fit's groups and union use it, the one-Gram
-                                 // fit keeps the refactoring (its points and weights as before, bit for bit)
+                                 // fit keeps the refactoring up to tol (its points and weights as before, bit for bit)
+                                 // and updates the factor only where it goes on for the elimination
   bool      fitForce  = false; // -ecsw_fit_force: the action fit also fits the resultant contact force (online output);
                                // off by default: a third term changes what a given -ecsw_tol means (docs/hyper_reduction.md)
   bool      eliminate = true;  // -ecsw_eliminate: the fit goes on to eliminateFrom x tol (at most twice the points that first
@@ -62,6 +63,8 @@ struct CubatureResult {
   PetscInt               iterations = 0; // Lawson-Hanson steps (inner removals included)
   PetscInt               eliminated = 0;  // points removed after the fit (CubatureOptions::eliminate)
   PetscInt               plainPoints = 0; // the points of the fit stopped on first reaching tol (without the elimination)
+  PetscLogDouble         timeFit = 0, timeLonger = 0, timeEliminate = 0; // seconds: the fit to tol, its continuation to
+                                                                         // eliminateFrom x tol, the elimination
 };
 
 // The fit restricted to candidate points C (a subset of the Q points): the Gram matrix on C only (|C| x |C|) and the

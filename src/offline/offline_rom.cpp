@@ -709,6 +709,10 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     c["M_without_elimination"] = (long long)cr.plainPoints; // the fit stopped on first reaching -ecsw_tol
     c["eliminate"]    = co.eliminate;
     c["eliminate_from"] = (double)co.eliminateFrom;
+    JsonValue &ft = c["fit_time_s"]; // the final fit's seconds (the union's in the hierarchical fit): to tol, on to
+    ft["fit"]        = (double)cr.timeFit; // eliminate_from x tol, the elimination
+    ft["longer_fit"] = (double)cr.timeLonger;
+    ft["eliminate"]  = (double)cr.timeEliminate;
     c["weights"]      = cr.weights;
     c["states"]       = (long long)msAll;
     c["states_distributed"] = distribute; // the states' evaluations split over the ranks (-ecsw_distribute_states)

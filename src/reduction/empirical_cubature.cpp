@@ -810,6 +810,8 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
   std::vector<PetscReal> plainX;
   PetscReal              plainRel = -1;
   size_t                 plainHistory = 0;
+  PetscLogDouble         t0, tPlain = 0, t1, t2;
+  PetscCall(PetscTime(&t0));
   // (the longer fit stops at twice the plain fit's points: in the hierarchical fit's union f x tol may be out of reach,
   // and Lawson-Hanson would otherwise run on to the gradient's end or maxPoints)
   while (rel > tolFit && (PetscInt)S.size() < opt.maxPoints && !(plainRel >= 0 && S.size() >= 2 * plainS.size())) {
@@ -825,8 +827,11 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
     in[j] = 1;
     for (;;) {
       ++res->iterations;
-      const bool ok = opt.incremental ? chol.Update(H, Q, S) : SolveOnSupport(H, Q, S, b, &z);
-      if (ok && opt.incremental) chol.Solve(b, &z);
+      // past the plain fit's result (recorded below) the factor is updated, not refactored: the longer fit only feeds
+      // the elimination, which solves every removal exactly, and the plain fit's points and weights stay as before
+      const bool inc = opt.incremental || plainRel >= 0;
+      const bool ok  = inc ? chol.Update(H, Q, S) : SolveOnSupport(H, Q, S, b, &z);
+      if (ok && inc) chol.Solve(b, &z);
       if (!ok) { // j adds nothing independent: drop it for good
         S.erase(std::find(S.begin(), S.end(), j));
         in[j] = 0;
@@ -874,12 +879,18 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
       plainRel = rel;
       plainHistory = res->history.size();
       for (PetscInt p : S) plainX.push_back(x[p]);
+      PetscCall(PetscTime(&tPlain));
     }
   }
+  PetscCall(PetscTime(&t1));
+  res->timeFit     = (plainRel >= 0 ? tPlain : t1) - t0;
+  res->timeLonger  = plainRel >= 0 ? t1 - tPlain : 0;
   res->plainPoints = (PetscInt)(plainRel < 0 ? S.size() : plainS.size());
   if (plainRel >= 0) {
     const size_t longer = S.size();
     res->eliminated     = EliminateCubaturePoints(H, Q, b, c, opt.tol, &S, &x, &rel);
+    PetscCall(PetscTime(&t2));
+    res->timeEliminate = t2 - t1;
     if (S.size() >= plainS.size()) { // no fewer points than the plain fit: its result
       std::fill(x.begin(), x.end(), 0.0);
       for (size_t i = 0; i < plainS.size(); ++i) x[plainS[i]] = plainX[i];
@@ -889,7 +900,7 @@ PetscErrorCode EmpiricalCubature(const std::vector<PetscReal> &H, PetscInt Qall,
       res->eliminated = 0;
     } else if (res->eliminated > 0)
       res->history.push_back(rel); // the last entry: after the elimination
-    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e\n", longer, (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel));
+    if (opt.monitor) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  cubature: %zu points at %g x tol, %" PetscInt_FMT " eliminated: M = %zu (the fit stopped at tol: %" PetscInt_FMT "), rel residual = %.3e; %.2f s fit, %.2f s longer fit, %.2f s elimination\n", longer, (double)opt.eliminateFrom, res->eliminated, S.size(), res->plainPoints, (double)rel, res->timeFit, res->timeLonger, res->timeEliminate));
   }
   res->residual = rel;
   res->points   = S;
