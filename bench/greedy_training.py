@@ -11,7 +11,8 @@ grown budget after budget: the same picks as separate runs), one offline run wit
 (runs/<scene>.opts) and one `rbcontact validate`. Columns: training set, FOM solves, N, R, Mc, max relative
 errors u / lambda / force, the greedy's last max indicator, online median, offline time, targets met.
 
-It is a benchmark: it exits 0 unless a run fails. Timings depend on the machine's load.
+It is a benchmark: it exits 0 unless a run fails (a validate that fails because the reduced model does not converge
+at a test point makes a row "failed", which misses). Timings depend on the machine's load.
 Usage: /usr/bin/python3 bench/greedy_training.py [--np 2] [--scene half_disks] [--grids 5 6 4x3 ...] [--grids-up-to M [--grids-from m]]
            [--budgets 12 16 20 24 32 40] [--extra="-greedy_candidates_size 1000"] [--test-seeds 7 3] [--json out.json]
 (--extra takes its value after "=" when it starts with a dash.) --test-seeds validates every model on more test
