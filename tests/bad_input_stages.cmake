@@ -18,6 +18,7 @@ rbc_bad_stage(ecsw_group_max_points "empirical cubature: group 0 of 3 reaches .*
 rbc_bad_stage(supremizers_infsup "-pod_supremizers_infsup 1.5 out of range [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -pod_supremizers_infsup 1.5 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_tol "-greedy_tol 0 must be > 0" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_tol 0 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_max_solves "-greedy_max_solves 0 must be >= 1" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 0 -rom /tmp/rbc_never.h5)
+rbc_bad_stage(greedy_indicator "Unknown option bogus for -greedy_indicator" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_indicator bogus -rom /tmp/rbc_never.h5)
 rbc_bad_stage(train_type "Unknown value 'greedyy' for option -train_type [(]grid, random, lhs or file; the offline stage also takes greedy[)]" offline -options_file runs/ring_on_block.opts -train_type greedyy -rom /tmp/rbc_never.h5)
 rbc_bad_stage(offline_no_snapshot_file "give the snapshot file with -snapshots" offline -options_file runs/ring_on_block.opts -offline_stop snapshots)
 rbc_bad_stage(snapshots_subcomm "-snapshots_subcomm 3 must lie in [[]1, 1[]]" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm 3)

@@ -12,7 +12,7 @@
 namespace rbc {
 
 // GreedyCriterion's names (option values and report keys), in the PetscOptionsEnum form
-static const char *const kCriterionNames[] = {"residual", "penetration", "max", "estimate", "GreedyCriterion", "GREEDY_", NULL};
+static const char *const kCriterionNames[] = {"residual", "penetration", "max", "estimate"}; // GreedyCriterion's order
 
 PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
 {
@@ -22,9 +22,9 @@ PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
   PetscCall(PetscOptionsInt("-max_solves", "FOM solves in all (initial set included)", "", o->maxSolves, &o->maxSolves, NULL));
   PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks)", "", o->batch, &o->batch, NULL));
   PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
-  {
-    PetscEnum c = (PetscEnum)o->criterion;
-    PetscCall(PetscOptionsEnum("-indicator", "Measure that ranks the candidates", "", kCriterionNames, c, &c, NULL));
+  { // a list option on a PetscInt: a PetscEnum may not hold 3 (UBSan: outside the range of PETSc's one-value enum type)
+    PetscInt c = (PetscInt)o->criterion;
+    PetscCall(PetscOptionsEList("-indicator", "Measure that ranks the candidates", "", kCriterionNames, 4, kCriterionNames[c], &c, NULL));
     o->criterion = (GreedyCriterion)c;
   }
   PetscCall(PetscOptionsBool("-monitor", "Print every round", "", o->monitor, &o->monitor, NULL));
