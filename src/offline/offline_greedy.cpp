@@ -11,8 +11,8 @@
 
 namespace rbc {
 
-// GreedyCriterion's names (option values and report keys), in the PetscOptionsEnum form
-static const char *const kCriterionNames[] = {"residual", "penetration", "max", "estimate"}; // GreedyCriterion's order
+// GreedyCriterion's names (option values and report keys), in its order
+static const char *const kCriterionNames[] = {"residual", "penetration", "max", "estimate"};
 
 PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
 {
@@ -24,7 +24,7 @@ PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
   PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
   { // a list option on a PetscInt: a PetscEnum may not hold 3 (UBSan: outside the range of PETSc's one-value enum type)
     PetscInt c = (PetscInt)o->criterion;
-    PetscCall(PetscOptionsEList("-indicator", "Measure that ranks the candidates", "", kCriterionNames, 4, kCriterionNames[c], &c, NULL));
+    PetscCall(PetscOptionsEList("-indicator", "Measure that ranks the candidates", "", kCriterionNames, (PetscInt)(sizeof kCriterionNames / sizeof *kCriterionNames), kCriterionNames[c], &c, NULL));
     o->criterion = (GreedyCriterion)c;
   }
   PetscCall(PetscOptionsBool("-monitor", "Print every round", "", o->monitor, &o->monitor, NULL));
