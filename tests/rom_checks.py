@@ -345,6 +345,14 @@ def bad_input(args):
     # (-rom_kacanov_max_it 1 is the linearized reduced model, converged by definition, as -kacanov_max_it 1 for the FOM)
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "2", "-rom_warm_start", "0", "-rom_kacanov_rtol_primal", "1e-15",
                         "-rom_kacanov_rtol_dual", "1e-15"], ["did not converge", "-rom_kacanov_max_it"], "reduced Kacanov not converged")
+    # validate names the test parameter where the reduced model failed, and its `online -mu` reproduces the failure
+    stall = ["-rom_kacanov_max_it", "2", "-rom_warm_start", "0", "-rom_kacanov_rtol_primal", "1e-15", "-rom_kacanov_rtol_dual", "1e-15"]
+    p = run(args, 2, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-rom_hyper", "eim", "-test_size", "2", "-validate_repeat", "1"] + stall, expect_ok=False)
+    m = re.search(r"failed on 2 of 2 test parameters; first: at test parameter 0 \(radius [0-9.e+-]+; online -mu ([0-9.e+-]+)\): reduced model: ROM Kacanov iterations did not converge", p.stdout)
+    check(p.returncode != 0 and m is not None, "validate, reduced model not converged: error naming the failed count, the first test parameter and its online -mu")
+    if m:
+        q = run(args, 1, "online", ["-rom", rom, "-rom_hyper", "eim", "-mu", m.group(1)] + stall, expect_ok=False)
+        check(q.returncode != 0 and "did not converge" in q.stdout, "online -mu %s (the parameter validate named): the same failure" % m.group(1))
     run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it", "1", "-rom_warm_start", "0", "-report", d + "/lin.json"])
     lin = report(d + "/lin.json")
     check(lin["converged"] and lin["kacanov_iterations"] == 1, "-rom_kacanov_max_it 1: the linearized reduced model (1 iterate, converged)")
@@ -861,6 +869,22 @@ def dual_refit(args):
           and same and nm == plain["pod"]["n"] and nr == ds["R_stored"] and dr["rom"]["Mc"] == plain["rom"]["Mc"] and dr["ecsw"]["tol"] == plain["ecsw"]["tol"] and dr["pod"]["n"] == plain["pod"]["n"],
           "-dual_select_refit_ecsw_tol 5e-2: Mc %d, held-out lambda %.3e > %.3e: not kept; every dataset of the ROM file, the basis file's %d modes and %d dual "
           "vectors and the report's sizes as without the refit" % (rd["Mc"], rd["max_rel_err_lambda"], (1 + rd["slack"]) * c["max_rel_err_lambda"], nm, nr))
+    # -dual_select_floor: the same refit kept when its held-out errors are under floors (the candidates pinned to the
+    # chosen R and all, so that the floors, which also widen the choice, leave the choice and thus the refit as above);
+    # the report says the relative rule alone refused it, the files hold the refit
+    fl = [rd["max_rel_err_" + q] * 1.01 for q in ("u", "lambda", "force")]
+    run(args, 2, "offline", opts + ["-snapshots_restart", "-rom", d + "/floor.h5", "-report", d + "/floor.json", "-dual_select_refit",
+                                    "-dual_select_refit_ecsw_tol", "5e-2", "-dual_select_R", "%d,%d" % (ds["R"], ds["R_stored"]),
+                                    "-dual_select_floor", ",".join("%.17g" % x for x in fl)] + sel)
+    fr = report(d + "/floor.json")
+    rfl = fr["dual_select"]["refit"]
+    with h5py.File(d + "/floor.h5", "r") as f:
+        zf = [int(v) for v in f["online/sizes"][:]]
+    check(fr["dual_select"]["R"] == ds["R"] and fr["dual_select"]["floor"] == fl and rfl["kept"] and not rfl["kept_relative"] and rfl["Mc"] == rd["Mc"]
+          and rfl["max_rel_err_lambda"] == rd["max_rel_err_lambda"] and fr["rom"]["Mc"] == rd["Mc"] and zf[4] == ds["R"],
+          "-dual_select_floor %.2e,%.2e,%.2e: the refit of -dual_select_refit_ecsw_tol 5e-2 (Mc %d, held-out u %.2e lambda %.2e force %.2e) kept, "
+          "refused by the relative rule alone (kept_relative %s); the ROM file holds R %d, Mc %d"
+          % (fl[0], fl[1], fl[2], rfl["Mc"], rfl["max_rel_err_u"], rfl["max_rel_err_lambda"], rfl["max_rel_err_force"], rfl["kept_relative"], zf[4], fr["rom"]["Mc"]))
     # the manual form from the same snapshots, on 2 and 1 ranks: the same model (the cubature fitted to the same rows).
     # On 2 ranks (the refit's) the same errors; the 1-rank file's bases differ from it by rounding, which the single
     # precision sums of the file (-rom_ecsw_precision single) would turn into their noise: A^ = s A_sphere + A_block is
@@ -898,6 +922,9 @@ def dual_refit(args):
                                (["-dual_select_refit"], ["-dual_select_refit", "-dual_select_snapshots"], "-dual_select_refit without a choice"),
                                (sel + ["-dual_select_refit", "-dual_select_refit_slack", "-0.5"], ["-dual_select_refit_slack", "-0.5"], "a negative refit slack"),
                                (sel + ["-dual_select_refit", "-dual_select_refit_ecsw_tol", "2"], ["-dual_select_refit_ecsw_tol", "2"], "a refit tolerance of 2"),
+                               (sel + ["-dual_select_floor", "1e-3,2e-2"], ["-dual_select_floor", "3 values", "2 given"], "two floors"),
+                               (sel + ["-dual_select_floor", "1e-3,-2e-2,1e-3"], ["-dual_select_floor", "lambda floor", "-0.02"], "a negative floor"),
+                               (sel + ["-dual_select_floor", "1e-3,nan,1e-3"], ["-dual_select_floor", "lambda floor"], "a NaN floor"),
                                (["-dual_truncate", "5", "-estimate"], ["-dual_truncate", "-estimate"], "-dual_truncate with -estimate")):
         expect_error(args, opts + ["-snapshots_restart", "-rom", d + "/bad.h5"] + extra, words, "offline " + what, stage="offline", np_=2)
     check(not os.path.exists(d + "/bad.h5"), "refused before the bases: no ROM file written")

@@ -1,9 +1,11 @@
 // tests/test_dual_selection.cpp: the offline choice of the answer's dual vectors (dual_selection.hpp) on hand-made
 // tables: ChooseDualSize's rule (lambda within the slack of the best, u and force (max and mean) within the guard of every
 // dual vector's, the smallest such R; the defaults: the best lambda; failed rows never; none admissible: every dual vector) and DualSelectionCandidates (evenly
-// spaced from ceil(f R) to R, a given list with R added and larger values left out).
+// spaced from ceil(f R) to R, a given list with R added and larger values left out); the floors of both rules
+// (-dual_select_floor) and RefitKept on the finest level's refit.
 #include "rbcontact/dual_selection.hpp"
 #include "test_check.hpp"
+#include <cmath>
 
 using rbc::DualSizeRow;
 using rbctest::Check;
@@ -71,6 +73,44 @@ int main(int argc, char **argv)
   { // nothing admissible (the best lambda's u is worse, every dual vector's lambda is not within the slack): all of them
     std::vector<DualSizeRow> t{Row(20, 5e-4, 1.0e-2, 1e-4), Row(30, 1e-4, 2.0e-2, 1e-4)};
     PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0.1, 0.1)].R == 30, "none admissible: every dual vector, R 30", (double)t[rbc::ChooseDualSize(t, 0.1, 0.1)].R, 30));
+  }
+  { // floors (-dual_select_floor): an error at or below its floor passes its comparison whatever its ratio
+    std::vector<DualSizeRow> t{Row(20, 3e-5, 1.1e-2, 4e-5), Row(25, 1.5e-5, 1.0e-2, 2e-5), Row(30, 1e-5, 1.0e-2, 1e-5)};
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1)].R == 30, "no floor: R 25's u 1.5x and force 2x every vector's refused, R 30", (double)t[rbc::ChooseDualSize(t, 0, 0.1)].R, 30));
+    const rbc::DualErrorFloor f{1e-4, 2e-3, 1e-4};
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1, f)].R == 25, "floors on u and force: R 25; R 20's lambda 1.1e-2 is 10 % above the best and its floor", (double)t[rbc::ChooseDualSize(t, 0, 0.1, f)].R, 25));
+    const rbc::DualErrorFloor f2{1e-4, 1.2e-2, 1e-4};
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1, f2)].R == 20, "every error under its floor: the smallest R, 20", (double)t[rbc::ChooseDualSize(t, 0, 0.1, f2)].R, 20));
+    const rbc::DualErrorFloor f3{2.9e-5, 1.2e-2, 1e-4}; // u 3e-5 just above its floor
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1, f3)].R == 25, "u 3e-5 above its floor 2.9e-5 and 3x every vector's: R 25", (double)t[rbc::ChooseDualSize(t, 0, 0.1, f3)].R, 25));
+    t[0].meanU = 2.95e-5; // the mean, not only the max, is compared with the u floor
+    const rbc::DualErrorFloor f4{2.9e-5, 1.2e-2, 1e-4};
+    t[0].u = 2.8e-5;
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1, f4)].R == 25, "max u under its floor, mean u above it and 5.9x: R 25", (double)t[rbc::ChooseDualSize(t, 0, 0.1, f4)].R, 25));
+    t[0].failed = true;
+    PetscCall(Check(c, t[rbc::ChooseDualSize(t, 0, 0.1, f2)].R == 25, "a failed row under every floor: never chosen", (double)t[rbc::ChooseDualSize(t, 0, 0.1, f2)].R, 25));
+  }
+  { // RefitKept on the finest 3D level's refit of 2026-11-29 (docs/rom3d.md "The finest level with the elimination"): the
+    // chosen row R 103 held-out lambda 1.48e-2, u 1.69e-4, force 5.3e-5; the refit (Mc 2993 -> 2469) 1.44e-2, 1.68e-4,
+    // 8.8e-5: force +64 %, refused by the relative rule; a quarter of the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)
+    // as floors keeps it
+    const DualSizeRow chosen = Row(103, 1.69e-4, 1.48e-2, 5.3e-5), refit = Row(103, 1.68e-4, 1.44e-2, 8.8e-5);
+    const rbc::DualErrorFloor quarter{2.5e-4, 5e-3, 2.5e-4}, tight{2.5e-4, 5e-3, 8.7e-5};
+    PetscCall(Check(c, !rbc::RefitKept(refit, chosen, 0.1, 0.1), "finest refit: refused without floors (force 8.8e-5 > 1.1 x 5.3e-5)", 0, 0));
+    PetscCall(Check(c, rbc::RefitKept(refit, chosen, 0.1, 0.1, quarter), "finest refit: kept with a quarter of the targets as floors", 1, 1));
+    PetscCall(Check(c, !rbc::RefitKept(refit, chosen, 0.1, 0.1, tight), "finest refit: refused with the force floor 8.7e-5 < 8.8e-5", 0, 0));
+    DualSizeRow bad = refit;
+    bad.meanForce = 3e-4; // the mean above its floor and 11x the chosen row's
+    PetscCall(Check(c, !rbc::RefitKept(bad, chosen, 0.1, 0.1, quarter), "finest refit: a mean force 3e-4 above its floor refused", 0, 0));
+    bad = refit;
+    bad.lambda = 1.7e-2; // +15 %, above the lambda floor 5e-3
+    PetscCall(Check(c, !rbc::RefitKept(bad, chosen, 0.1, 0.1, quarter), "finest refit: lambda +15 % above its floor refused", 0, 0));
+    bad = refit;
+    bad.force = NAN;
+    PetscCall(Check(c, !rbc::RefitKept(bad, chosen, 0.1, 0.1, quarter), "a NaN error never passes a floor", 0, 0));
+    bad = refit;
+    bad.failed = true;
+    PetscCall(Check(c, !rbc::RefitKept(bad, chosen, 0.1, 0.1, quarter), "a failed refit is never kept", 0, 0));
   }
   { // candidates
     rbc::DualSelectionOptions o;

@@ -17,6 +17,13 @@
 
 namespace rbc {
 
+// Absolute held-out errors (relative errors in validate's measures) under which the rules below do not compare: an
+// error at or below its floor is admitted whatever its growth against the reference row (docs/dual_basis.md "Floors").
+// 0 (the default): the rules are purely relative.
+struct DualErrorFloor {
+  PetscReal u = 0, lambda = 0, force = 0;
+};
+
 struct DualSelectionOptions {
   PetscInt              size = 0;           // -dual_select_size: random held-out parameters solved by the FOM here (0: off)
   PetscInt              seed = 11;          // -dual_select_seed
@@ -36,6 +43,8 @@ struct DualSelectionOptions {
                                             // guard's default: the chosen row is a minimum over the candidates, biased low
                                             // by their spread (docs/dual_basis.md)
   PetscReal             refitEcswTol = 0;   // -dual_select_refit_ecsw_tol: the refit's cubature tolerance (0: -ecsw_tol's)
+  DualErrorFloor        floor;              // -dual_select_floor u,lambda,force: held-out errors at or below these pass
+                                            // the relative rules (choice and refit) whatever their growth (0: off)
   PetscInt              truncate = 0;       // -dual_truncate: the bases cut to this many dual vectors before the online
                                             // model is built (0: all; TruncateBases)
   bool Enabled() const { return size > 0 || !snapshots.empty(); }
@@ -55,8 +64,9 @@ std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, Pet
 // The rule (rows: DualSizeRow, validation.hpp): admissible are the rows that did not fail whose max lambda error is
 // within (1 + slack) of the best row's and whose u and force errors, max and mean, are within (1 + guardSlack) of
 // those with every dual vector (the row of the largest R); the admissible row of the smallest R is chosen, the
-// largest R when none is. Returns the chosen row's index.
-size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack);
+// largest R when none is. An error at or below its floor (u: max and mean u; lambda; force: max and mean force) passes
+// its comparison whatever its ratio. Returns the chosen row's index.
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack, const DualErrorFloor &floor = DualErrorFloor());
 
 // With the options o (DualSelectionFromOptions) enabled: validates the ROM at romPath (w: its writer, holding the
 // model) on the held-out FOM solutions for every candidate, chooses R (ChooseDualSize) and, when R is below the
@@ -70,8 +80,9 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
 
 // -dual_select_refit: the ROM at romPath, built again for the chosen R (its every dual vector), validated on the same
 // held-out solutions; the rule of keeping it (RefitKept): lambda within (1 + refitSlack) of the chosen row's, u and
-// force (max and mean) within (1 + guard) of it. row: the refitted model's held-out errors.
+// force (max and mean) within (1 + guard) of it, each comparison passed also by an error at or below its floor; a failed
+// refit never. row: the refitted model's held-out errors.
 PetscErrorCode ValidateRefit(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, const DualSelectionOptions &o, DualSizeRow *row);
-bool           RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard);
+bool           RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard, const DualErrorFloor &floor = DualErrorFloor());
 
 } // namespace rbc

@@ -11,7 +11,9 @@ namespace rbc {
 PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
 {
   char      path[PETSC_MAX_PATH_LEN] = "";
-  PetscInt  rbuf[256], nr = 256;
+  PetscInt  rbuf[256], nr = 256, nf = 3;
+  PetscReal fbuf[3] = {o->floor.u, o->floor.lambda, o->floor.force};
+  PetscBool fset = PETSC_FALSE;
   PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE, refit = o->refit ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
@@ -27,7 +29,13 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCall(PetscOptionsBool("-refit", "below the stored count: the bases cut to the chosen R and the online model (its cubature) built again for them", "", refit, &refit, NULL));
   PetscCall(PetscOptionsReal("-refit_slack", "the refitted model kept if its held-out lambda error is within this relative slack of the chosen row's", "", o->refitSlack, &o->refitSlack, NULL));
   PetscCall(PetscOptionsReal("-refit_ecsw_tol", "the refit's cubature tolerance (0: -ecsw_tol's)", "", o->refitEcswTol, &o->refitEcswTol, NULL));
+  PetscCall(PetscOptionsRealArray("-floor", "u,lambda,force: held-out max (and mean) errors at or below these pass the choice's and the refit's relative rules (0: off; e.g. a quarter of the targets)", "", fbuf, &nf, &fset));
   PetscOptionsEnd();
+  if (fset) {
+    PetscCheck(nf == 3, comm, PETSC_ERR_ARG_SIZ, "-dual_select_floor takes 3 values (u,lambda,force: relative errors), %" PetscInt_FMT " given", nf);
+    for (PetscInt k = 0; k < 3; ++k) PetscCheck(std::isfinite((double)fbuf[k]) && fbuf[k] >= 0 && fbuf[k] < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_floor: the %s floor %g is not in [0, 1) (relative errors)", k == 0 ? "u" : k == 1 ? "lambda" : "force", (double)fbuf[k]);
+    o->floor = DualErrorFloor{fbuf[0], fbuf[1], fbuf[2]};
+  }
   o->refit = refit == PETSC_TRUE;
   PetscOptionsBegin(comm, "dual_", "The dual basis cut before the online model is built (offline)", "TruncateBases");
   PetscCall(PetscOptionsInt("-truncate", "keep the leading dual vectors (and their supremizers) only, before the online model (0: all)", "", o->truncate, &o->truncate, NULL));
@@ -73,7 +81,13 @@ std::vector<PetscInt> DualSelectionCandidates(const DualSelectionOptions &o, Pet
   return c;
 }
 
-size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack)
+// e within factor x ref, or at or below its floor (false for a NaN e)
+static bool Within(PetscReal e, PetscReal factor, PetscReal ref, PetscReal floor)
+{
+  return e <= factor * ref || e <= floor;
+}
+
+size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, PetscReal guardSlack, const DualErrorFloor &floor)
 {
   size_t all = 0;
   for (size_t k = 1; k < rows.size(); ++k)
@@ -88,8 +102,8 @@ size_t ChooseDualSize(const std::vector<DualSizeRow> &rows, PetscReal slack, Pet
     // u and force no worse than with every dual vector, at the worst parameter and on average (a max over a few
     // held-out parameters is set by one of them and hides a change at the others)
     const PetscReal g     = 1 + guardSlack;
-    const bool      guard = a.failed || (r.u <= g * a.u && r.force <= g * a.force && r.meanU <= g * a.meanU && r.meanForce <= g * a.meanForce);
-    const bool admissible = !r.failed && r.lambda <= (1 + slack) * best && guard;
+    const bool      guard = a.failed || (Within(r.u, g, a.u, floor.u) && Within(r.force, g, a.force, floor.force) && Within(r.meanU, g, a.meanU, floor.u) && Within(r.meanForce, g, a.meanForce, floor.force));
+    const bool admissible = !r.failed && Within(r.lambda, 1 + slack, best, floor.lambda) && guard;
     if (admissible && (chosen == rows.size() || r.R < rows[chosen].R)) chosen = k;
   }
   return chosen == rows.size() ? all : chosen;
@@ -148,7 +162,7 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   PetscCall(RunValidation(world, scene, romPath, held, vs, &vr));
 
   d["candidates"] = vr.root["sweep_R"]; // validate's rows (-validate_sweep_R), one per candidate
-  const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack, o.guard)], &a = rows.back();
+  const DualSizeRow &c = rows[ChooseDualSize(rows, o.slack, o.guard, o.floor)], &a = rows.back();
   if (chosen) *chosen = c;
   if (c.R < R) { // R itself: no dataset (the file's default), the file as written
     w->Dataset("/online/dual_select", {1}, {(double)c.R});
@@ -159,6 +173,8 @@ PetscErrorCode SelectDualSize(MPI_Comm world, const SceneSpec &scene, const std:
   else d["snapshots"] = o.snapshots;
   d["slack"]                         = (double)o.slack;
   d["guard"]                         = (double)o.guard;
+  d["floor"]                         = std::vector<double>{(double)o.floor.u, (double)o.floor.lambda, (double)o.floor.force};
+  d["R_relative"]                    = (long long)rows[ChooseDualSize(rows, o.slack, o.guard)].R; // the rule without the floors
   d["R"]                             = (long long)c.R;
   d["N"]                             = (long long)c.N;
   d["R_stored"]                      = (long long)R;
@@ -195,10 +211,11 @@ PetscErrorCode ValidateRefit(MPI_Comm world, const SceneSpec &scene, const std::
   PetscFunctionReturn(0);
 }
 
-bool RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard)
+bool RefitKept(const DualSizeRow &refit, const DualSizeRow &chosen, PetscReal refitSlack, PetscReal guard, const DualErrorFloor &floor)
 {
   const PetscReal g = 1 + guard;
-  return !refit.failed && refit.lambda <= (1 + refitSlack) * chosen.lambda && refit.u <= g * chosen.u && refit.force <= g * chosen.force && refit.meanU <= g * chosen.meanU && refit.meanForce <= g * chosen.meanForce;
+  return !refit.failed && Within(refit.lambda, 1 + refitSlack, chosen.lambda, floor.lambda) && Within(refit.u, g, chosen.u, floor.u) && Within(refit.force, g, chosen.force, floor.force) && Within(refit.meanU, g, chosen.meanU, floor.u) &&
+         Within(refit.meanForce, g, chosen.meanForce, floor.force);
 }
 
 } // namespace rbc

@@ -499,7 +499,7 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     PetscCall(rw.Write(world, romPath));
     DualSizeRow row;
     PetscCall(ValidateRefit(world, fom.scene, romPath, dso, &row));
-    const bool kept = RefitKept(row, chosen, dso.refitSlack, dso.guard);
+    const bool kept = RefitKept(row, chosen, dso.refitSlack, dso.guard, dso.floor), keptRelative = RefitKept(row, chosen, dso.refitSlack, dso.guard);
     if (!kept) {
       rep->root = before;
       PetscCall(w.Write(world, bpath));
@@ -520,8 +520,9 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     r["slack"]             = (double)dso.refitSlack;
     r["ecsw_tol"]          = refitTol; // the refit's cubature tolerance (the report's ecsw: the kept model's)
     r["kept"]              = kept;
+    r["kept_relative"]     = keptRelative; // the rule without -dual_select_floor
     rep->root["time_s"]["dual_select_refit"] = (double)(t1 - t0);
-    PetscCall(PetscPrintf(world, "rbcontact offline: the online model refitted to R %" PetscInt_FMT " (N %" PetscInt_FMT "): Mc %lld -> %lld, held-out max rel err lambda %.3e u %.3e force %.3e (before: %.3e, %.3e, %.3e): %s\n", row.R, row.N, mcBefore, mc, row.lambda, row.u, row.force, chosen.lambda, chosen.u, chosen.force, kept ? "kept" : "not kept (-dual_select_refit_slack, -dual_select_guard), the files as before"));
+    PetscCall(PetscPrintf(world, "rbcontact offline: the online model refitted to R %" PetscInt_FMT " (N %" PetscInt_FMT "): Mc %lld -> %lld, held-out max rel err lambda %.3e u %.3e force %.3e (before: %.3e, %.3e, %.3e): %s\n", row.R, row.N, mcBefore, mc, row.lambda, row.u, row.force, chosen.lambda, chosen.u, chosen.force, kept ? (keptRelative ? "kept" : "kept (under -dual_select_floor)") : "not kept (-dual_select_refit_slack, -dual_select_guard, -dual_select_floor), the files as before"));
     PetscFunctionReturn(0);
   };
   PetscCall(writers(&w, &wr, 0));

@@ -25,6 +25,7 @@
 #include <numeric>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <sstream>
 
 namespace rbc {
@@ -515,7 +516,15 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       }
       PetscCall(PetscLogEventEnd(VAL_ROM, 0, 0, 0, 0));
       if (!sol.converged) {
-        if (!E->failed) E->firstFailure = sol.message;
+        if (!E->failed) { // the parameter named, so that `online -mu` reproduces it
+          std::ostringstream o;
+          o << "at test parameter " << j << " (";
+          for (size_t k = 0; k < F[j].mu.size(); ++k) o << (k ? ", " : "") << (k < scene.params.size() ? scene.params[k].name : "mu" + std::to_string(k)) << " " << std::setprecision(17) << F[j].mu[k];
+          o << "; online -mu ";
+          for (size_t k = 0; k < F[j].mu.size(); ++k) o << (k ? "," : "") << std::setprecision(17) << F[j].mu[k];
+          o << "): " << sol.message;
+          E->firstFailure = o.str();
+        }
         ++E->failed;
         continue;
       }
