@@ -80,7 +80,8 @@ struct Solution {
   bool                converged = false;
   PetscInt            iterations = 0;
   double              contactForce = std::numeric_limits<double>::quiet_NaN();
-  double              maxPressure = std::numeric_limits<double>::quiet_NaN(), halfwidth = std::numeric_limits<double>::quiet_NaN(), contactLength = std::numeric_limits<double>::quiet_NaN();
+  double              maxPressure = std::numeric_limits<double>::quiet_NaN(), halfwidth = std::numeric_limits<double>::quiet_NaN(), contactLength = std::numeric_limits<double>::quiet_NaN(),
+                      contactRadius = std::numeric_limits<double>::quiet_NaN();
   // the online error estimate (docs/error_estimate.md): estimated relative errors, nan when the ROM file has none
   double              estU = std::numeric_limits<double>::quiet_NaN(), estLambda = std::numeric_limits<double>::quiet_NaN(), estForce = std::numeric_limits<double>::quiet_NaN();
   std::string         message;
@@ -135,6 +136,7 @@ public:
       s.maxPressure   = so.maxPressure;
       s.halfwidth     = so.halfwidth;
       s.contactLength = so.contactLength;
+      s.contactRadius = so.contactRadius;
       if (sol.estimate.available) {
         s.estU      = sol.estimate.u;
         s.estLambda = sol.estimate.lambda;
@@ -249,6 +251,7 @@ PYBIND11_MODULE(_rbcontact, m)
     .def_readonly("max_pressure", &Solution::maxPressure, "max nodal contact pressure (the FOM report's max_pressure; nan without the ROM file's surface data)")
     .def_readonly("contact_halfwidth", &Solution::halfwidth, "2D: the moment half-width of the pressure (the FOM report's contact_halfwidth_moment)")
     .def_readonly("contact_length", &Solution::contactLength, "2D: twice the half-width")
+    .def_readonly("contact_radius", &Solution::contactRadius, "3D: the moment contact radius of the pressure (the FOM report's contact_halfwidth_moment, Hertz's a); NaN in 2D")
     .def_readonly("error_u", &Solution::estU, "estimated relative error of u in the energy norm (nan: the ROM file has no error estimate, offline -estimate)")
     .def_readonly("error_lambda", &Solution::estLambda, "estimated relative error of the multipliers (slave-mass weighted l2)")
     .def_readonly("error_force", &Solution::estForce, "estimated relative error of the contact force")

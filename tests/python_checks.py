@@ -56,6 +56,10 @@ def main():
         # (mpiexec before the first model initializes MPI in this process)
         rome = os.path.join(d, "rom_e.h5")
         run(args.exe, 2, ["offline", "-options_file", "runs/ring_on_block.opts", "-rom", rome, "-estimate", "-report", d + "/off_e.json"])
+        # a small 3D model (2 x 2 grid) and its online report at one parameter, for the 3D outputs below
+        rom3 = os.path.join(d, "rom3.h5")
+        run(args.exe, 2, ["offline", "-options_file", "runs/sphere_block3d.opts", "-train_size", "2", "-rom", rom3, "-report", d + "/off3.json"])
+        run(args.exe, 1, ["online", "-rom", rom3, "-mu", "1.1,0.045", "-online_repeat", "1", "-report", d + "/on3.json"])
         m = rbcontact.ReducedModel(rom)
         (name, lo, hi), = m.parameters
         check(name == "radius" and abs(lo - 0.95) < 1e-14 and abs(hi - 1.15) < 1e-14, "parameter box from the file: %s in [%g, %g]" % (name, lo, hi))
@@ -83,6 +87,10 @@ def main():
         pm, hw = fj["max_pressure"], fj["contact_halfwidth_moment"]
         check(abs(s.max_pressure - pm) <= 1e-2 * pm and abs(s.contact_halfwidth - hw) <= 1e-2 * hw and s.contact_length == 2 * s.contact_halfwidth,
               "max pressure %.6f and half-width %.6f vs the FOM's %.6f, %.6f (rel %.1e, %.1e <= 1e-2)" % (s.max_pressure, s.contact_halfwidth, pm, hw, abs(s.max_pressure - pm) / pm, abs(s.contact_halfwidth - hw) / hw))
+        check(np.isnan(s.contact_radius), "2D: contact_radius (3D) is nan")
+        s3, o3 = rbcontact.ReducedModel(rom3).solve([1.1, 0.045]), json.load(open(d + "/on3.json"))["outputs"]
+        check(s3.converged and abs(s3.contact_radius - o3["contact_radius"]) <= 1e-12 * o3["contact_radius"] and np.isnan(s3.contact_halfwidth) and np.isnan(s3.contact_length),
+              "3D: contact_radius %.12g = the online report's %.12g; half-width and length nan" % (s3.contact_radius, o3["contact_radius"]))
         check(np.array_equal(m.contact_forces(np.array([[r]])), np.array([s.contact_force])), "contact_forces on an (n, 1) array = solve")
         # the online error estimate (docs/error_estimate.md): nan without it in the file, the online report's with it
         check(np.isnan(s.error_u) and np.isnan(s.error_lambda) and np.isnan(s.error_force), "a ROM without -estimate: error_u, error_lambda, error_force are nan")

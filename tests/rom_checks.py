@@ -324,6 +324,9 @@ def pipeline(args):
     check(xr.shape == xf.shape and np.abs(xr - xf).max() <= 1e-12, "reconstructed fields on the FOM's (physical, radius 1.02) configuration")
     po = rr["outputs"]["max_pressure"]
     check(po is not None and abs(po - rr["max_pressure"]) <= 1e-12 * rr["max_pressure"], "online max pressure (surface data of the ROM file) %.12g = that of the reconstructed field on the mesh %.12g" % (po, rr["max_pressure"]))
+    hw, hm = rr["outputs"]["contact_halfwidth"], rr["contact_halfwidth_moment"]
+    check(hw is not None and abs(hw - hm) <= 1e-5 * hm and rr["outputs"]["contact_radius"] is None,
+          "online contact half-width %.10g = that of the reconstructed multipliers on the mesh %.10g (rel %.1e <= 1e-5; no 3D radius in 2D)" % (hw, hm, abs(hw - hm) / hm))
     shutil.rmtree(d, ignore_errors=True)
 
 
@@ -552,6 +555,17 @@ def sphere_block3d(args):
           "3D ROM at its training parameters within the 3D targets (u 1e-3, lambda 2e-2, force 1e-3)")
     dmax = max(abs(a - b) / max(abs(b), 1e-300) for k in ("rel_err_u", "rel_err_lambda", "rel_err_force") for a, b in zip(vals[1][k], vals[2][k]))
     check(dmax <= 1e-6, "1 and 2 ranks: the same errors to %.1e relative (<= 1e-6)" % dmax)
+    # the contact radius computed online (surface data of the ROM file, no mesh; docs/online.md "Outputs of interest")
+    # against the FOM's moment radius (its report's contact_halfwidth_moment), and against the same definition applied on
+    # the mesh to the reconstructed multipliers: equal up to the resultant's direction, online's against the mesh's
+    cr = t["max_rel_err_contact_radius_online"]
+    check(cr is not None and len(t["rel_err_contact_radius_online"]) == 9 and cr <= 1e-2 and t["max_rel_err_halfwidth_online"] is None,
+          "3D contact radius computed online against the FOM's at the 9 parameters: max rel err %s <= 1e-2 (no 2D half-width)" % cr)
+    run(args, 2, "online", ["-options_file", "runs/sphere_block3d.opts", "-rom", rom, "-mu", "1.1,0.045", "-rom_reconstruct", d + "/rec.h5", "-report", d + "/rec.json"])
+    rr = report(d + "/rec.json")
+    ra, rm = rr["outputs"]["contact_radius"], rr["contact_halfwidth_moment"]
+    check(ra is not None and rm > 0 and abs(ra - rm) <= 1e-5 * rm and rr["outputs"]["contact_halfwidth"] is None,
+          "online contact radius %.10g = that of the reconstructed multipliers on the mesh %.10g (rel %.1e <= 1e-5)" % (ra, rm, abs(ra - rm) / rm))
     # the online solves timed on rank 0 while the other ranks wait (-validate_time_all_ranks false, docs/online.md
     # "Validation"): 9 medians, each of a real solve
     ot = report("%s/val2.json" % d)["online_time_s"]

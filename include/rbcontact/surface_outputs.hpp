@@ -1,11 +1,13 @@
 // include/rbcontact/surface_outputs.hpp: outputs of interest of a reduced solution that need the pressure
-// field on the slave surface: the maximum nodal pressure and (2D) the contact half-width, computed online
+// field on the slave surface: the maximum nodal pressure, the contact half-width (2D) or radius (3D), computed online
 // from the reduced multipliers alone (no mesh): the dual basis on the slave vertices W (r x R_fom) and the
 // slave facets (reference vertex coordinates, body, the canonical multiplier row of each vertex) are stored
 // in the ROM file (/online/outputs). The definitions are the FOM report's (SummarizeContact, kacanov.hpp):
 // lambda = W' lambda^, max_pressure = max_i lambda_i, the half-width 2 sqrt(m2/m0 - (m1/m0)^2) of the moments
 // m_k = sum_i lambda_i w_i s_i^k along the tangent of the resultant (w_i = int psi_i at mu, s_i = x_i(mu) . t;
-// the FOM report's contact_halfwidth_moment, Hertz's a for Hertz's pressure). docs/online.md.
+// the FOM report's contact_halfwidth_moment, Hertz's a for Hertz's pressure); in 3D the contact radius
+// sqrt(5/2 (m2/m0 - |m1/m0|^2)) with m_k the moments of |q|^k, q = x_i(mu) projected on the plane normal to the
+// resultant (the FOM report's contact_halfwidth_moment in 3D: Hertz's a for Hertz's p0 sqrt(1 - r^2/a^2)). docs/online.md.
 #pragma once
 #include <string>
 #include <vector>
@@ -19,6 +21,8 @@ struct SurfaceOutputValues {
   PetscReal maxPressure = NAN;   // max_i lambda_i (nodal pressure)
   PetscReal halfwidth   = NAN;   // 2D: the moment half-width (NaN in 3D or without a resultant)
   PetscReal contactLength = NAN; // 2D: 2 x halfwidth
+  PetscReal contactRadius = NAN; // 3D: the moment radius sqrt(5/2 (m2/m0 - |m1/m0|^2)) of the pressure in the plane normal
+                                 // to the resultant (NaN in 2D or without a resultant)
 };
 
 class SurfaceOutputs {

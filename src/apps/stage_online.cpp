@@ -96,6 +96,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   o["max_pressure"]      = (double)so.maxPressure;
   o["contact_halfwidth"] = (double)so.halfwidth;
   o["contact_length"]    = (double)so.contactLength;
+  o["contact_radius"]    = (double)so.contactRadius; // 3D (null in 2D)
   // the online error estimate (docs/error_estimate.md): relative errors of u (energy), lambda (slave-mass l2), force
   JsonValue &ee = rep.root["error_estimate"];
   ee["available"] = sol.estimate.available;

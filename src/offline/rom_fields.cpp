@@ -285,6 +285,7 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   PetscCall(SummarizeContact(sys, lambda, fom.elas.dim, &cs));
   rep->root["contact_force"] = (double)cs.force;
   rep->root["max_pressure"]  = (double)cs.maxPressure;
+  rep->root["contact_halfwidth_moment"] = (double)cs.halfwidthMoment; // 2D the half-width, 3D the radius, by the pressure's moments (as fom's)
   rep->root["nactive"]       = (long long)cs.nactive;
   PetscReal energy;
   PetscCall(fom.elas.Energy(fom.u, &energy));

@@ -137,7 +137,7 @@ void EffectivityStats(const std::vector<double> &eff, JsonValue *j)
 struct Errors {
   std::vector<double> u, lambda, force;
   std::vector<double> forceOnline; // the online resultant (ReducedSolution::force, no mesh); empty with the EIM
-  std::vector<double> pmaxOnline, halfwidthOnline; // the online max pressure and half-width (surface_outputs.hpp)
+  std::vector<double> pmaxOnline, halfwidthOnline, radiusOnline; // the online max pressure, half-width (2D), radius (3D) (surface_outputs.hpp)
   std::vector<double> outOfRange; // contact projections at the edge of the stored contact patch, per parameter
   std::vector<double> estU, estLambda, estForce; // the online error estimates (ReducedSolution::estimate), when available
   std::vector<double> rawU, rawLambda, rawForce; // and their enriched-space changes before the calibration
@@ -176,6 +176,7 @@ struct Errors {
     };
     online("max_pressure", pmaxOnline);
     online("halfwidth", halfwidthOnline);
+    online("contact_radius", radiusOnline);
     (*j)["out_of_range"]        = outOfRange; // > 0: the patch kept offline (-eim_patch_rings) was too small there
     (*j)["max_out_of_range"]    = mx(outOfRange);
     (*j)["failed"]              = (long long)failed;
@@ -556,6 +557,7 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       m.SurfaceOutputsOf(F[j].mu, sol, &so);
       if (std::isfinite(so.maxPressure) && F[j].maxPressure > 0) E->pmaxOnline.push_back(std::abs(so.maxPressure - F[j].maxPressure) / F[j].maxPressure);
       if (std::isfinite(so.halfwidth) && F[j].halfwidth > 0) E->halfwidthOnline.push_back(std::abs(so.halfwidth - F[j].halfwidth) / F[j].halfwidth);
+      if (std::isfinite(so.contactRadius) && F[j].halfwidth > 0) E->radiusOnline.push_back(std::abs(so.contactRadius - F[j].halfwidth) / F[j].halfwidth); // 3D: the FOM's moment radius
     }
     PetscFunctionReturn(0);
   };

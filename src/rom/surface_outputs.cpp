@@ -1,4 +1,4 @@
-// src/rom/surface_outputs.cpp: the maximum pressure and the contact half-width of a reduced solution from
+// src/rom/surface_outputs.cpp: the maximum pressure and the contact half-width (2D) or radius (3D) of a reduced solution from
 // the dual basis on the slave vertices and the slave facets (include/rbcontact/surface_outputs.hpp).
 #include "rbcontact/surface_outputs.hpp"
 #include "../contact/contact_point.hpp"
@@ -94,8 +94,26 @@ void SurfaceOutputs::Evaluate(const GeometryMap &map, const std::vector<PetscRea
   PetscReal fn = 0;
   for (PetscReal f : force) fn += f * f;
   fn = std::sqrt(fn);
-  if (dim_ != 2 || force.size() != 2 || !(fn > 0)) return;
+  if (force.size() != (size_t)dim_ || !(fn > 0)) return;
   Weights(map, mu, &w, &x);
+  if (dim_ == 3) { // the contact radius by the pressure's second moment in the plane normal to the resultant (SummarizeContact)
+    const PetscReal nh[3] = {force[0] / fn, force[1] / fn, force[2] / fn};
+    PetscReal       m0 = 0, m1[3] = {0, 0, 0}, m2 = 0;
+    for (PetscInt i = 0; i < Rfom_; ++i) {
+      const PetscReal *xi = &x[3 * (size_t)i];
+      const PetscReal  xn = xi[0] * nh[0] + xi[1] * nh[1] + xi[2] * nh[2], f = lam[i] * w[i];
+      PetscReal        q2 = 0;
+      for (PetscInt d = 0; d < 3; ++d) {
+        const PetscReal q = xi[d] - xn * nh[d];
+        q2 += q * q;
+        m1[d] += f * q;
+      }
+      m0 += f;
+      m2 += f * q2;
+    }
+    if (m0 > 0) out->contactRadius = std::sqrt(std::max<PetscReal>(0.0, 2.5 * (m2 / m0 - (m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]) / (m0 * m0))));
+    return;
+  }
   const PetscReal t[2] = {-force[1] / fn, force[0] / fn};
   PetscReal       m0 = 0, m1 = 0, m2 = 0;
   for (PetscInt i = 0; i < Rfom_; ++i) {
