@@ -3,6 +3,7 @@
 // pressure, active zone).
 #include "rbcontact/kacanov.hpp"
 #include "contact_point.hpp"
+#include "pressure_moments.hpp"
 #include <petscblaslapack.h>
 #include <algorithm>
 #include <cmath>
@@ -799,20 +800,10 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
   // 3D: the contact radius from the pressure's second moment in the plane normal to the resultant,
   // a = sqrt(5/2 (int p |q|^2 / int p - |int p q / int p|^2)) (= a for Hertz's p0 sqrt(1 - r^2/a^2))
   if (dim == 3 && s->force > 0) {
-    const PetscReal nh[3] = {s->forceVec[0] / s->force, s->forceVec[1] / s->force, s->forceVec[2] / s->force};
-    PetscReal       m0 = 0, m1[3] = {0, 0, 0}, m2 = 0;
-    for (size_t i = 0; i < lam.size(); ++i) {
-      const PetscReal xn = x[0][i] * nh[0] + x[1][i] * nh[1] + x[2][i] * nh[2], f = lam[i] * w[i];
-      PetscReal       q[3], q2 = 0;
-      for (PetscInt d = 0; d < 3; ++d) {
-        q[d] = x[d][i] - xn * nh[d];
-        q2 += q[d] * q[d];
-        m1[d] += f * q[d];
-      }
-      m0 += f;
-      m2 += f * q2;
-    }
-    if (m0 > 0) s->halfwidthMoment = std::sqrt(std::max<PetscReal>(0.0, 2.5 * (m2 / m0 - (m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]) / (m0 * m0))));
+    const PetscReal  nh[3] = {s->forceVec[0] / s->force, s->forceVec[1] / s->force, s->forceVec[2] / s->force};
+    PressureMoments3 pm(nh);
+    for (size_t i = 0; i < lam.size(); ++i) pm.Add(x[0][i], x[1][i], x[2][i], lam[i] * w[i]);
+    (void)pm.Radius(&s->halfwidthMoment);
   }
   // 2D half-width: extent of the active nodes along the tangent of the mean normal, half of it.
   if (dim == 2 && s->nactive && s->force > 0) {
@@ -823,12 +814,9 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
     std::sort(active.begin(), active.end());
     {
       // second moment of the pressure along the tangent (exact a for p0 sqrt(1 - x^2/a^2))
-      PetscReal m0 = 0, m1 = 0, m2 = 0;
-      for (size_t i = 0; i < lam.size(); ++i) {
-        const PetscReal st = x[0][i] * t[0] + x[1][i] * t[1], f = lam[i] * w[i];
-        m0 += f; m1 += f * st; m2 += f * st * st;
-      }
-      if (m0 > 0) s->halfwidthMoment = 2 * std::sqrt(std::max(0.0, m2 / m0 - (m1 / m0) * (m1 / m0)));
+      PressureMoments2 pm;
+      for (size_t i = 0; i < lam.size(); ++i) pm.Add(x[0][i] * t[0] + x[1][i] * t[1], lam[i] * w[i]);
+      (void)pm.HalfWidth(&s->halfwidthMoment);
     }
     s->halfwidth = 0.5 * (active.back().first - active.front().first);
     if (active.size() >= 3) {

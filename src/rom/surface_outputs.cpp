@@ -2,6 +2,7 @@
 // the dual basis on the slave vertices and the slave facets (include/rbcontact/surface_outputs.hpp).
 #include "rbcontact/surface_outputs.hpp"
 #include "../contact/contact_point.hpp"
+#include "../contact/pressure_moments.hpp"
 #include <algorithm>
 #include <cmath>
 
@@ -97,34 +98,20 @@ void SurfaceOutputs::Evaluate(const GeometryMap &map, const std::vector<PetscRea
   if (force.size() != (size_t)dim_ || !(fn > 0)) return;
   Weights(map, mu, &w, &x);
   if (dim_ == 3) { // the contact radius by the pressure's second moment in the plane normal to the resultant (SummarizeContact)
-    const PetscReal nh[3] = {force[0] / fn, force[1] / fn, force[2] / fn};
-    PetscReal       m0 = 0, m1[3] = {0, 0, 0}, m2 = 0;
-    for (PetscInt i = 0; i < Rfom_; ++i) {
-      const PetscReal *xi = &x[3 * (size_t)i];
-      const PetscReal  xn = xi[0] * nh[0] + xi[1] * nh[1] + xi[2] * nh[2], f = lam[i] * w[i];
-      PetscReal        q2 = 0;
-      for (PetscInt d = 0; d < 3; ++d) {
-        const PetscReal q = xi[d] - xn * nh[d];
-        q2 += q * q;
-        m1[d] += f * q;
-      }
-      m0 += f;
-      m2 += f * q2;
-    }
-    if (m0 > 0) out->contactRadius = std::sqrt(std::max<PetscReal>(0.0, 2.5 * (m2 / m0 - (m1[0] * m1[0] + m1[1] * m1[1] + m1[2] * m1[2]) / (m0 * m0))));
+    const PetscReal  nh[3] = {force[0] / fn, force[1] / fn, force[2] / fn};
+    PressureMoments3 pm(nh);
+    for (PetscInt i = 0; i < Rfom_; ++i) pm.Add(x[3 * (size_t)i], x[3 * (size_t)i + 1], x[3 * (size_t)i + 2], lam[i] * w[i]);
+    PetscReal a;
+    if (pm.Radius(&a)) out->contactRadius = a;
     return;
   }
-  const PetscReal t[2] = {-force[1] / fn, force[0] / fn};
-  PetscReal       m0 = 0, m1 = 0, m2 = 0;
-  for (PetscInt i = 0; i < Rfom_; ++i) {
-    const PetscReal s = x[3 * (size_t)i] * t[0] + x[3 * (size_t)i + 1] * t[1], f = lam[i] * w[i];
-    m0 += f;
-    m1 += f * s;
-    m2 += f * s * s;
-  }
-  if (m0 > 0) {
-    out->halfwidth     = 2 * std::sqrt(std::max<PetscReal>(0, m2 / m0 - (m1 / m0) * (m1 / m0)));
-    out->contactLength = 2 * out->halfwidth;
+  const PetscReal  t[2] = {-force[1] / fn, force[0] / fn};
+  PressureMoments2 pm;
+  for (PetscInt i = 0; i < Rfom_; ++i) pm.Add(x[3 * (size_t)i] * t[0] + x[3 * (size_t)i + 1] * t[1], lam[i] * w[i]);
+  PetscReal a;
+  if (pm.HalfWidth(&a)) {
+    out->halfwidth     = a;
+    out->contactLength = 2 * a;
   }
 }
 
