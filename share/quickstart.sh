@@ -150,6 +150,8 @@ t, ro = r["test"], r["rom"]
 print("3D ROM sphere_block3d (%d random points, %d dofs): N %d R %d Mc %d" % (t["n"], ro["ndofs"], ro["N"], ro["R"], ro["Mc"]))
 print("  max rel err u %.2e (target 1e-3), lambda %.2e (target 2e-2), force %.2e (target 1e-3); online median %.2e s (in a sweep %.2e s), FOM median %.2e s, speedup %.0f"
       % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], r["online_time_s"]["median"], r["online_time_s"]["sweep_median"], r["fom_time_s"]["median"], r["speedup_median"]))
+print("  outputs computed online (no mesh) against the FOM's: max rel err max pressure %.2e, contact radius %.2e"
+      % (t["max_rel_err_max_pressure_online"], t["max_rel_err_contact_radius_online"]))
 PY
   # one online answer of the 3D ROM on the mesh: the deformed bodies and the pressure on the slave surface
   rbc online "results/sphere_block3d/online.json" -rom "results/sphere_block3d/rom.h5" -mu 1.1,0.045 -online_repeat 1000 -options_file runs/sphere_block3d.opts -rom_reconstruct "results/sphere_block3d/online_fields.h5"
