@@ -6,7 +6,8 @@
 //   2. the primal change Relax returns = |g - x| / |x| computed here; the history holds every iterate;
 //   3. max_it 1 is the linearized model (converged after one iterate); a loop that runs out of iterations
 //      reports it with the option names and the history;
-//   4. the options: -t_kacanov_max_it, _anderson, _relaxation read with the prefix; out-of-range values refused.
+//   4. the options: -t_kacanov_max_it, _anderson, _relaxation read with the prefix; out-of-range values refused;
+//   5. Cycle: the period and start of a cycle the history ends in, and the message naming it.
 #include "rbcontact/kacanov_loop.hpp"
 #include <petscblaslapack.h>
 #include <cmath>
@@ -147,6 +148,49 @@ int main(int argc, char **argv)
     const std::string msg = loop.NotConverged(true);
     Check(!conv && it == 3 && msg.find("did not converge in 3") != std::string::npos && msg.find("-kacanov_max_it") != std::string::npos && msg.find("it 3: du") != std::string::npos,
           "max_it 3, tolerance 1e-12: not converged, message names the option and the history", (double)it, 3);
+  }
+  {
+    // Cycle: a history that ends in a cycle (the reduced model of a 2 x 5 half_disks grid at one test parameter,
+    // docs/greedy_training.md: period 3 after a transient) is named with its period and start; a converging one, a
+    // period broken by a change of 1e-3 or by another active count, and fewer than three periods are not
+    auto record = [](KacanovLoop &l, const std::vector<double> &du, const std::vector<double> &dl, const std::vector<PetscInt> &na) -> PetscErrorCode {
+      bool c;
+      PetscFunctionBeginUser;
+      l.Begin(1);
+      for (size_t i = 0; i < du.size(); ++i) PetscCall(l.Record(PETSC_COMM_SELF, (PetscInt)i + 1, du[i], dl[i], na[i], 13, nullptr, &c));
+      PetscFunctionReturn(0);
+    };
+    KacanovLoop              loop(1e-5, 1e-4, "test");
+    std::vector<double>      du{2.5e-3, 9.8e-4, 5.9e-4, 5.1e-4}, dl{1e-1, 6.3e-2, 1.6e-2, 3.4e-2};
+    std::vector<PetscInt>    na{7, 7, 7, 8};
+    const double             cu[3] = {4.386e-4, 4.825e-4, 2.752e-4}, cl[3] = {2.534e-2, 2.510e-2, 2.113e-2};
+    for (int k = 0; k < 12; ++k) {
+      du.push_back(cu[k % 3] * (1 + 1e-9 * (k % 2))); // equal to rounding
+      dl.push_back(cl[k % 3]);
+      na.push_back(7);
+    }
+    PetscCall(record(loop, du, dl, na));
+    PetscInt from = 0;
+    const PetscInt per = loop.Cycle(&from);
+    const std::string msg = loop.NotConverged(false);
+    Check(per == 3 && from == 5 && msg.find("repeat with period 3 from iterate 5") != std::string::npos, "a history ending in a period-3 cycle after 4 transient iterates: period 3 from iterate 5, in the message", (double)per, 3);
+    std::vector<double> dc(16), lc(16);
+    for (int k = 0; k < 16; ++k) {
+      dc[k] = 1e-2 * std::pow(0.5, k);
+      lc[k] = 1e-1 * std::pow(0.5, k);
+    }
+    PetscCall(record(loop, dc, lc, std::vector<PetscInt>(16, 7)));
+    Check(loop.Cycle() == 0 && loop.NotConverged(false).find("repeat") == std::string::npos, "a converging history: no cycle, none in the message", (double)loop.Cycle(), 0);
+    std::vector<double> db = du;
+    db[du.size() - 2] *= 1 + 1e-3;
+    PetscCall(record(loop, db, dl, na));
+    Check(loop.Cycle() == 0, "the same history with one change off by 1e-3 among the last 6: no cycle", (double)loop.Cycle(), 0);
+    std::vector<PetscInt> nb = na;
+    nb.back() = 8;
+    PetscCall(record(loop, du, dl, nb));
+    Check(loop.Cycle() == 0, "the same history with another active count at the last iterate: no cycle", (double)loop.Cycle(), 0);
+    PetscCall(record(loop, std::vector<double>(du.end() - 8, du.end()), std::vector<double>(dl.end() - 8, dl.end()), std::vector<PetscInt>(8, 7)));
+    Check(loop.Cycle() == 0, "8 iterates of a period-3 cycle (fewer than three periods): not called one", (double)loop.Cycle(), 0);
   }
   {
     // the dual change against multipliers the loop did not compute (a warm start's): recorded, not tested

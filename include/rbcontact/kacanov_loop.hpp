@@ -41,8 +41,13 @@ public:
   // The next input from the input x and its (relaxed) image g: Anderson's mix, or g itself. Returns true
   // when next differs from g (a mix was used).
   bool Next(const PetscReal *x, const PetscReal *g, PetscReal *next);
-  // "did not converge in ... iterations (options); last changes ..." with the history when withHistory.
+  // "did not converge in ... iterations (options); last changes ..." with the history when withHistory; when the
+  // history ends in a cycle (Cycle), the message says so.
   std::string NotConverged(bool withHistory) const;
+  // The period p (2..12) of a cycle the history ends in: its last 2p iterates repeat the p before them (du and dl to
+  // 1e-6 relative, the active counts exactly), the smallest such p; 0 when there is none. *from: the first iterate
+  // (1-based) of the repeating stretch. A converging loop's changes fall, so they never repeat.
+  PetscInt Cycle(PetscInt *from = nullptr) const;
   // The relative change rule: diff / prev, or 0 / infinity when prev = 0 (cur = 0 / cur != 0).
   static PetscReal RelChange(PetscReal diff, PetscReal prev, PetscReal cur);
 

@@ -74,12 +74,34 @@ bool KacanovLoop::Next(const PetscReal *x, const PetscReal *g, PetscReal *next)
   return false;
 }
 
+PetscInt KacanovLoop::Cycle(PetscInt *from) const
+{
+  const auto &du = history.du, &dl = history.dl;
+  const auto &na    = history.nactive;
+  const size_t n     = du.size();
+  auto         close = [](PetscReal a, PetscReal b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); };
+  auto         same  = [&](size_t j, size_t p) { return close(du[j], du[j - p]) && close(dl[j], dl[j - p]) && na[j] == na[j - p]; };
+  for (size_t p = 2; p <= 12 && 3 * p <= n; ++p) {
+    bool cyc = true;
+    for (size_t i = 0; i < 2 * p && cyc; ++i) cyc = same(n - 1 - i, p);
+    if (!cyc) continue;
+    size_t s = n - 2 * p; // the repeating stretch starts at s - p at the latest: walk back while the match holds
+    while (s > p && same(s - 1, p)) --s;
+    if (from) *from = (PetscInt)(s - p) + 1;
+    return (PetscInt)p;
+  }
+  return 0;
+}
+
 std::string KacanovLoop::NotConverged(bool withHistory) const
 {
   const std::string  p = "-" + prefix_ + "kacanov_";
   std::ostringstream o;
   o << label << " iterations did not converge in " << maxIt << " iterations (" << p << "max_it; tolerances " << p << "rtol_primal " << rtolPrimal << ", " << p << "rtol_dual " << rtolDual << "; try " << p << "relaxation 0.5)";
   if (!history.du.empty()) o << "; last changes du " << history.du.back() << ", dlambda " << history.dl.back();
+  PetscInt from = 0;
+  if (const PetscInt per = Cycle(&from))
+    o << "; the changes repeat with period " << per << " from iterate " << from << ": a cycle, not a slow approach, so more iterations do not help (a smaller " << p << "relaxation may; for a reduced model, a cycle that damping does not remove says the training set does not resolve this parameter)";
   if (withHistory) {
     o << ". History:";
     for (size_t i = 0; i < history.du.size(); ++i) o << "\n  it " << i + 1 << ": du " << history.du[i] << ", dlambda " << history.dl[i] << ", active " << history.nactive[i];
