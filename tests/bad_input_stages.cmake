@@ -30,6 +30,8 @@ rbc_bad_stage(int_value_unparsed "Input string 2x has no integer value.*[(]optio
 rbc_bad_stage(bool_value_unparsed "Unknown logical value: maybe [(]option -contact maybe[)]" fom -options_file runs/ring_on_block.opts -contact maybe)
 # an option naming a body that -bodies does not declare (a misspelled body left its map silently unused)
 rbc_bad_stage(map_unknown_body "option -map_rign names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -map_rign dilation)
+# an array option given more values than it takes (PETSc drops those beyond its buffer without a word)
+rbc_bad_stage(map_center_too_many "-map_ring_dilation_center takes at most 3 coordinates, more were given" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center 0,0.005,0,1)
 rbc_bad_stage(param_unknown_body "option -param_E_blok names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -param_E_blok radius)
 rbc_bad_stage(dirichlet_value_missing "-dirichlet_slave_u is not given: -dirichlet lists the label 'slave'" fom -options_file runs/ring_on_block.opts -dirichlet ring_top,block_bottom,slave)
 # the parameter names in a count mismatch; an out-of-box value with the digits that were given

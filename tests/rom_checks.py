@@ -937,6 +937,7 @@ def dual_refit(args):
                                (sel + ["-dual_select_refit", "-dual_select_refit_slack", "-0.5"], ["-dual_select_refit_slack", "-0.5"], "a negative refit slack"),
                                (sel + ["-dual_select_refit", "-dual_select_refit_ecsw_tol", "2"], ["-dual_select_refit_ecsw_tol", "2"], "a refit tolerance of 2"),
                                (sel + ["-dual_select_floor", "1e-3,2e-2"], ["-dual_select_floor", "3 values", "2 given"], "two floors"),
+                               (sel + ["-dual_select_floor", "1e-3,2e-2,1e-3,1e-3"], ["-dual_select_floor", "3 values", "more than 3 given"], "four floors"),
                                (sel + ["-dual_select_floor", "1e-3,-2e-2,1e-3"], ["-dual_select_floor", "lambda floor", "-0.02"], "a negative floor"),
                                (sel + ["-dual_select_floor", "1e-3,nan,1e-3"], ["-dual_select_floor", "lambda floor"], "a NaN floor"),
                                (["-dual_truncate", "5", "-estimate"], ["-dual_truncate", "-estimate"], "-dual_truncate with -estimate")):

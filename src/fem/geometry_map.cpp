@@ -195,11 +195,12 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
       PetscCall(PetscOptionsReal((bp + "_ref").c_str(), "Parameter value of the mesh (default: -mu_default)", "docs/reference_configuration.md", ref, &ref, NULL));
       PetscCheck(ref != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_ref must be nonzero", bp.c_str());
       if (kind == "dilation" || kind == "translation") {
-        PetscReal v[3] = {0, 0, 0};
-        PetscInt  n    = 3;
+        PetscReal v[4] = {0, 0, 0, 0}; // (room for a fourth value: PETSc drops the values beyond the buffer silently)
+        PetscInt  n    = 4;
         const std::string opt = bp + (kind == "dilation" ? "_center" : "_dir");
         PetscCall(PetscOptionsRealArray(opt.c_str(), kind == "dilation" ? "Fixed point of the dilation" : "Direction of the translation", "docs/reference_configuration.md", v, &n, &flg));
         PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s is required", opt.c_str());
+        PetscCheck(n <= 3, comm, PETSC_ERR_ARG_SIZ, "%s takes at most 3 coordinates, more were given", opt.c_str());
         const std::array<PetscReal, 3> a = {v[0], v[1], v[2]};
         if (kind == "dilation") bodies[b].blocks.push_back(std::make_unique<Dilation>(p, ref, a));
         else bodies[b].blocks.push_back(std::make_unique<Translation>(p, ref, a));

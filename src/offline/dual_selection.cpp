@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <string>
 #include "rbcontact/snapshot_file.hpp"
 #include "rbcontact/training_set.hpp"
 
@@ -11,8 +12,8 @@ namespace rbc {
 PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
 {
   char      path[PETSC_MAX_PATH_LEN] = "";
-  PetscInt  rbuf[256], nr = 256, nf = 3;
-  PetscReal fbuf[3] = {o->floor.u, o->floor.lambda, o->floor.force};
+  PetscInt  rbuf[256], nr = 256, nf = 4; // (room for a fourth value: PETSc drops the values beyond the buffer silently)
+  PetscReal fbuf[4] = {o->floor.u, o->floor.lambda, o->floor.force, 0};
   PetscBool fset = PETSC_FALSE;
   PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE, refit = o->refit ? PETSC_TRUE : PETSC_FALSE;
 
@@ -32,7 +33,7 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCall(PetscOptionsRealArray("-floor", "u,lambda,force: held-out max (and mean) errors at or below these pass the choice's and the refit's relative rules (0: off; e.g. a quarter of the targets)", "", fbuf, &nf, &fset));
   PetscOptionsEnd();
   if (fset) {
-    PetscCheck(nf == 3, comm, PETSC_ERR_ARG_SIZ, "-dual_select_floor takes 3 values (u,lambda,force: relative errors), %" PetscInt_FMT " given", nf);
+    PetscCheck(nf == 3, comm, PETSC_ERR_ARG_SIZ, "-dual_select_floor takes 3 values (u,lambda,force: relative errors), %s given", nf < 4 ? std::to_string(nf).c_str() : "more than 3");
     for (PetscInt k = 0; k < 3; ++k) PetscCheck(std::isfinite((double)fbuf[k]) && fbuf[k] >= 0 && fbuf[k] < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_floor: the %s floor %g is not in [0, 1) (relative errors)", k == 0 ? "u" : k == 1 ? "lambda" : "force", (double)fbuf[k]);
     o->floor = DualErrorFloor{fbuf[0], fbuf[1], fbuf[2]};
   }
