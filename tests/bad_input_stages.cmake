@@ -32,6 +32,12 @@ rbc_bad_stage(bool_value_unparsed "Unknown logical value: maybe [(]option -conta
 rbc_bad_stage(map_unknown_body "option -map_rign names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -map_rign dilation)
 # an array option given more values than it takes (PETSc drops those beyond its buffer without a word)
 rbc_bad_stage(map_center_too_many "-map_ring_dilation_center takes at most 3 coordinates, more were given" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center 0,0.005,0,1)
+string(REPEAT "100," 64 RBC_65_VALUES)
+string(APPEND RBC_65_VALUES "100")
+rbc_bad_stage(array_too_long "option -body_E takes at most 64 values, more were given" fom -options_file runs/ring_on_block.opts -body_E ${RBC_65_VALUES})
+string(REPEAT "nosuch.h5," 16 RBC_17_FILES)
+string(APPEND RBC_17_FILES "nosuch.h5")
+rbc_bad_stage(snapshots_from_too_many "-snapshots_from takes at most 16 files, more were given" offline -options_file runs/ring_on_block.opts -snapshots_from ${RBC_17_FILES} -rom /tmp/rbc_never.h5)
 rbc_bad_stage(param_unknown_body "option -param_E_blok names no body of -bodies [(]ring, block[)]" fom -options_file runs/ring_on_block.opts -param_E_blok radius)
 rbc_bad_stage(dirichlet_value_missing "-dirichlet_slave_u is not given: -dirichlet lists the label 'slave'" fom -options_file runs/ring_on_block.opts -dirichlet ring_top,block_bottom,slave)
 # the parameter names in a count mismatch; an out-of-box value with the digits that were given

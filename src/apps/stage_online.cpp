@@ -24,8 +24,8 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   ReducedModel   model;
   ReducedSolution sol;
 
-  PetscInt       nmu = 16;
-  PetscReal      muIn[16] = {0}; // -help prints muIn[0] of an unset -mu
+  PetscInt       nmu = 65;       // (one more than taken: PETSc drops values beyond the buffer silently)
+  PetscReal      muIn[65] = {0}; // -help prints muIn[0] of an unset -mu
   PetscBool      muSet = PETSC_FALSE;
 
   PetscFunctionBeginUser;
@@ -42,6 +42,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     PetscBool hasMu = PETSC_FALSE;
     PetscCall(PetscOptionsHasName(NULL, NULL, "-mu", &hasMu));
     PetscCheck(!hasMu || (muSet && nmu > 0), comm, PETSC_ERR_USER_INPUT, "option -mu is given without a value (the scene's defaults are used only without -mu)");
+    PetscCheck(!muSet || nmu <= 64, comm, PETSC_ERR_ARG_SIZ, "option -mu takes at most 64 values, more were given");
     for (PetscInt i = 0; muSet && i < nmu; ++i) PetscCheck(std::isfinite(muIn[i]), comm, PETSC_ERR_USER_INPUT, "option -mu: value %" PetscInt_FMT " is not a finite number", i + 1);
   }
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));

@@ -46,12 +46,13 @@ static PetscErrorCode GetString(PetscOptionItems *PetscOptionsObject, const char
 
 static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscReal> *v, PetscBool *set)
 {
-  PetscReal buf[64] = {0}; // -help prints buf[0] of an unset option
-  PetscInt  n = 64;
+  PetscReal buf[65] = {0}; // -help prints buf[0] of an unset option; one more than taken: PETSc drops values beyond the buffer silently
+  PetscInt  n = 65;
   PetscBool flg;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsRealArray(name, text, kMan, buf, &n, &flg));
+  PetscCheck(!flg || n <= 64, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "option %s takes at most 64 values, more were given", name);
   // every rank reads the same options: a local error on each (no collective, no hang)
   PetscBool has = PETSC_FALSE;
   PetscCall(PetscOptionsHasName(NULL, NULL, name, &has));
@@ -65,12 +66,13 @@ static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const c
 
 static PetscErrorCode GetIntArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscInt> *v, PetscBool *set)
 {
-  PetscInt  buf[64] = {0};
-  PetscInt  n = 64;
+  PetscInt  buf[65] = {0}; // one more than taken: PETSc drops values beyond the buffer silently
+  PetscInt  n = 65;
   PetscBool flg;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsIntArray(name, text, kMan, buf, &n, &flg));
+  PetscCheck(!flg || n <= 64, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "option %s takes at most 64 values, more were given", name);
   if (flg) v->assign(buf, buf + n);
   if (set) *set = flg;
   PetscFunctionReturn(0);

@@ -12,7 +12,7 @@ namespace rbc {
 PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
 {
   char      path[PETSC_MAX_PATH_LEN] = "";
-  PetscInt  rbuf[256], nr = 256, nf = 4; // (room for a fourth value: PETSc drops the values beyond the buffer silently)
+  PetscInt  rbuf[257], nr = 257, nf = 4; // (one value more than taken: PETSc drops the values beyond the buffer silently)
   PetscReal fbuf[4] = {o->floor.u, o->floor.lambda, o->floor.force, 0};
   PetscBool fset = PETSC_FALSE;
   PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE, refit = o->refit ? PETSC_TRUE : PETSC_FALSE;
@@ -42,6 +42,7 @@ PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
   PetscCall(PetscOptionsInt("-truncate", "keep the leading dual vectors (and their supremizers) only, before the online model (0: all)", "", o->truncate, &o->truncate, NULL));
   PetscOptionsEnd();
   if (pset) o->snapshots = path;
+  PetscCheck(!rset || nr <= 256, comm, PETSC_ERR_ARG_SIZ, "-dual_select_R takes at most 256 values, more were given");
   if (rset) o->candidates.assign(rbuf, rbuf + nr);
   PetscCheck(o->size >= 0 && o->size <= 10000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_size %" PetscInt_FMT " out of range [0, 1e4]", o->size);
   PetscCheck(o->slack >= 0 && o->slack <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_select_slack %g out of range [0, 10]", (double)o->slack);

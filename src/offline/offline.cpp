@@ -65,14 +65,15 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
   PetscCall(PetscOptionsString("-offline_basis_output", "write the POD modes, supremizers and dual basis on the mesh to this HDF5 file (+ .xmf for ParaView)", "", viewPath, viewPath, sizeof viewPath, NULL));
   {
-    char     *from[16] = {NULL};
-    PetscInt  nfrom    = 16;
+    char     *from[17] = {NULL}; // (one more than taken: PETSc drops values beyond the buffer silently)
+    PetscInt  nfrom    = 17;
     PetscBool set      = PETSC_FALSE;
     PetscCall(PetscOptionsStringArray("-snapshots_from", "copy the done snapshots of these snapshot files (same scene and mesh) at points of this training set, before solving the rest", "", from, &nfrom, &set));
     for (PetscInt i = 0; i < (set ? nfrom : 0); ++i) {
       s->from.emplace_back(from[i]);
       PetscCall(PetscFree(from[i]));
     }
+    PetscCheck(!set || nfrom <= 16, comm, PETSC_ERR_ARG_SIZ, "-snapshots_from takes at most 16 files, more were given");
   }
   PetscCall(PetscOptionsString("-snapshots_initial_guess", "a contact snapshot's solve starts from: zero (the reference configuration) or nearest (its group's nearest snapshot solved earlier in this run, extrapolated by its sensitivities if stored; docs/offline.md)", "", guess, guess, sizeof guess, NULL));
   PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));

@@ -32,8 +32,8 @@ namespace rbc {
 
 PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &reportPath, ValidationSettings *s)
 {
-  PetscInt  nf = 32;
-  PetscReal fbuf[32];
+  PetscInt  nf = 33; // (one more than taken, here and below: PETSc drops values beyond the buffer silently)
+  PetscReal fbuf[33];
   PetscBool fset = PETSC_FALSE, sweep = s->sweep ? PETSC_TRUE : PETSC_FALSE, residual = s->residual ? PETSC_TRUE : PETSC_FALSE;
   char      sweepOut[PETSC_MAX_PATH_LEN];
 
@@ -52,17 +52,20 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   }
   PetscCall(PetscOptionsBool("-validate_sweep", "also the speed-against-error sweep over truncated sizes", "", sweep, &sweep, NULL));
   PetscCall(PetscOptionsRealArray("-validate_sweep_fractions", "fractions of N, R (and the EIM sizes) of the sweep's rows", "", fbuf, &nf, &fset));
+  PetscCheck(!fset || nf <= 32, comm, PETSC_ERR_ARG_SIZ, "-validate_sweep_fractions takes at most 32 values, more were given");
   PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
   {
-    PetscInt  rbuf[256], nr = 256;
+    PetscInt  rbuf[257], nr = 257;
     PetscBool rset = PETSC_FALSE;
     PetscCall(PetscOptionsIntArray("-validate_sweep_R", "also the errors with these numbers of dual vectors (all POD modes; untimed)", "", rbuf, &nr, &rset));
+    PetscCheck(!rset || nr <= 256, comm, PETSC_ERR_ARG_SIZ, "-validate_sweep_R takes at most 256 values, more were given");
     if (rset) s->rValues.assign(rbuf, rbuf + nr);
   }
   {
-    PetscInt  tbuf[64], ntb = 64;
+    PetscInt  tbuf[65], ntb = 65;
     PetscBool tset = PETSC_FALSE;
     PetscCall(PetscOptionsIntArray("-validate_threads", "also time the online solves with these numbers of threads (-rom_threads; report online_time_s.by_threads)", "", tbuf, &ntb, &tset));
+    PetscCheck(!tset || ntb <= 64, comm, PETSC_ERR_ARG_SIZ, "-validate_threads takes at most 64 values, more were given");
     if (tset) s->threadValues.assign(tbuf, tbuf + ntb);
   }
   PetscCall(PetscOptionsBool("-validate_residual", "also the residual of each reduced solution on the mesh (the greedy indicator) and its effectivity against the energy error", "", residual, &residual, NULL));

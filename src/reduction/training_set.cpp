@@ -189,7 +189,7 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   const std::string pre = prefix ? prefix : "";
   const std::string optType = "-" + pre + "type", optSize = "-" + pre + "size", optSeed = "-" + pre + "seed", optFile = "-" + pre + "file";
   char              typeBuf[64] = "", fileBuf[PETSC_MAX_PATH_LEN] = "";
-  PetscInt          sizes[64], nsizes = 64, seed = defSeed;
+  PetscInt          sizes[65], nsizes = 65, seed = defSeed; // (one more than taken: PETSc drops values beyond the buffer silently)
   PetscBool         flgSize = PETSC_FALSE, flgFile = PETSC_FALSE;
   std::string       type, file;
   PetscMPIInt       rank;
@@ -208,6 +208,7 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
 
   PetscCheck(type == "grid" || type == "random" || type == "lhs" || type == "file", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "Unknown value '%s' for option %s (grid, random, lhs or file%s)", type.c_str(), optType.c_str(), pre == "train_" ? "; the offline stage also takes greedy" : "");
   PetscCheck(seed >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT " must be >= 0", optSeed.c_str(), seed);
+  PetscCheck(!flgSize || nsizes <= 64, comm, PETSC_ERR_ARG_SIZ, "%s takes at most 64 values, more were given", optSize.c_str());
   std::vector<PetscInt> counts;
   if (flgSize) counts.assign(sizes, sizes + nsizes);
   for (PetscInt c : counts) PetscCheck(c >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: %" PetscInt_FMT " samples; every count must be >= 1", optSize.c_str(), c);
