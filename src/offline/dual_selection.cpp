@@ -12,7 +12,7 @@ namespace rbc {
 PetscErrorCode DualSelectionFromOptions(MPI_Comm comm, DualSelectionOptions *o)
 {
   char      path[PETSC_MAX_PATH_LEN] = "";
-  PetscInt  rbuf[257], nr = 257, nf = 4; // (one value more than taken: PETSc drops the values beyond the buffer silently)
+  PetscInt  rbuf[257] = {0}, nr = 257, nf = 4; // (one value more than taken: PETSc drops the values beyond the buffer silently)
   PetscReal fbuf[4] = {o->floor.u, o->floor.lambda, o->floor.force, 0};
   PetscBool fset = PETSC_FALSE;
   PetscBool pset = PETSC_FALSE, rset = PETSC_FALSE, estimate = PETSC_FALSE, refit = o->refit ? PETSC_TRUE : PETSC_FALSE;

@@ -33,7 +33,7 @@ namespace rbc {
 PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &reportPath, ValidationSettings *s)
 {
   PetscInt  nf = 33; // (one more than taken, here and below: PETSc drops values beyond the buffer silently)
-  PetscReal fbuf[33];
+  PetscReal fbuf[33] = {0.2, 0.4, 0.6, 0.8, 1.0}; // (-help prints its first value: the default's)
   PetscBool fset = PETSC_FALSE, sweep = s->sweep ? PETSC_TRUE : PETSC_FALSE, residual = s->residual ? PETSC_TRUE : PETSC_FALSE;
   char      sweepOut[PETSC_MAX_PATH_LEN];
 
@@ -55,14 +55,14 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   PetscCheck(!fset || nf <= 32, comm, PETSC_ERR_ARG_SIZ, "-validate_sweep_fractions takes at most 32 values, more were given");
   PetscCall(PetscOptionsString("-validate_sweep_output", "stem of the sweep's .json and .csv (default: the report's, + _sweep)", "", sweepOut, sweepOut, sizeof sweepOut, NULL));
   {
-    PetscInt  rbuf[257], nr = 257;
+    PetscInt  rbuf[257] = {0}, nr = 257; // (initialized: -help prints the first value)
     PetscBool rset = PETSC_FALSE;
     PetscCall(PetscOptionsIntArray("-validate_sweep_R", "also the errors with these numbers of dual vectors (all POD modes; untimed)", "", rbuf, &nr, &rset));
     PetscCheck(!rset || nr <= 256, comm, PETSC_ERR_ARG_SIZ, "-validate_sweep_R takes at most 256 values, more were given");
     if (rset) s->rValues.assign(rbuf, rbuf + nr);
   }
   {
-    PetscInt  tbuf[65], ntb = 65;
+    PetscInt  tbuf[65] = {1}, ntb = 65;
     PetscBool tset = PETSC_FALSE;
     PetscCall(PetscOptionsIntArray("-validate_threads", "also time the online solves with these numbers of threads (-rom_threads; report online_time_s.by_threads)", "", tbuf, &ntb, &tset));
     PetscCheck(!tset || ntb <= 64, comm, PETSC_ERR_ARG_SIZ, "-validate_threads takes at most 64 values, more were given");
