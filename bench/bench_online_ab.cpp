@@ -59,8 +59,8 @@ double Median(std::vector<double> x)
 int main(int argc, char **argv)
 {
   char      rom[PETSC_MAX_PATH_LEN] = "", a[512] = "", b[512] = "";
-  PetscReal mu[8];
-  PetscInt  nmu = 8, pairs = 30, block = 20, nrand = 0, seed = 1;
+  PetscReal mu[9]; // (one more than taken: PETSc drops values beyond the buffer silently)
+  PetscInt  nmu = 9, pairs = 30, block = 20, nrand = 0, seed = 1;
   PetscBool set = PETSC_FALSE, muSet = PETSC_FALSE;
 
   PetscCall(SlepcInitialize(&argc, &argv, NULL, "rbc_bench_online_ab -rom rom.h5 -a \"options\" -b \"options\"\n"));
@@ -69,6 +69,7 @@ int main(int argc, char **argv)
   PetscCall(PetscOptionsGetString(NULL, NULL, "-a", a, sizeof a, NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-b", b, sizeof b, NULL));
   PetscCall(PetscOptionsGetRealArray(NULL, NULL, "-mu", mu, &nmu, &muSet));
+  PetscCheck(!muSet || nmu <= 8, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "-mu takes at most 8 values, more were given");
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-pairs", &pairs, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-block", &block, NULL));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-mu_random", &nrand, NULL));

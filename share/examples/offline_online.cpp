@@ -17,13 +17,14 @@ static const char help[] = "Offline, validation and online solves of a scene's r
 
 int main(int argc, char **argv)
 {
-  PetscInt        sizes[16] = {3, 5}, nsizes = 16;
+  PetscInt        sizes[17] = {3, 5}, nsizes = 17; // (one more than taken: PETSc drops values beyond the buffer silently)
   PetscBool       set       = PETSC_FALSE;
   rbc::SceneSpec  scene;
 
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(PetscOptionsGetIntArray(NULL, NULL, "-sizes", sizes, &nsizes, &set));
   if (!set) nsizes = 2;
+  PetscCheck(nsizes <= 16, PETSC_COMM_WORLD, PETSC_ERR_ARG_SIZ, "-sizes takes at most 16 values, more were given");
   PetscCall(rbc::SceneSpecFromOptions(PETSC_COMM_WORLD, &scene)); // meshes, bodies, contact, parameters
   PetscCall(PetscOptionsSetValue(NULL, "-train_type", "grid"));
   PetscCall(PetscOptionsSetValue(NULL, "-test_type", "random"));
