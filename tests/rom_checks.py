@@ -14,6 +14,9 @@
   eim_train   extra EIM training radii (no FOM solves) shrink the EIM's share of the error.
   half_disks  two parameters (radius, imposed displacement): the whole pipeline runs, the ROM converges
               and its errors are reported.
+  probe       the ROM solved over its box without the FOM: offline's warning on a training set whose reduced loop
+              fails (half_disks 2 x 5), the `online -mu` it names, the probe stage on 1 and 2 ranks, -offline_probe_fail,
+              the largest estimated errors against online's, bad input.
   estimate    offline -estimate (docs/error_estimate.md): the enrichment and calibration in the ROM file, the same on
               1 and 2 ranks; online reports the estimate (and why not with -rom_error_estimate false or without an
               enrichment); its raw changes against a separate solve with every stored basis function; validate's
@@ -1054,6 +1057,63 @@ def estimate(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def probe(args):
+    """The ROM solved over its box without the FOM (offline's last step, the `probe` stage; docs/online.md "Probing a model")."""
+    d = tempfile.mkdtemp(prefix="rbc_rom_probe_")
+    # half_disks on 2 radii x 5 displacements with sensitivities: a model whose reduced loop cycles at some parameters
+    # (docs/greedy_training.md "Grid 2 x 5's failure"); the offline stage warns and names one
+    opts = ["-options_file", "runs/half_disks.opts", "-snapshots_sensitivities", "-ecsw_tol", "1e-4", "-train_type", "grid", "-train_size", "2,5"]
+    p = run(args, 2, "offline", opts + ["-rom", d + "/bad.h5", "-report", d + "/bad.json"])
+    pr = report(d + "/bad.json")["probe"]
+    m = re.search(r"warning: the reduced model \S+ failed at (\d+) of 1000 probe parameters; first at probe parameter \d+ \(radius [0-9.e+-]+, displacement [0-9.e+-]+; online -mu ([0-9.e+-]+,[0-9.e+-]+)\)", p.stdout)
+    check(pr["size"] == 1000 and pr["type"] == "lhs" and pr["failed"] > 0 and m is not None and int(m.group(1)) == pr["failed"],
+          "grid 2 x 5: offline warns that the ROM failed at %s of 1000 probe parameters, naming the first and its online -mu" % pr["failed"])
+    check(pr["out_of_range"] > 0 and "first_out_of_range" in pr and "reached the edge of the stored contact data" in p.stdout,
+          "grid 2 x 5: the probe parameters with projections at the edge of the stored data counted (%s) and warned" % pr["out_of_range"])
+    if m:
+        q = run(args, 1, "online", ["-rom", d + "/bad.h5", "-mu", m.group(2)], expect_ok=False)
+        check(q.returncode != 0 and "did not converge" in q.stdout, "online -mu %s (the parameter the probe named): the same failure" % m.group(2))
+    # the probe stage on the same file: 1 and 2 ranks count the same failures (each point is solved alone)
+    reps = {}
+    for np_ in (1, 2):
+        q = run(args, np_, "probe", ["-rom", d + "/bad.h5", "-report", "%s/p%d.json" % (d, np_)], expect_ok=False)
+        check(q.returncode != 0 and "probe parameters; first at probe parameter" in q.stdout, "probe stage, %d rank(s): exit code and the first failure named" % np_)
+        reps[np_] = q.stdout
+    f1 = re.search(r"failed at (\d+) of 1000 probe parameters; first at probe parameter (\d+)", reps[1])
+    f2 = re.search(r"failed at (\d+) of 1000 probe parameters; first at probe parameter (\d+)", reps[2])
+    check(f1 is not None and f2 is not None and f1.groups() == f2.groups() and int(f1.group(1)) == pr["failed"],
+          "probe stage: the same failures on 1 and 2 ranks and as offline's probe (%s, %s)" % (f1 and f1.groups(), f2 and f2.groups()))
+    # -offline_probe_fail: an error, the ROM file still written
+    p = run(args, 2, "offline", opts + ["-rom", d + "/bad.h5", "-offline_probe_fail", "-report", d + "/fail.json"], expect_ok=False)
+    check(p.returncode != 0 and "-offline_probe_fail" in p.stdout and os.path.exists(d + "/bad.h5"), "-offline_probe_fail: an error naming it, the ROM file kept")
+    # the shipped ring model: no failure, no projection at the edge; with an estimate, the largest one and where it is
+    rom, off = offline(args, d, np_=2, extra=["-estimate", "-probe_size", "200"])
+    pr = off["probe"]
+    check(pr["size"] == 200 and pr["failed"] == 0 and pr["out_of_range"] == 0 and pr["estimate_available"],
+          "ring_on_block: 200 probe parameters, none failed, none at the edge (%s), estimates available" % pr["out_of_range"])
+    for np_ in (1, 2):
+        run(args, np_, "probe", ["-rom", rom, "-probe_size", "200", "-report", "%s/q%d.json" % (d, np_)])
+    q1, q2 = report(d + "/q1.json")["probe"], report(d + "/q2.json")["probe"]
+    same = all(abs(q1["estimate"][k]["max"] - q2["estimate"][k]["max"]) <= 1e-12 * q2["estimate"][k]["max"] and q1["estimate"][k]["mu"] == q2["estimate"][k]["mu"] for k in ("u", "lambda", "force"))
+    check(same and q1["kacanov_iterations"] == q2["kacanov_iterations"], "probe stage: the same largest estimates and iterations on 1 and 2 ranks")
+    for k in ("u", "lambda", "force"):
+        mu = q2["estimate"][k]["mu"]["radius"]
+        run(args, 1, "online", ["-rom", rom, "-mu", repr(mu), "-report", d + "/on.json"])
+        e = report(d + "/on.json")["error_estimate"]
+        check(abs(e[k] - q2["estimate"][k]["max"]) <= 1e-10 * e[k], "the largest estimated %s error (%.3e at radius %.6f) is online's there (%.3e)" % (k, q2["estimate"][k]["max"], mu, e[k]))
+    check(all(abs(q2["estimate"][k]["max"] - pr["estimate"][k]["max"]) <= 1e-12 * pr["estimate"][k]["max"] for k in ("u", "lambda", "force")),
+          "the probe stage (same type, size and seed) gives offline's largest estimates")
+    # -offline_probe 0: no probe; bad input
+    _, off = offline(args, d, np_=1, extra=["-offline_probe", "0"])
+    check("probe" not in off, "-offline_probe 0: no probe in the report")
+    expect_error(args, [], ["-rom"], "probe without -rom", stage="probe")
+    expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5"], "probe of a missing ROM file", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_size", "0"], ["-probe_size"], "-probe_size 0", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_type", "bogus"], ["-probe_type", "bogus"], "unknown -probe_type", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_size", "5", "-probe_type", "file", "-probe_file", d + "/nosuch.txt"], ["nosuch.txt"], "missing -probe_file", stage="probe")
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def files(args):
     """Files that belong together are checked together: the ROM against the scene as configured now
     (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
@@ -1112,7 +1172,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit", "probe"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--contact-terms-exe", help="tests/test_rom_contact_terms (sphere_block3d runs it on its ROM)")
     args = ap.parse_args()

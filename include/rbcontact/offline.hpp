@@ -27,6 +27,8 @@ struct OfflineSettings {
   std::string basisView;               // -offline_basis_output: the bases on the mesh for ParaView (rom_fields.hpp, WriteBasisView)
   bool        sensitivities = false;   // -snapshots_sensitivities: every contact snapshot with du/dmu_i, dlambda/dmu_i (snapshot_sensitivity.hpp) for the bases
   std::vector<std::string> from;       // -snapshots_from a.h5,b.h5: copy their done snapshots at points of this training set (SnapshotFile::Import)
+  bool        probe = true;            // -offline_probe: solve the written ROM over its box (-probe_*, rom_probe.hpp)
+  bool        probeFail = false;       // -offline_probe_fail: a failure there is an error (default: a warning)
   std::string initialGuess = "zero";   // -snapshots_initial_guess zero|nearest: a contact solve starts from the reference configuration, or from its group's nearest earlier snapshot of this run (snapshot_continuation.hpp)
 };
 
@@ -39,7 +41,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s);
 // killed job), then builds and writes the bases and the ROM (as s.stop says). Report keys: stage, scene,
 // ntrain, train_type, nparams, fom_solves, resumed, imported, sensitivities, initial_guess, ndofs, ncontact, kacanov_iterations {min, max, mean},
 // affine_terms, time_s {snapshots, total, pod, dual, ...}, nranks, subcomms, snapshots, and the steps' keys
-// (pod, dual, nnls, eim, ecsw, rom, greedy). Collective on world.
+// (pod, dual, nnls, eim, ecsw, rom, greedy, probe). Collective on world.
 PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineSettings &s, Report *rep);
 
 // The offline stage from the options database alone, as `rbcontact offline` and the Python module run it:

@@ -1,5 +1,5 @@
 // src/apps/main.cpp: the rbcontact executable. The first argument is the stage word (fom, offline,
-// online, validate, dualbasis); PETSc options follow it. Each stage writes -report <file.json>.
+// online, validate, probe, dualbasis); PETSc options follow it. Each stage writes -report <file.json>.
 #include <petscsys.h>
 #include <slepcsys.h>
 #include <cctype>
@@ -19,6 +19,7 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "  offline   snapshots, bases, EIM -> the ROM file (-rom rom.h5; -offline_stop snapshots|bases)\n"
                            "  online    reduced solve at a parameter (-rom rom.h5 -mu v; -rom_reconstruct fields.h5)\n"
                            "  validate  ROM against FOM on a test set, speed against error (-rom rom.h5 -test_size n; -validate_sweep)\n"
+                           "  probe     ROM solved over its parameter box, no FOM: failures, iterations, estimated errors (-rom rom.h5 -probe_size n)\n"
                            "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
                            "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md, eim.md, online.md).\n";
 
@@ -32,9 +33,9 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name)
   };
   static const Family fam[] = {{"train_", "offline"},      {"snapshots", "offline dualbasis"}, {"offline_", "offline"}, {"pod_", "offline"},
                                {"dual_", "offline dualbasis"}, {"nnls_", "offline dualbasis"}, {"mcpg_", "offline dualbasis"}, {"nmf_", "offline dualbasis"},
-                               {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate"}, {"online_", "online"},
+                               {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate probe"}, {"online_", "online"},
                                {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"},
-                               {"greedy_", "offline"}};
+                               {"greedy_", "offline"},     {"probe_", "offline probe"}};
   std::string skipped; // families of the offline steps -offline_stop leaves out
   if (stage == "offline") {
     char      stop[32] = "";
@@ -51,8 +52,8 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name)
   for (const auto &f : fam)
     if (name.compare(0, std::strlen(f.prefix), f.prefix) == 0)
       return (" " + std::string(f.stages) + " ").find(" " + stage + " ") == std::string::npos || skipped.find(" " + std::string(f.prefix) + " ") != std::string::npos;
-  // online and dualbasis read their own families only (plus the scene with -rom_reconstruct)
-  if (stage == "dualbasis") return true;
+  // online, probe and dualbasis read their own families only (online: plus the scene with -rom_reconstruct)
+  if (stage == "dualbasis" || stage == "probe") return true;
   if (stage == "online") {
     PetscBool rec = PETSC_FALSE;
     (void)PetscOptionsHasName(NULL, NULL, "-rom_reconstruct", &rec);
@@ -192,8 +193,9 @@ int main(int argc, char **argv)
   else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
   else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);
   else if (stage == "validate") ierr = rbc::StageValidate(PETSC_COMM_WORLD);
+  else if (stage == "probe") ierr = rbc::StageProbe(PETSC_COMM_WORLD);
   else {
-    firstError = "unknown stage '" + stage + "' (known: fom, offline, online, validate, dualbasis)";
+    firstError = "unknown stage '" + stage + "' (known: fom, offline, online, validate, probe, dualbasis)";
     PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
     ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
   }

@@ -8,4 +8,5 @@ PetscErrorCode StageOffline(MPI_Comm comm);
 PetscErrorCode StageDualBasis(MPI_Comm comm);
 PetscErrorCode StageOnline(MPI_Comm comm);
 PetscErrorCode StageValidate(MPI_Comm comm);
+PetscErrorCode StageProbe(MPI_Comm comm);
 } // namespace rbc

@@ -3,6 +3,7 @@
 // finished round written to the snapshot file before the next starts: a killed job resumes) and the
 // bases and ROM steps (offline_bases.cpp, offline_greedy.cpp, offline_rom.cpp).
 #include "rbcontact/offline.hpp"
+#include "rbcontact/rom_probe.hpp"
 #include "rbcontact/dual_selection.hpp"
 #include "rbcontact/offline_bases.hpp"
 #include "rbcontact/offline_greedy.hpp"
@@ -32,6 +33,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
 {
   char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64], guess[64];
   PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE, sens = s->sensitivities ? PETSC_TRUE : PETSC_FALSE;
+  PetscBool probe = s->probe ? PETSC_TRUE : PETSC_FALSE, probeFail = s->probeFail ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(romPath, s->rom.c_str(), sizeof romPath));
@@ -77,6 +79,8 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   }
   PetscCall(PetscOptionsString("-snapshots_initial_guess", "a contact snapshot's solve starts from: zero (the reference configuration) or nearest (its group's nearest snapshot solved earlier in this run, extrapolated by its sensitivities if stored; docs/offline.md)", "", guess, guess, sizeof guess, NULL));
   PetscCall(PetscOptionsInt("-snapshots_subcomm", "groups of ranks solving the snapshots (0: one per rank below 200k dofs, else 1)", "", s->subcomms, &s->subcomms, NULL));
+  PetscCall(PetscOptionsBool("-offline_probe", "after writing the ROM, solve it at -probe_size parameters of its box (no FOM; -probe_type, -probe_seed) and warn where the reduced loop fails (docs/online.md \"Probing a model\")", "", probe, &probe, NULL));
+  PetscCall(PetscOptionsBool("-offline_probe_fail", "a failure of the probe is an error (exit code), not a warning; the ROM file stays written", "", probeFail, &probeFail, NULL));
   PetscOptionsEnd();
   PetscCheck(!strcmp(guess, "zero") || !strcmp(guess, "nearest"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-snapshots_initial_guess %s: unknown (zero or nearest)", guess);
   PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
@@ -90,6 +94,8 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   s->trainType = trainType;
   s->basisView = viewPath;
   s->initialGuess = guess;
+  s->probe     = probe;
+  s->probeFail = probeFail;
   PetscFunctionReturn(0); // the files are checked by RunOffline, before any work
 }
 
@@ -490,6 +496,15 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       // every group computes the (deterministic) bases; world rank 0 (group 0's root) writes them
       PetscCall(OfflineBases(world, fom, order, s.snapshots, s.rom, h, &rep, scene.contact ? &cmap : nullptr, full, s.basis, greedy, s.sensitivities));
       if (full && !s.basisView.empty()) PetscCall(WriteBasisView(world, scene, s.rom, s.basisView, &rep));
+      if (full && s.probe) { // the written file over its box, as online reads it (rom_probe.hpp)
+        ProbeSummary ps;
+        PetscCall(ProbeRomFile(world, s.rom, 1000, &rep.root["probe"], &ps));
+        if (ps.failed) {
+          PetscCheck(!s.probeFail, world, PETSC_ERR_NOT_CONVERGED, "offline: the reduced model %s failed at %" PetscInt_FMT " of %" PetscInt_FMT " probe parameters (-offline_probe_fail); first %s", romPath, ps.failed, ps.size, ps.firstFailure.c_str());
+          PetscCall(PetscPrintf(world, "rbcontact offline: warning: the reduced model %s failed at %" PetscInt_FMT " of %" PetscInt_FMT " probe parameters; first %s. The training set does not resolve that part of the box: add training parameters near it (docs/online.md \"Probing a model\")\n", romPath, ps.failed, ps.size, ps.firstFailure.c_str()));
+        }
+        if (ps.outOfRange) PetscCall(PetscPrintf(world, "rbcontact offline: warning: at %" PetscInt_FMT " of %" PetscInt_FMT " probe parameters contact projections reached the edge of the stored contact data, where the answers may be wrong (first: %s): more -eim_patch_rings, or training parameters near them (docs/online.md \"Probing a model\")\n", ps.outOfRange, ps.size, ps.firstOutOfRange.c_str()));
+      }
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }
