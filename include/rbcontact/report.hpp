@@ -66,9 +66,25 @@ PetscErrorCode BcastString(MPI_Comm comm, std::string *s);
 // Writes text to path atomically (path.tmp.<pid> then rename) on rank 0 of comm; errors name the file.
 PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std::string &text);
 
-// Checks, before any work, that path (given with option; empty: nothing to check) can be written:
-// its directory exists and is writable, and path is not a directory. Collective (rank 0 looks).
+// The file an output named path is renamed onto: path itself, or where it points when it is a symbolic link
+// (so that the link stays a link; the temporary file goes beside the target, on its file system).
+std::string OutputTarget(const std::string &path);
+
+// Checks, before any work, that path (given with option; empty: nothing to check) can be written: its
+// directory exists and is writable, path is not a directory, nor an existing device, FIFO or socket (the
+// rename of the temporary file would replace it: -report /dev/null as root), and the temporary file
+// (OutputTarget(path) + ".tmp.<pid>") can be created there (a name too long, /proc). Collective (rank 0 looks).
 PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option);
+
+// Checks, before any work, that the outputs (option, path) name distinct files and none of them names an
+// input (option, path): -report equal to -rom, -rom_reconstruct onto the ROM it reads. Empty paths are
+// skipped; files compare by device and inode when they exist, else by their resolved directory and name.
+// Collective (rank 0 looks).
+// True once CheckOutputPath or CheckDistinctFiles refused the -report path: the failure report (src/apps/main.cpp)
+// is then not written there either.
+bool ReportPathRefused();
+
+PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputs);
 
 // The report of one stage run: filled by the stage, written by Write() if -report was given, with the
 // key "provenance" (rbcontact/provenance.hpp) added unless the stage set it. Collective on comm.

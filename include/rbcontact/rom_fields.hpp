@@ -15,8 +15,8 @@ namespace rbc {
 class RomBases {
 public:
   // The basis file named by the ROM (attribute basis_file; -rom_basis overrides); checks its sizes
-  // against the model and ndofs (the scene's free dofs).
-  PetscErrorCode Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt ndofs);
+  // against the model, ndofs (the scene's free dofs) and nmult (its multipliers), and that every value is finite.
+  PetscErrorCode Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt ndofs, PetscInt nmult);
   // u (global vector of order's DM) from the active reduced coordinates v of model.
   PetscErrorCode Displacement(const ReducedModel &model, const CanonicalOrder &order, const std::vector<PetscReal> &v, Vec u) const;
   // lambda in canonical multiplier order from the active reduced multipliers.

@@ -74,6 +74,10 @@ public:
   const std::string    &Path() const { return path_; }
   const SnapshotHeader &Header() const { return header_; }
 
+  // Before Open (which may replace an existing file, -snapshots_restart 0): that from is a snapshot file of the problem
+  // of header (every field Import compares). Collective; rank 0 reads the header only. Errors name the file.
+  static PetscErrorCode CheckImport(MPI_Comm comm, const std::string &from, const SnapshotHeader &header);
+
   // Reading (any rank, independent; for the basis builders and the tests).
   static PetscErrorCode ReadHeader(const std::string &path, SnapshotHeader *header);
   // All done snapshots, ordered by training index; the contact matrix compacted (CompactContactMatrix) as each is read.

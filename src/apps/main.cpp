@@ -8,6 +8,7 @@
 #include <cstring>
 #include <sstream>
 #include <string>
+#include <sys/stat.h>
 #include <unistd.h>
 #include "rbcontact/provenance.hpp"
 #include "stages.hpp"
@@ -158,12 +159,22 @@ static void FailureReport(const std::string &stage, PetscErrorCode ierr)
   r["error"]       = firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError;
   r["error_code"]  = (long long)ierr;
   r["provenance"]  = rbc::ProvenanceJson(rbc::LocalProvenance());
-  const std::string tmp = std::string(path) + ".tmp." + std::to_string((long)getpid());
+  const std::string target = rbc::OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+  struct stat       st;
+  if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return; // a directory or device (refused by CheckOutputPath): never replaced
+  if (rbc::ReportPathRefused()) return;                                 // the path the run refused (an input, another output)
+  { // never an HDF5 file (a ROM, snapshot or field file named by mistake, before the stage could compare the paths)
+    char  sig[8] = {0};
+    FILE *h      = std::fopen(target.c_str(), "rb");
+    const bool hdf5 = h && std::fread(sig, 1, 8, h) == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
+    if (h) std::fclose(h);
+    if (hdf5) return;
+  }
   FILE             *f   = std::fopen(tmp.c_str(), "w");
   if (!f) return;
   const std::string text = r.Dump() + "\n";
   const bool        ok   = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), path) != 0) {
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), target.c_str()) != 0) {
     std::remove(tmp.c_str());
     std::fprintf(stderr, "rbcontact: could not write the failure report %s\n", path);
   }

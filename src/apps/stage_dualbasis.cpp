@@ -27,6 +27,11 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, out, "-dual_out"));
   {
+    std::string in = spec; // file.h5:/dataset
+    if (in.find(":/") != std::string::npos) in = in.substr(0, in.find(":/"));
+    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-dual_out", out}}, {{"-snapshots", in}}));
+  }
+  {
     // check the basis type before reading possibly large data
     char type[32] = "cpg";
     PetscCall(PetscOptionsGetString(NULL, NULL, "-dual_type", type, sizeof type, NULL));

@@ -22,6 +22,7 @@ PetscErrorCode StageProbe(MPI_Comm comm)
   PetscOptionsEnd();
   PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "probe: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
+  PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}}, {{"-rom", romPath}}));
   rep.root["stage"] = "probe";
   PetscCall(ProbeRomFile(comm, romPath, 1000, &rep.root["probe"], &ps));
   const JsonValue &p = rep.root["probe"];

@@ -1,5 +1,6 @@
 // src/io/output.cpp: HDF5 output of the FOM fields (PetscViewerHDF5, VIZ layout) written to a temp
 // file and renamed, plus an XDMF index so that ParaView opens it.
+#include "rbcontact/report.hpp"
 #include "rbcontact/provenance.hpp"
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
@@ -84,7 +85,7 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   {
     long pid = (long)getpid();
     PetscCallMPI(MPI_Bcast(&pid, 1, MPI_LONG, 0, comm));
-    tmp = h5file + ".tmp." + std::to_string(pid);
+    tmp = OutputTarget(h5file) + ".tmp." + std::to_string(pid);
   }
   PetscCall(elas.VonMises(u, &vm));
   // The mesh is the reference one: write it in the physical configuration at mu (x = h_b(mu)(xr) on
@@ -204,7 +205,7 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   }
   PetscCall(PetscViewerDestroy(&v));
   PetscCall(VecDestroy(&vm));
-  if (rank == 0) PetscCheck(std::rename(tmp.c_str(), h5file.c_str()) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot move '%s' to '%s' (-fom_output)", tmp.c_str(), h5file.c_str());
+  if (rank == 0) PetscCheck(std::rename(tmp.c_str(), OutputTarget(h5file).c_str()) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot move '%s' to '%s' (-fom_output)", tmp.c_str(), h5file.c_str());
   PetscCallMPI(MPI_Barrier(comm));
 
   // Sizes for the XDMF: count owned vertices and cells.

@@ -5,10 +5,18 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 namespace rbc {
+
+static bool reportRefused = false; // CheckOutputPath / CheckDistinctFiles refused -report (ReportPathRefused)
+bool        ReportPathRefused() { return reportRefused; }
 
 JsonValue JsonValue::Number(double v) { JsonValue j; j.kind_ = Kind::Number; j.num_ = v; return j; }
 JsonValue JsonValue::Integer(long long v) { JsonValue j; j.kind_ = Kind::Integer; j.int_ = v; return j; }
@@ -139,13 +147,13 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+    const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
     std::ofstream     f(tmp);
     if (!f) ok = 0;
     else {
       f << text;
       f.close();
-      if (!f || std::rename(tmp.c_str(), path.c_str()) != 0) { ok = 0; std::remove(tmp.c_str()); }
+      if (!f || std::rename(tmp.c_str(), target.c_str()) != 0) { ok = 0; std::remove(tmp.c_str()); }
     }
   }
   PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
@@ -168,10 +176,74 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
     if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) why = "the directory '" + dir + "' does not exist";
     else if (access(dir.c_str(), W_OK | X_OK) != 0) why = "the directory '" + dir + "' is not writable";
     else if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) why = "it is a directory";
+    else if (stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      why = "it is a device, FIFO or socket, not a regular file: outputs are written to a temporary file renamed onto their name, which would replace it (leave the option out to skip this output)";
     else if (stat(path.c_str(), &st) == 0 && access(path.c_str(), W_OK) != 0) why = "the file exists and is not writable";
+    else { // the temporary file the writers create (the longest name they use), created and removed
+      const std::string tmp = OutputTarget(path) + ".tmp." + std::to_string((long)getpid());
+      const int         fd  = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+      if (fd < 0) why = "cannot create the temporary file '" + tmp + "': " + std::strerror(errno);
+      else {
+        close(fd);
+        std::remove(tmp.c_str());
+      }
+    }
   }
   PetscCall(BcastString(comm, &why));
+  if (!why.empty() && std::string(option) == "-report") reportRefused = true;
   PetscCheck(why.empty(), comm, PETSC_ERR_FILE_OPEN, "%s %s: cannot write there: %s (checked before any work; nothing was computed or written)", option, path.c_str(), why.c_str());
+  PetscFunctionReturn(0);
+}
+
+std::string OutputTarget(const std::string &path)
+{
+  struct stat st;
+  if (lstat(path.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return path;
+  char buf[PATH_MAX];
+  if (realpath(path.c_str(), buf)) return buf;
+  // a dangling link: the file it names, relative to the link's directory
+  const ssize_t n = readlink(path.c_str(), buf, sizeof buf - 1);
+  if (n <= 0) return path;
+  buf[n]                  = 0;
+  const std::string link  = buf;
+  const size_t      slash = path.find_last_of('/');
+  return link[0] == '/' || slash == std::string::npos ? link : path.substr(0, slash + 1) + link;
+}
+
+// A key that is the same for two names of one file: device and inode when it exists, else the resolved
+// directory and the name.
+static std::string FileKey(const std::string &path)
+{
+  struct stat st;
+  if (stat(path.c_str(), &st) == 0) return "inode " + std::to_string((unsigned long long)st.st_dev) + ":" + std::to_string((unsigned long long)st.st_ino);
+  const std::string target = OutputTarget(path);
+  const size_t      slash  = target.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : target.substr(0, slash)), name = slash == std::string::npos ? target : target.substr(slash + 1);
+  char buf[PATH_MAX];
+  return std::string("path ") + (realpath(dir.c_str(), buf) ? buf : dir.c_str()) + "/" + name;
+}
+
+PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputs)
+{
+  PetscMPIInt rank;
+  std::string why;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    std::vector<std::string> ko, ki;
+    for (const auto &o : outputs) ko.push_back(o.second.empty() ? std::string() : FileKey(o.second));
+    for (const auto &i : inputs) ki.push_back(i.second.empty() ? std::string() : FileKey(i.second));
+    for (size_t a = 0; a < outputs.size() && why.empty(); ++a) {
+      if (ko[a].empty()) continue;
+      for (size_t b = a + 1; b < outputs.size() && why.empty(); ++b)
+        if (ko[a] == ko[b] && (reportRefused = reportRefused || outputs[a].first == "-report" || outputs[b].first == "-report", true)) why = outputs[a].first + " " + outputs[a].second + " and " + outputs[b].first + " " + outputs[b].second + " name the same file: one output would replace the other";
+      for (size_t b = 0; b < inputs.size() && why.empty(); ++b)
+        if (ko[a] == ki[b] && (reportRefused = reportRefused || outputs[a].first == "-report", true)) why = "the output " + outputs[a].first + " " + outputs[a].second + " is the input " + inputs[b].first + " " + inputs[b].second + ": writing it would replace what is read";
+    }
+  }
+  PetscCall(BcastString(comm, &why));
+  PetscCheck(why.empty(), comm, PETSC_ERR_ARG_WRONG, "%s (checked before any work; nothing was computed or written)", why.c_str());
   PetscFunctionReturn(0);
 }
 

@@ -1,5 +1,6 @@
 // src/io/rom_file.cpp: writing and reading the ROM file (HDF5 C API on rank 0, atomic rename).
 #include <algorithm>
+#include "rbcontact/report.hpp"
 #include "rbcontact/provenance.hpp"
 #include "rbcontact/rom_file.hpp"
 #include "h5util.hpp"
@@ -47,7 +48,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
   if (rank == 0) {
     H5Quiet           quiet;
     Ctx               c{"ROM file '" + path + "'", std::string()};
-    const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+    const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
     bool              ok  = true;
     {
       H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
@@ -66,7 +67,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
       }
       if (ok) ok = FlushSync(c, f.get());
     }
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) ok = c.Fail("cannot rename the temporary file into place", false);
+    if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = c.Fail("cannot rename the temporary file into place", false);
     if (!ok) {
       std::remove(tmp.c_str());
       std::snprintf(msg, sizeof msg, "%s", c.err.c_str());

@@ -281,13 +281,13 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
     }
     return ReadDone(c, file->get(), h.trainingPoints.size(), done);
   }
-  const std::string tmp = path + ".tmp." + std::to_string((long)getpid());
+  const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
   {
     H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
     bool ok = f.ok() || ct.Fail("cannot create the file (directory missing or not writable?)");
     ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && FlushSync(ct, f.get()) && CloseFile(ct, &f);
-    if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + path + "': " + std::strerror(errno), false);
+    if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + target + "': " + std::strerror(errno), false);
     if (!ok) {
       f.Reset();
       std::remove(tmp.c_str());
@@ -507,6 +507,33 @@ PetscErrorCode SnapshotFile::Close()
   done_.clear();
   PetscCall(BcastString(comm, &err));
   PetscCheck(err.empty(), comm, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::CheckImport(MPI_Comm comm, const std::string &from, const SnapshotHeader &header)
+{
+  PetscMPIInt rank;
+  std::string err;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    H5Quiet        q;
+    Ctx            c{"Snapshot file '" + from + "' (-snapshots_from)", std::string()};
+    SnapshotHeader fh;
+    H5Id           f;
+    bool           ok = FileExists(from) || c.Fail("no such file", false);
+    ok                = ok && OpenExisting(c, from, false, &f) && ReadHeaderH5(c, f.get(), &fh) && CloseFile(c, &f);
+    if (ok) { // as Import: every header field but the training set
+      SnapshotHeader now  = header;
+      now.trainingPoints  = fh.trainingPoints;
+      const std::string d = SnapshotHeaderDiff(fh, now);
+      if (!d.empty()) ok = c.Fail("was made for another scene/mesh/parameter box: " + d, false);
+    }
+    if (!ok) err = c.err + " (checked before the snapshot file of this run was opened: it is untouched)";
+  }
+  PetscCall(BcastString(comm, &err));
+  PetscCheck(err.empty(), comm, PETSC_ERR_FILE_READ, "%s", err.c_str());
   PetscFunctionReturn(0);
 }
 

@@ -159,6 +159,16 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   if (full) PetscCall(CheckOutputPath(world, s.basis, "-rom_basis"));
   PetscCheck(s.basisView.empty() || full, world, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
   if (!s.basisView.empty()) PetscCall(CheckOutputPath(world, s.basisView, "-offline_basis_output"));
+  {
+    char reportPath[PETSC_MAX_PATH_LEN] = "";
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+    std::vector<std::pair<std::string, std::string>> outs = {{"-report", reportPath}, {"-snapshots", s.snapshots}}, ins;
+    if (bases) outs.push_back({"-rom", s.rom});
+    if (full) outs.push_back({"-rom_basis", s.basis});
+    if (!s.basisView.empty()) outs.push_back({"-offline_basis_output", s.basisView});
+    for (const auto &from : s.from) ins.push_back({"-snapshots_from", from});
+    PetscCall(CheckDistinctFiles(world, outs, ins));
+  }
   PetscCheck(!scene.params.empty(), world, PETSC_ERR_USER_INPUT, "offline: the scene declares no parameters (-mu_names)");
   // -train_type greedy (docs/greedy_training.md): the snapshot file's training set is the pool (initial
   // set, then the candidates); the FOM solves the initial set, then the parameters the indicator picks
@@ -254,6 +264,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscCall(PetscFree(all));
     }
     SnapshotFile file;
+    for (const auto &from : s.from) PetscCall(SnapshotFile::CheckImport(world, from, h)); // before Open may replace the file
     PetscCall(file.Open(world, snapPath, h, restart));
     PetscInt                 imported = 0;
     std::vector<std::string> extras; // what this run writes with every snapshot (the packing below)

@@ -2,6 +2,7 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_file.hpp"
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 #include "rbcontact/mesh.hpp"
@@ -62,7 +63,7 @@ PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const Sc
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt nd)
+PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt nd, PetscInt nmult)
 {
   std::vector<unsigned long long> dims;
   char                            buf[PETSC_MAX_PATH_LEN] = "";
@@ -94,8 +95,14 @@ PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const st
   ndofs = nd;
   PetscCall(RomReadDataset(path, "/dual/basis", &dims, &W));
   PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Rfull, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /dual/basis has %llu vectors, the ROM R = %" PetscInt_FMT, path.c_str(), dims.empty() ? 0ULL : dims[0], model.Rfull);
+  PetscCheck((PetscInt)dims[1] == nmult, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /dual/basis has vectors of length %llu, the scene has %" PetscInt_FMT " contact multipliers (another scene or mesh?)", path.c_str(), dims[1], nmult);
   r = (PetscInt)dims[0];
   R = (PetscInt)dims[1];
+  for (const auto *a : {&modes, &W}) {
+    size_t bad = 0;
+    while (bad < a->size() && std::isfinite((*a)[bad])) ++bad;
+    PetscCheck(bad == a->size(), comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: %s holds a non-finite value (entry %zu): a corrupt file; rerun offline", path.c_str(), a == &modes ? "/pod/modes" : "/dual/basis", bad);
+  }
   PetscFunctionReturn(0);
 }
 
@@ -221,13 +228,13 @@ static PetscErrorCode SceneOfRom(MPI_Comm comm, const SceneSpec &scene, const Re
   PetscCall(fom->SetupAffine());
   PetscCall(fom->SetMu(mu));
   PetscCall(order->BuildDofs(fom->elas));
-  PetscCall(bases->Read(comm, model, model.file, order->NumDofs()));
   if (!fom->u) {
     PetscCall(DMCreateGlobalVector(fom->dm, &fom->u));
     PetscCall(PetscObjectSetName((PetscObject)fom->u, "displacement"));
   }
   PetscCheck(scene.contact, comm, PETSC_ERR_SUP, "%s: the scene has no contact pair (-contact_slave, -contact_master)", what);
   PetscCall(cmap->Setup(fom->elas, scene.slave, scene.master));
+  PetscCall(bases->Read(comm, model, model.file, order->NumDofs(), cmap->NumMultipliers()));
   cmap->SetGeometry(&fom->map, mu);
   PetscFunctionReturn(0);
 }

@@ -326,6 +326,12 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
 {
   Report        &rep = *report;
   const char    *romPath = romPathIn.c_str(), *sweepOut = settings.sweepOutput.c_str();
+  {
+    char reportPath[PETSC_MAX_PATH_LEN] = "";
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
+    const std::string so = settings.sweep ? settings.sweepOutput : std::string();
+    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-validate_sweep_output (.json)", so.empty() ? so : so + ".json"}, {"-validate_sweep_output (.csv)", so.empty() ? so : so + ".csv"}}, {{"-rom", romPathIn}}));
+  }
   const PetscInt repeat = settings.repeat;
   const bool     sweep  = settings.sweep;
   const auto    &fractions = settings.fractions;
@@ -356,9 +362,9 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
   PetscCall(CheckRomScene(comm, romPath, scene, fom.map)); // the same materials, loads, maps, mesh as offline
   PetscCall(fom.SetupAffine());
   PetscCall(order.BuildDofs(fom.elas));
-  PetscCall(bases.Read(comm, model, romPath, order.NumDofs()));
   PetscCall(kac.SetFromOptions(comm));
   PetscCall(cmap.Setup(fom.elas, scene.slave, scene.master));
+  PetscCall(bases.Read(comm, model, romPath, order.NumDofs(), cmap.NumMultipliers()));
   PetscCall(kac.ShareFactor(fom, cmap));
   const PetscInt dim = fom.elas.dim;
 
