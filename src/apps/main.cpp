@@ -3,6 +3,12 @@
 #include <petscsys.h>
 #include <slepcsys.h>
 #include <cctype>
+#include <vector>
+#include <functional>
+#include <fstream>
+#include <climits>
+#include <cerrno>
+#include <algorithm>
 #include <cstdlib>
 #include <dlfcn.h>
 #include <cstring>
@@ -145,32 +151,28 @@ static PetscErrorCode OneBlasThreadPerRank()
 // A failed run still leaves its -report: {"stage", "converged": false, "error": the first message,
 // "error_code", "provenance"}, written by rank 0 alone (the failure need not be collective: no
 // communication here), to a temporary file then renamed. A report the stage wrote before failing
-// is replaced: the run did not finish.
-static void FailureReport(const std::string &stage, PetscErrorCode ierr)
+// is replaced: the run did not finish. Never onto a device, a path the run refused (an input, another
+// output) or an HDF5 file (a ROM, snapshot or field file named by mistake).
+static void WriteFailureReport(const char *path, const std::string &stage, const std::string &error, long long code, bool provenance)
 {
-  char        path[PETSC_MAX_PATH_LEN] = "";
-  PetscBool   set                      = PETSC_FALSE;
-  PetscMPIInt rank                     = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (rank != 0 || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
   rbc::JsonValue r = rbc::JsonValue::Object();
   r["stage"]       = stage;
   r["converged"]   = false;
-  r["error"]       = firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError;
-  r["error_code"]  = (long long)ierr;
-  r["provenance"]  = rbc::ProvenanceJson(rbc::LocalProvenance());
+  r["error"]       = error;
+  r["error_code"]  = code;
+  if (provenance) r["provenance"] = rbc::ProvenanceJson(rbc::LocalProvenance());
   const std::string target = rbc::OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
   struct stat       st;
   if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return; // a directory or device (refused by CheckOutputPath): never replaced
   if (rbc::ReportPathRefused()) return;                                 // the path the run refused (an input, another output)
-  { // never an HDF5 file (a ROM, snapshot or field file named by mistake, before the stage could compare the paths)
-    char  sig[8] = {0};
-    FILE *h      = std::fopen(target.c_str(), "rb");
-    const bool hdf5 = h && std::fread(sig, 1, 8, h) == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
+  {
+    char       sig[8] = {0};
+    FILE      *h      = std::fopen(target.c_str(), "rb");
+    const bool hdf5   = h && std::fread(sig, 1, 8, h) == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
     if (h) std::fclose(h);
     if (hdf5) return;
   }
-  FILE             *f   = std::fopen(tmp.c_str(), "w");
+  FILE *f = std::fopen(tmp.c_str(), "w");
   if (!f) return;
   const std::string text = r.Dump() + "\n";
   const bool        ok   = std::fwrite(text.data(), 1, text.size(), f) == text.size();
@@ -178,6 +180,60 @@ static void FailureReport(const std::string &stage, PetscErrorCode ierr)
     std::remove(tmp.c_str());
     std::fprintf(stderr, "rbcontact: could not write the failure report %s\n", path);
   }
+}
+
+static void FailureReport(const std::string &stage, PetscErrorCode ierr)
+{
+  char        path[PETSC_MAX_PATH_LEN] = "";
+  PetscBool   set                      = PETSC_FALSE;
+  PetscMPIInt rank                     = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  if (rank != 0 || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
+  WriteFailureReport(path, stage, firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError, (long long)ierr, true);
+}
+
+// Before PETSc reads them: every -options_file of the command line, and those the files name in turn, exists and is
+// readable, and none includes itself (PETSc 3.18 then recurses until the stack overflows: a segmentation fault with
+// no message). Files are named as given, resolved from the working directory as PETSc does. "" when all is well.
+static std::string CheckOptionsFiles(int argc, char **argv)
+{
+  std::vector<std::string>                             chain, shown;
+  std::function<std::string(const std::string &, int)> visit = [&](const std::string &file, int depth) -> std::string {
+    char buf[PATH_MAX];
+    if (!realpath(file.c_str(), buf)) return "options file " + file + " (-options_file): " + std::strerror(errno);
+    const std::string canon = buf;
+    if (std::find(chain.begin(), chain.end(), canon) != chain.end()) {
+      std::string path;
+      for (const auto &s : shown) path += s + " -> ";
+      return "options file " + file + " includes itself through -options_file (" + path + file + ")";
+    }
+    if (depth >= 16) return "options file " + file + ": -options_file nested more than 16 deep";
+    std::ifstream in(file);
+    if (!in) return "options file " + file + " (-options_file): cannot be read";
+    chain.push_back(canon);
+    shown.push_back(file);
+    for (std::string line; std::getline(in, line);) {
+      const size_t hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream       ls(line);
+      std::vector<std::string> tok;
+      for (std::string t; ls >> t;) tok.push_back(t);
+      for (size_t k = 0; k + 1 < tok.size(); ++k)
+        if (tok[k] == "-options_file") {
+          const std::string e = visit(tok[k + 1], depth + 1);
+          if (!e.empty()) return e;
+        }
+    }
+    chain.pop_back();
+    shown.pop_back();
+    return "";
+  };
+  for (int i = 1; i + 1 < argc; ++i)
+    if (!std::strcmp(argv[i], "-options_file")) {
+      const std::string e = visit(argv[i + 1], 0);
+      if (!e.empty()) return e;
+    }
+  return "";
 }
 
 int main(int argc, char **argv)
@@ -191,6 +247,19 @@ int main(int argc, char **argv)
   for (int i = 1; i < argc - 1; ++i) argv[i] = argv[i + 1];
   --argc;
 
+  {
+    const std::string bad = CheckOptionsFiles(argc, argv);
+    if (!bad.empty()) { // PETSc is not initialized: MPI only, for the rank and a clean exit under mpirun
+      int rank = 0;
+      MPI_Init(&argc, &argv);
+      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+      std::fprintf(stderr, "[%d] rbcontact error: %s\n", rank, bad.c_str());
+      for (int i = 1; rank == 0 && i + 1 < argc; ++i)
+        if (!std::strcmp(argv[i], "-report") && argv[i + 1][0]) WriteFailureReport(argv[i + 1], stage, bad, (long long)PETSC_ERR_FILE_OPEN, false);
+      MPI_Finalize();
+      return (int)PETSC_ERR_FILE_OPEN;
+    }
+  }
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(OneBlasThreadPerRank());
   {

@@ -5,6 +5,7 @@
 // Internal (not installed).
 #pragma once
 #include <cmath>
+#include <limits>
 #include <vector>
 #include "rbcontact/contact.hpp"
 
@@ -85,6 +86,13 @@ inline void EvaluateContactPoint(const SurfaceFacet &F, PetscInt dim, const Pets
   }
   e->bm[0] = e->bm[1] = e->bm[2] = 0;
   find(zdef, &e->m, e->bm, &e->dist);
+  // no facet found: a non-finite point (a corrupt file, a diverged iterate). Facet 0 stands in and the gap is NaN,
+  // which the callers' checks of non-finite terms report (never an index of -1)
+  const bool lost = e->m < 0;
+  if (lost) {
+    e->m     = 0;
+    e->bm[0] = 1;
+  }
   const SurfaceFacet &M = masters[e->m];
   PetscReal           r0 = 0, r1 = 0, r2 = 0, n0 = 0, n1 = 0, nz = 0;
   FacetBasis(M, e->bm, e->Nm);
@@ -118,6 +126,7 @@ inline void EvaluateContactPoint(const SurfaceFacet &F, PetscInt dim, const Pets
   e->gap += (z[0] - r0) * e->n2[0];
   e->gap += (z[1] - r1) * e->n2[1];
   if (d3) e->gap += (z[2] - r2) * e->n2[2];
+  if (lost) e->gap = std::numeric_limits<PetscReal>::quiet_NaN();
 }
 
 } // namespace rbc

@@ -505,6 +505,7 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
     PetscFunctionBeginUser;
     PetscCall(RomReadDataset(file, group + "/" + name, &dims, &data));
     PetscCheck(data.size() == n, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s has %zu entries (%zu expected)", file.c_str(), group.c_str(), name.c_str(), data.size(), n);
+    for (size_t i = 0; i < n; ++i) PetscCheck(std::isfinite(data[i]) && std::abs(data[i]) < 1e150, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s entry %zu is %g: a corrupt file", file.c_str(), group.c_str(), name.c_str(), i, data[i]);
     PetscFunctionReturn(0);
   };
   PetscCall(need("theta", nnode * dim * std::max<PetscInt>(N, 1)));
@@ -529,6 +530,7 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
       for (int i = 0; i < 9; ++i) F.Xref[i] = r[4 + i];
       for (int a = 0; a < F.nnodes; ++a) {
         F.nodeKind[a] = (PetscInt)r[13 + a];
+        PetscCheck((F.nodeKind[a] >= 0 && F.nodeKind[a] < F.nv) || (F.nodeKind[a] >= 3 && F.nodeKind[a] <= (dim == 2 ? 3 : 5)), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s facet %zu: node kind %" PetscInt_FMT " out of range", file.c_str(), group.c_str(), f, F.nodeKind[a]);
         const PetscInt node = (PetscInt)r[19 + a];
         PetscCheck(node >= 0 && node < nnode, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s facet %zu: node %" PetscInt_FMT " out of range", file.c_str(), group.c_str(), f, node);
         for (PetscInt d = 0; d < dim; ++d) F.dof[a * dim + d] = node * dim + d;
@@ -560,7 +562,8 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
   PetscCall(RomReadDataset(file, group + "/cand", &dims, &data));
   cand.assign(data.begin(), data.end());
   if (candStart.size() > 1) {
-    PetscCheck(candStart.size() == np + 1 && candStart.back() == (PetscInt)cand.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s candidate lists are inconsistent", file.c_str(), group.c_str());
+    PetscCheck(candStart.size() == np + 1 && candStart.front() == 0 && candStart.back() == (PetscInt)cand.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s candidate lists are inconsistent", file.c_str(), group.c_str());
+    for (size_t p = 0; p < np; ++p) PetscCheck(candStart[p] <= candStart[p + 1], PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/cand_start decreases at point %zu: a corrupt file", file.c_str(), group.c_str(), p);
     for (PetscInt m : cand) PetscCheck(m >= 0 && m < (PetscInt)nm, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s candidate facet out of range", file.c_str(), group.c_str());
   } else cand.clear();
   meas_.assign(ns, 0.0);

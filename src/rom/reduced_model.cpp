@@ -473,6 +473,10 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
   PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
   PetscCheck(threads >= 1 && threads <= 256, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_threads %" PetscInt_FMT " must be in [1, 256]", threads);
+  // no EIM term at all is no contact term (Mk) or no gap (Mg): a converged answer without contact; the internal
+  // callers (the EIM's size selection) may still truncate to 0
+  PetscCheck(mk != 0 || MkFull == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk 0 out of range [1, %" PetscInt_FMT "]: without an EIM term of kappa the reduced model has no contact (-1: the offline selection)", MkFull);
+  PetscCheck(mg != 0 || MgFull == 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg 0 out of range [1, %" PetscInt_FMT "]: without an EIM term of the gap the reduced model has no gap (-1: the offline selection)", MgFull);
   PetscCall(qp.SetFromOptions("rom_"));
   qp.residuals = false; // SolveLoop computes them once, for the returned pair
   PetscCall(qpEst_.SetFromOptions("rom_"));
