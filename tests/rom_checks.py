@@ -14,6 +14,9 @@
   eim_train   extra EIM training radii (no FOM solves) shrink the EIM's share of the error.
   half_disks  two parameters (radius, imposed displacement): the whole pipeline runs, the ROM converges
               and its errors are reported.
+  guards      outputs onto a FIFO, through a symbolic link, with a name too long, onto another output or an input;
+              corrupt basis files and /online/contact data, -rom_Mk 0, options files that include themselves or are missing:
+              refused before any work, the files left intact, the failure report written.
   probe       the ROM solved over its box without the FOM: offline's warning on a training set whose reduced loop
               fails (half_disks 2 x 5), the `online -mu` it names, the probe stage on 1 and 2 ranks, -offline_probe_fail,
               the largest estimated errors against online's, bad input.
@@ -1114,6 +1117,85 @@ def probe(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def guards(args):
+    """Outputs that would destroy something, and corrupt inputs that crashed or gave NaN (found by an audit, 2026-11-29):
+    refused with a message naming the option or file, before any work, and what was there left intact."""
+    import hashlib
+    d = tempfile.mkdtemp(prefix="rbc_rom_guards_")
+    md5 = lambda f: hashlib.md5(open(f, "rb").read()).hexdigest()
+    rom, _ = offline(args, d, np_=1, extra=["-train_size", "5", "-rom_hyper", "ecsw,eim", "-eim_max", "10", "-offline_probe", "0"])
+    sums = {f: md5(f) for f in (rom, d + "/rom.basis.h5", d + "/rom.snapshots.h5")}
+    base = ["-rom", rom, "-mu", "1.02"]
+    # a FIFO (a device as root: /dev/null) would be replaced by the renamed temporary file
+    os.mkfifo(d + "/fifo")
+    expect_error(args, base + ["-report", d + "/fifo"], ["-report", "device, FIFO or socket"], "-report onto a FIFO")
+    check(os.path.exists(d + "/fifo") and not os.path.isfile(d + "/fifo"), "the FIFO is still a FIFO")
+    # a symbolic link is written through
+    with open(d + "/target.json", "w") as f:
+        f.write("{}")
+    os.symlink(d + "/target.json", d + "/link.json")
+    run(args, 1, "online", base + ["-report", d + "/link.json"])
+    check(os.path.islink(d + "/link.json") and report(d + "/target.json")["stage"] == "online", "-report through a symbolic link: the link kept, its target written")
+    # the temporary name too long: refused before the solve
+    expect_error(args, base + ["-report", d + "/" + "a" * 250 + ".json"], ["-report", "File name too long"], "-report whose temporary name is too long")
+    # outputs naming the same file, or an input
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-train_size", "3", "-rom", d + "/x.h5", "-snapshots", d + "/x.h5"],
+                 ["-snapshots", "-rom", "name the same file"], "offline -rom = -snapshots", stage="offline")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-fom_output", d + "/f.h5", "-report", d + "/f.h5"], ["-report", "-fom_output", "name the same file"], "fom -report = -fom_output", stage="fom")
+    expect_error(args, base + ["-options_file", "runs/ring_on_block.opts", "-rom_reconstruct", rom], ["-rom_reconstruct", "is the input -rom"], "online -rom_reconstruct onto its -rom")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "2", "-report", rom], ["-report", "is the input -rom"], "validate -report onto its -rom", stage="validate")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-train_size", "3", "-rom", d + "/y.h5", "-snapshots_from", d + "/rom.snapshots.h5", "-report", d + "/rom.snapshots.h5"],
+                 ["-report", "is the input -snapshots_from"], "offline -report onto its -snapshots_from", stage="offline")
+    # a missing -snapshots_from with -snapshots_restart 0: refused before the snapshot file is replaced
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-train_size", "3", "-rom", d + "/z.h5", "-snapshots", d + "/rom.snapshots.h5", "-snapshots_restart", "0", "-snapshots_from", d + "/nosuch.h5"],
+                 ["nosuch.h5", "no such file", "untouched"], "-snapshots_restart 0 with a missing -snapshots_from", stage="offline")
+    check(all(md5(f) == m for f, m in sums.items()), "the ROM, basis and snapshot files are unchanged by the refused runs (failure reports included)")
+    # corrupt basis files: a NaN, a dual basis of the wrong length
+    for name, ds, change, words in (("modes_nan", "pod/modes", lambda a: a.__setitem__((0, 100), np.nan), ["/pod/modes", "non-finite"]),
+                                    ("dual_short", "dual/basis", lambda a: None, ["/dual/basis", "length 40"])):
+        shutil.copy(d + "/rom.basis.h5", d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "a") as f:
+            a = np.array(f[ds])
+            change(a)
+            if name == "dual_short":
+                a = np.resize(a, (a.shape[0], 40))
+            del f[ds]
+            f[ds] = a
+        expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "2", "-validate_repeat", "1", "-rom_basis", d + "/%s.h5" % name],
+                     ["%s.h5" % name] + words, "validate with a basis file: %s" % name, stage="validate")
+    # no EIM term is no contact
+    expect_error(args, base + ["-rom_hyper", "eim", "-rom_Mk", "0"], ["-rom_Mk 0", "out of range"], "-rom_Mk 0 with the EIM")
+    expect_error(args, base + ["-rom_hyper", "eim", "-rom_Mg", "0"], ["-rom_Mg 0", "out of range"], "-rom_Mg 0 with the EIM")
+    # /online/contact: values that crashed the online solve
+    for name, ds, idx, val, words in (("theta_nan", "online/contact/theta", (0, 0), np.nan, ["/online/contact/theta", "corrupt"]),
+                                      ("theta_big", "online/contact/theta", (0, 0), 1e300, ["/online/contact/theta", "corrupt"]),
+                                      ("kind", "online/contact/slave", (0, 13), 99, ["node kind 99"]),
+                                      ("cand_start", "online/contact/cand_start", (1,), -5, ["cand_start decreases"])):
+        shutil.copy(rom, d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "a") as f:
+            a = np.array(f[ds])
+            a[idx] = val
+            f[ds][...] = a
+        for hyper in ("ecsw", "eim"):
+            p = run(args, 1, "online", ["-rom", d + "/%s.h5" % name, "-mu", "1.02", "-rom_hyper", hyper], expect_ok=False)
+            ok = p.returncode != 0 and all(w in p.stdout for w in words + [name + ".h5"]) and "SEGV" not in p.stdout
+            check(ok, "a ROM file with /online/contact tampered (%s), -rom_hyper %s: refused naming the file and dataset" % (name, hyper))
+            if not ok:
+                print(p.stdout[-800:])
+    # options files: one that includes itself, one missing; the previous report replaced by the failure's
+    with open(d + "/self.opts", "w") as f:
+        f.write("-options_file %s/self.opts\n" % d)
+    for opts, words in ((d + "/self.opts", ["includes itself"]), (d + "/nosuch.opts", ["nosuch.opts", "No such file"])):
+        with open(d + "/old.json", "w") as f:
+            f.write('{"stage": "old", "converged": true}')
+        for np_ in (1, 2):
+            p = run(args, np_, "online", base + ["-options_file", opts, "-report", d + "/old.json"], expect_ok=False)
+            r = report(d + "/old.json")
+            check(p.returncode != 0 and all(w in p.stdout for w in words) and "SEGV" not in p.stdout and r["converged"] is False and words[0] in r["error"],
+                  "-options_file %s, %d rank(s): refused, the report says so" % (os.path.basename(opts), np_))
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def files(args):
     """Files that belong together are checked together: the ROM against the scene as configured now
     (scene_hash), the ROM against its basis file (rom_id), and a failed offline run leaves the previous
@@ -1172,7 +1254,7 @@ def files(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit", "probe"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit", "probe", "guards"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--contact-terms-exe", help="tests/test_rom_contact_terms (sphere_block3d runs it on its ROM)")
     args = ap.parse_args()

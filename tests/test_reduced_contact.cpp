@@ -20,6 +20,7 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -374,6 +375,20 @@ static PetscErrorCode Run()
     EvaluatePatch(full, all, &back);
     const bool again = Bitwise(back.kappa, ref[0].kappa) && Bitwise(back.gamma, ref[0].gamma) && back.hit == ref[0].hit;
     PetscCall(Check(comm, again, "SetGeometry at mu, 1.01 mu, then mu again: kappa, gamma, hits bit for bit those of the first visit", again ? 0.0 : 1.0, 0));
+    { // non-finite reduced coordinates (a diverged iterate, a corrupt file): no closest facet is found; the point's gap
+      // is NaN (which the reduced QP refuses) and its facet a valid index, never -1 (this read master[-1] and crashed)
+      std::vector<PetscReal> vnan(3, std::numeric_limits<PetscReal>::quiet_NaN()); // v has 3 entries
+      Eval                   bad;
+      full.SetReduced(vnan.data());
+      EvaluatePatch(full, all, &bad);
+      bool nanGap = true, validHit = true;
+      for (size_t p = 0; p < bad.gamma.size(); ++p) {
+        nanGap   = nanGap && std::isnan(bad.gamma[p]);
+        validHit = validHit && bad.hit[p] >= 0 && bad.hit[p] < (PetscInt)full.master.size();
+      }
+      PetscCall(Check(comm, nanGap && validHit, "NaN reduced coordinates: every point's gap NaN, its facet a valid index (no crash)", nanGap && validHit ? 0.0 : 1.0, 0));
+      full.SetReduced(v);
+    }
     // every facet's coordinates are its body's map at the last parameter applied to its reference ones (mu2, mu, mu2)
     bool mapped = true;
     for (const auto &m : {mu2, mu, mu2}) {
