@@ -67,3 +67,5 @@ rbc_bad_stage_np2(mumps_parallel_ordering "INFOG[(]1[)] = -38: a parallel orderi
 rbc_bad_stage_np2(output_dir_offline "-rom /nonexistent_rbc/rom.h5: cannot write there" offline -options_file runs/ring_on_block.opts -rom /nonexistent_rbc/rom.h5)
 rbc_bad_stage_np2(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of physical group 'master'[)] has the tag of physical group 'pin_core'" fom -options_file runs/hard_cases/pin_in_hole.opts -mesh_file @PIN_MSH22@)
 rbc_bad_stage_np2(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be in" fom -options_file runs/ring_on_block.opts -fom_dual_matrix saddle -fom_saddle_rtol_forcing -1)
+# an integer beyond 32 bits (PETSc 3.18 cast it without a word: -mesh_refine 4294967296 ran as 0; src/apps/petsc_int_option.cpp)
+rbc_bad_stage(int_value_wraps "Input string 4294967296 is out of the range of a 32-bit integer [(]option -mesh_refine 4294967296[)]" fom -options_file runs/ring_on_block.opts -mesh_refine 4294967296)
