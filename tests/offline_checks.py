@@ -188,6 +188,19 @@ def mismatch(args):
         check(p.returncode != 0 and ("bad_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and "non-finite" in p.stdout,
               "non-finite value in a done row of /snapshots/%s: refused naming the file, the row and the dataset" % ds)
         check(not os.path.exists(d + "/never.h5"), "no ROM written from the corrupt %s row" % ds)
+    # a finished row whose parameter is not its training point, or with a negative multiplier (resumed without a word
+    # before 2026-11-29; the negative one failed later in the dual basis without naming the file)
+    for ds, row, val, words in (("mu", 0, 1.1, "is not training point 1"), ("lambda", 1, -5.0, "negative multiplier")):
+        bad = d + "/odd_%s.h5" % ds
+        shutil.copy(d + "/s.h5", bad)
+        with h5py.File(bad, "r+") as f:
+            x = np.array(f["snapshots/" + ds][row])
+            x[len(x) // 2] = val
+            f["snapshots/" + ds][row] = x
+        p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
+                            "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and ("odd_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and words in p.stdout and not os.path.exists(d + "/never.h5"),
+              "a done row of /snapshots/%s with %s: refused naming the file and the row, no ROM" % (ds, words))
 
 
 def bases(args):

@@ -236,6 +236,26 @@ static std::string CheckOptionsFiles(int argc, char **argv)
   return "";
 }
 
+// A list value with an empty entry (-body_E ,100,100: PETSc's "String of length zero has no numerical value", naming no
+// option; -body_E 100,,100 read as 100,100 without a word; a trailing comma dropped): refused, naming the option.
+static PetscErrorCode EmptyListEntries()
+{
+  char *all = nullptr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  std::string        name, bad;
+  std::istringstream in(all ? all : "");
+  for (std::string tok; bad.empty() && in >> tok;) {
+    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
+    if (isName) name = tok;
+    else if (!name.empty() && (tok.front() == ',' || tok.back() == ',' || tok.find(",,") != std::string::npos)) bad = name + " " + tok;
+  }
+  PetscCall(PetscFree(all));
+  PetscCheck(bad.empty(), PETSC_COMM_WORLD, PETSC_ERR_USER_INPUT, "option %s: an empty entry in the list (a comma too many?)", bad.c_str());
+  PetscFunctionReturn(0);
+}
+
 int main(int argc, char **argv)
 {
   if (argc < 2 || argv[1][0] == '-') {
@@ -267,8 +287,9 @@ int main(int argc, char **argv)
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-rbc_full_traceback", &full, NULL));
     if (!full) PetscCall(PetscPushErrorHandler(ConciseErrorHandler, NULL));
   }
-  PetscErrorCode ierr = 0;
-  if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
+  PetscErrorCode ierr = EmptyListEntries();
+  if (ierr) {
+  } else if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
   else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
   else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
   else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);

@@ -43,7 +43,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
     PetscCall(PetscOptionsHasName(NULL, NULL, "-mu", &hasMu));
     PetscCheck(!hasMu || (muSet && nmu > 0), comm, PETSC_ERR_USER_INPUT, "option -mu is given without a value (the scene's defaults are used only without -mu)");
     PetscCheck(!muSet || nmu <= 64, comm, PETSC_ERR_ARG_SIZ, "option -mu takes at most 64 values, more were given");
-    for (PetscInt i = 0; muSet && i < nmu; ++i) PetscCheck(std::isfinite(muIn[i]), comm, PETSC_ERR_USER_INPUT, "option -mu: value %" PetscInt_FMT " is not a finite number", i + 1);
+    for (PetscInt i = 0; muSet && i < nmu; ++i) PetscCheck(std::isfinite(muIn[i]), comm, PETSC_ERR_USER_INPUT, "option -mu: value %" PetscInt_FMT " of the list is not a finite number (inf or nan)", i + 1);
   }
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, recPath, "-rom_reconstruct"));

@@ -58,7 +58,7 @@ static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const c
   PetscCall(PetscOptionsHasName(NULL, NULL, name, &has));
   PetscCheck(!has || (flg && n > 0), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "option %s is given without a value", name);
   for (PetscInt i = 0; flg && i < n; ++i)
-    PetscCheck(std::isfinite(buf[i]), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "option %s: value %" PetscInt_FMT " is not a finite number", name, i + 1);
+    PetscCheck(std::isfinite(buf[i]), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "option %s: value %" PetscInt_FMT " of the list is not a finite number (inf or nan)", name, i + 1);
   if (flg) v->assign(buf, buf + n);
   if (set) *set = flg;
   PetscFunctionReturn(0);

@@ -49,6 +49,7 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
+#include <iomanip>
 #include <sstream>
 #include <type_traits>
 
@@ -621,6 +622,22 @@ bool ReadAllH5(Ctx &c, const std::string &path, SnapshotHeader *hOut, std::vecto
       };
       ok = ok && finite("/snapshots/mu", s.mu) && finite("/snapshots/u", s.u) && finite("/snapshots/lambda", s.lambda);
       for (const auto &e : s.extra) ok = ok && finite("/snapshots/extra/" + e.first, e.second);
+      // the row's parameter is its training point (resumed and imported rows are matched to 1e-14), and its
+      // multipliers are those of a contact solution (>= 0): a row that says otherwise would build the bases wrong
+      bool same = s.mu.size() == h.trainingPoints[i].size();
+      for (size_t k = 0; same && k < s.mu.size(); ++k) same = Close14(s.mu[k], h.trainingPoints[i][k]);
+      if (ok && !same) {
+        std::ostringstream m;
+        m << std::setprecision(17) << "row " << i << " of /snapshots/mu (" << (s.mu.empty() ? 0.0 : s.mu[0]) << (s.mu.size() > 1 ? ", ..." : "") << ") is not training point " << i + 1
+          << " of /train/points (" << (h.trainingPoints[i].empty() ? 0.0 : h.trainingPoints[i][0]) << (h.trainingPoints[i].size() > 1 ? ", ..." : "") << "): the file is corrupt; recompute that snapshot";
+        ok = c.Fail(m.str(), false);
+      }
+      for (size_t k = 0; ok && k < s.lambda.size(); ++k)
+        if (s.lambda[k] < 0) {
+          std::ostringstream m;
+          m << "row " << i << " of /snapshots/lambda holds a negative multiplier (entry " << k << ", " << s.lambda[k] << "): not a contact solution; the file is corrupt, recompute that snapshot";
+          ok = c.Fail(m.str(), false);
+        }
       if (ok) snaps->push_back(std::move(s));
     }
     if (ok) ok = CloseFile(c, &f);
