@@ -71,3 +71,8 @@ rbc_bad_stage_np2(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be i
 rbc_bad_stage(int_value_wraps "Input string 4294967296 is out of the range of a 32-bit integer [(]option -mesh_refine 4294967296[)]" fom -options_file runs/ring_on_block.opts -mesh_refine 4294967296)
 # an empty entry in a list option (PETSc named no option, or dropped the entry without a word; src/apps/main.cpp)
 rbc_bad_stage(list_empty_entry "option -body_E 100,,100: an empty entry in the list" fom -options_file runs/ring_on_block.opts -body_E 100,,100)
+# a body of -bodies with no physical group of the mesh's dimension: "not a valid gmsh file?" on 1 rank, a hang on 2 (rank 0
+# left PETSc's reader with an error while the other ranks waited in it); checked before the reader (src/mesh/mesh_loader.cpp)
+find_program(RBC_MPIRUN_STAGE NAMES mpirun)
+add_test(NAME bad_input_body_without_group_np2 COMMAND ${RBC_EXPECT_ERROR_STAGE} "body 'block' of -bodies has no physical group of dimension 2" ${RBC_MPIRUN_STAGE} -n 2 ${RBC_EXE_STAGE} fom -options_file runs/ring_on_block.opts -mesh_file @NOBLOCK_GEO@ WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(bad_input_body_without_group_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 PROCESSORS 2 LABELS bad_input)

@@ -9,7 +9,8 @@
 # Prints the command, the exit code and the error lines, so a failing test shows why.
 # Special arguments: the tokens @GARBAGE_MSH@ / @GARBAGE_GEO@ in the command are replaced by the path
 # of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
-# meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag).
+# meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
+# by meshes/ring_on_block.geo without the block's Physical Surface.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -29,6 +30,10 @@ for a in "$@"; do
     # meshes/pin_in_hole.geo written in gmsh format 2.2: entity 13 (master arc) vs physical group 13
     "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/pin_in_hole.geo" -format msh22 -v 0 -o "$tmpdir/pin_in_hole.22.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
     args+=("$tmpdir/pin_in_hole.22.msh")
+  elif [ "$a" = "@NOBLOCK_GEO@" ]; then
+    # meshes/ring_on_block.geo without the block's Physical Surface (a body of -bodies with no cells in the mesh)
+    grep -v 'Physical Surface("block"' "$(dirname "$0")/../meshes/ring_on_block.geo" > "$tmpdir/noblock.geo"
+    args+=("$tmpdir/noblock.geo")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

@@ -4,6 +4,7 @@
 #include "rbcontact/partition.hpp"
 #include "rbcontact/report.hpp"
 #include <petscsf.h>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 #ifndef RBC_GMSH_EXECUTABLE
   #define RBC_GMSH_EXECUTABLE "gmsh"
@@ -293,6 +295,38 @@ static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, con
   PetscFunctionReturn(0);
 }
 
+// Before the reader: the bodies of -bodies with no physical group of the mesh's dimension in the $PhysicalNames of
+// an ASCII .msh ("" when every body has one, or when the file says nothing that can be read).
+static std::string BodiesWithoutGroup(const std::string &msh, const SceneSpec &scene)
+{
+  std::ifstream in(msh);
+  std::string   line;
+  while (std::getline(in, line) && line.rfind("$PhysicalNames", 0) != 0) {}
+  if (!in) return "";
+  int n = 0;
+  if (!(in >> n) || n <= 0) return "";
+  std::vector<std::pair<int, std::string>> groups; // dimension, name
+  int                                      top = 0;
+  for (int i = 0; i < n; ++i) {
+    int         dim, tag;
+    std::string name;
+    if (!(in >> dim >> tag) || !std::getline(in, name)) return "";
+    const size_t a = name.find('"'), b = name.rfind('"');
+    groups.emplace_back(dim, a != std::string::npos && b > a ? name.substr(a + 1, b - a - 1) : name);
+    top = std::max(top, dim);
+  }
+  std::string missing, all;
+  for (const auto &g : groups) all += (all.empty() ? "" : ", ") + g.second + " (" + std::to_string(g.first) + "D)";
+  for (const auto &b : scene.bodies) {
+    if (b.name == "all") continue;
+    bool found = false;
+    for (const auto &g : groups) found = found || (g.second == b.name && g.first == top);
+    if (!found) missing += (missing.empty() ? "'" : ", '") + b.name + "'";
+  }
+  if (missing.empty()) return "";
+  return "body " + missing + " of -bodies has no physical group of dimension " + std::to_string(top) + " in it (its groups: " + all + "), so gmsh saved that body's boundary without its cells: give its " + (top == 3 ? "volume" : "surface") + " a Physical " + (top == 3 ? "Volume" : "Surface") + " named as in -bodies";
+}
+
 PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
 {
   std::string msh;
@@ -305,6 +339,17 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   PetscCall(PetscOptionsHasName(NULL, NULL, "-dm_plex_gmsh_use_regions", &set));
   if (!set) PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_gmsh_use_regions", "true"));
   if (EndsWith(msh, ".msh")) PetscCall(CheckGmsh22Tags(comm, msh, "-mesh_file " + scene.mesh.file));
+  if (EndsWith(msh, ".msh")) {
+    // a body of -bodies whose cells are in no physical group: gmsh then saves only the lower-dimensional groups (the
+    // body's boundary curves without its cells), which PETSc's reader refuses on rank 0 while the other ranks wait in
+    // its collectives (a hang on 2 ranks for a generated mesh, which is not parsed on rank 0 first): checked before
+    std::string missing;
+    PetscMPIInt r0;
+    PetscCallMPI(MPI_Comm_rank(comm, &r0));
+    if (r0 == 0) missing = BodiesWithoutGroup(msh, scene);
+    PetscCall(BcastString(comm, &missing));
+    PetscCheck(missing.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "Mesh '%s' (from -mesh_file %s): %s", msh.c_str(), scene.mesh.file.c_str(), missing.c_str());
+  }
   {
     PetscErrorCode ierr = 0;
     PetscMPIInt    size, rank;
