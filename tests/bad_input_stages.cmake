@@ -74,5 +74,5 @@ rbc_bad_stage(list_empty_entry "option -body_E 100,,100: an empty entry in the l
 # a body of -bodies with no physical group of the mesh's dimension: "not a valid gmsh file?" on 1 rank, a hang on 2 (rank 0
 # left PETSc's reader with an error while the other ranks waited in it); checked before the reader (src/mesh/mesh_loader.cpp)
 find_program(RBC_MPIRUN_STAGE NAMES mpirun)
-add_test(NAME bad_input_body_without_group_np2 COMMAND ${RBC_EXPECT_ERROR_STAGE} "body 'block' of -bodies has no physical group of dimension 2" ${RBC_MPIRUN_STAGE} -n 2 ${RBC_EXE_STAGE} fom -options_file runs/ring_on_block.opts -mesh_file @NOBLOCK_GEO@ WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+add_test(NAME bad_input_body_without_group_np2 COMMAND ${RBC_EXPECT_ERROR_STAGE} "Physical name 'block' [(]option -bodies[)] does not exist as a group of dimension 2 [(]its groups: slave [(]1D[)].*no Physical Surface" ${RBC_MPIRUN_STAGE} -n 2 ${RBC_EXE_STAGE} fom -options_file runs/ring_on_block.opts -mesh_file @NOBLOCK_GEO@ WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(bad_input_body_without_group_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 PROCESSORS 2 LABELS bad_input)

@@ -2,20 +2,20 @@
 // online, validate, probe, dualbasis); PETSc options follow it. Each stage writes -report <file.json>.
 #include <petscsys.h>
 #include <slepcsys.h>
-#include <cctype>
-#include <vector>
-#include <functional>
-#include <fstream>
-#include <climits>
-#include <cerrno>
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <climits>
 #include <cstdlib>
-#include <dlfcn.h>
 #include <cstring>
+#include <dlfcn.h>
+#include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <vector>
 #include "rbcontact/provenance.hpp"
 #include "stages.hpp"
 

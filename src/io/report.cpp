@@ -2,14 +2,14 @@
 #include "rbcontact/report.hpp"
 #include "rbcontact/provenance.hpp"
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
+#include <fstream>
+#include <sstream>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -182,8 +182,8 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
     else { // the temporary file the writers create (the longest name they use), created and removed
       const std::string tmp = OutputTarget(path) + ".tmp." + std::to_string((long)getpid());
       const int         fd  = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
-      if (fd < 0) why = "cannot create the temporary file '" + tmp + "': " + std::strerror(errno);
-      else {
+      if (fd < 0 && errno != EEXIST) why = "cannot create the temporary file '" + tmp + "': " + std::strerror(errno);
+      else if (fd >= 0) {
         close(fd);
         std::remove(tmp.c_str());
       }
@@ -237,9 +237,15 @@ PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std
     for (size_t a = 0; a < outputs.size() && why.empty(); ++a) {
       if (ko[a].empty()) continue;
       for (size_t b = a + 1; b < outputs.size() && why.empty(); ++b)
-        if (ko[a] == ko[b] && (reportRefused = reportRefused || outputs[a].first == "-report" || outputs[b].first == "-report", true)) why = outputs[a].first + " " + outputs[a].second + " and " + outputs[b].first + " " + outputs[b].second + " name the same file: one output would replace the other";
+        if (ko[a] == ko[b]) {
+          why           = outputs[a].first + " " + outputs[a].second + " and " + outputs[b].first + " " + outputs[b].second + " name the same file: one output would replace the other";
+          reportRefused = reportRefused || outputs[a].first == "-report" || outputs[b].first == "-report";
+        }
       for (size_t b = 0; b < inputs.size() && why.empty(); ++b)
-        if (ko[a] == ki[b] && (reportRefused = reportRefused || outputs[a].first == "-report", true)) why = "the output " + outputs[a].first + " " + outputs[a].second + " is the input " + inputs[b].first + " " + inputs[b].second + ": writing it would replace what is read";
+        if (ko[a] == ki[b]) {
+          why           = "the output " + outputs[a].first + " " + outputs[a].second + " is the input " + inputs[b].first + " " + inputs[b].second + ": writing it would replace what is read";
+          reportRefused = reportRefused || outputs[a].first == "-report";
+        }
     }
   }
   PetscCall(BcastString(comm, &why));

@@ -315,16 +315,17 @@ static std::string BodiesWithoutGroup(const std::string &msh, const SceneSpec &s
     groups.emplace_back(dim, a != std::string::npos && b > a ? name.substr(a + 1, b - a - 1) : name);
     top = std::max(top, dim);
   }
-  std::string missing, all;
+  if (top < 2) return ""; // no cells in any group: left to the reader
+  std::string all;
   for (const auto &g : groups) all += (all.empty() ? "" : ", ") + g.second + " (" + std::to_string(g.first) + "D)";
   for (const auto &b : scene.bodies) {
     if (b.name == "all") continue;
     bool found = false;
     for (const auto &g : groups) found = found || (g.second == b.name && g.first == top);
-    if (!found) missing += (missing.empty() ? "'" : ", '") + b.name + "'";
+    if (!found)
+      return "Physical name '" + b.name + "' (option -bodies) does not exist as a group of dimension " + std::to_string(top) + " (its groups: " + all + "): misspelled, or the body's " + (top == 3 ? "volume has no Physical Volume" : "surface has no Physical Surface") + " (gmsh then saves its boundary without its cells)";
   }
-  if (missing.empty()) return "";
-  return "body " + missing + " of -bodies has no physical group of dimension " + std::to_string(top) + " in it (its groups: " + all + "), so gmsh saved that body's boundary without its cells: give its " + (top == 3 ? "volume" : "surface") + " a Physical " + (top == 3 ? "Volume" : "Surface") + " named as in -bodies";
+  return "";
 }
 
 PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
