@@ -115,6 +115,11 @@ for tag, path in (("refine 0", "validate.json"), ("refine 0", "validate_eim.json
           % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"], x["max_rel_err_u"], x["max_rel_err_lambda"]))
     print("  online median %.2e s per solve (in a sweep of distinct parameters %.2e s), FOM median %.2e s, speedup %.0f"
           % (r["online_time_s"]["median"], r["online_time_s"]["sweep_median"], r["fom_time_s"]["median"], r["speedup_median"]))
+for tag, path in (("refine 0", "offline.json"), ("refine 2", "refine2/offline.json")):
+    p = json.load(open(os.path.join(d, path))).get("probe")
+    if p:  # the offline stage solved its ROM over the whole box, no FOM (docs/online.md "Probing a model")
+        print("probe %s: the ROM at %d %s parameters of its box: %d failed, %d with projections at the edge of its contact data, Kacanov iterations max %d"
+              % (tag, p["size"], p["type"], p["failed"], p["out_of_range"], p.get("kacanov_iterations", {}).get("max", 0)))
 PY
   # the online error estimate (docs/error_estimate.md): the same snapshots, enriched bases and a calibration on 20
   # FOM solves (offline -estimate); every online solve reports its estimated errors, validate their effectivity
