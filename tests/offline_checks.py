@@ -173,16 +173,20 @@ def mismatch(args):
         check("Segmentation" not in p.stdout and "SEGV" not in p.stdout, "%s: no crash" % what)
     with h5py.File(d + "/s.h5", "r") as f:
         check(int(np.sum(np.array(f["snapshots/done"]))) == 3, "the refused file is untouched")
-    # a finished row holding a NaN (or inf): the bases step names the file, the dataset and the row
-    for ds, row, val in (("u", 1, np.nan), ("lambda", 2, np.inf)):
-        bad = d + "/bad_%s.h5" % ds
+    def bases_from_tampered(name, ds, row, val):
+        """The bases step on a copy of s.h5 whose done row `row` of /snapshots/<ds> has `val` in its middle entry."""
+        bad = d + "/%s.h5" % name
         shutil.copy(d + "/s.h5", bad)
         with h5py.File(bad, "r+") as f:
             x = np.array(f["snapshots/" + ds][row])
             x[len(x) // 2] = val
             f["snapshots/" + ds][row] = x
-        p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
-                            "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        return subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
+                               "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+    # a finished row holding a NaN (or inf): the bases step names the file, the dataset and the row
+    for ds, row, val in (("u", 1, np.nan), ("lambda", 2, np.inf)):
+        p = bases_from_tampered("bad_" + ds, ds, row, val)
         msg = [l for l in p.stdout.splitlines() if "error" in l.lower()][:1]
         print("  non-finite row of %s -> exit %d: %s" % (ds, p.returncode, msg[0] if msg else p.stdout[-300:]))
         check(p.returncode != 0 and ("bad_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and "non-finite" in p.stdout,
@@ -191,14 +195,7 @@ def mismatch(args):
     # a finished row whose parameter is not its training point, or with a negative multiplier (resumed without a word
     # before 2026-11-29; the negative one failed later in the dual basis without naming the file)
     for ds, row, val, words in (("mu", 0, 1.1, "is not training point 1"), ("lambda", 1, -5.0, "negative multiplier")):
-        bad = d + "/odd_%s.h5" % ds
-        shutil.copy(d + "/s.h5", bad)
-        with h5py.File(bad, "r+") as f:
-            x = np.array(f["snapshots/" + ds][row])
-            x[len(x) // 2] = val
-            f["snapshots/" + ds][row] = x
-        p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
-                            "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        p = bases_from_tampered("odd_" + ds, ds, row, val)
         check(p.returncode != 0 and ("odd_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and words in p.stdout and not os.path.exists(d + "/never.h5"),
               "a done row of /snapshots/%s with %s: refused naming the file and the row, no ROM" % (ds, words))
 
