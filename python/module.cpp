@@ -4,6 +4,7 @@
 // use (rbcontact.initialize(options) to pass PETSc options first) and finalized at exit; every PETSc error
 // becomes a Python RuntimeError carrying PETSc's message (the file, option or value it names).
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
+#include "rbcontact/rom_probe.hpp"
 #include "rbcontact/offline.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/validation.hpp"
@@ -220,14 +221,22 @@ private:
 std::string RunStage(const std::string &stage, const std::vector<std::string> &options)
 {
   Initialize({});
-  if (stage != "offline" && stage != "validate") throw std::runtime_error("rbcontact: unknown stage '" + stage + "' (offline or validate; online: ReducedModel)");
+  if (stage != "offline" && stage != "validate" && stage != "probe") throw std::runtime_error("rbcontact: unknown stage '" + stage + "' (offline, validate or probe; online: ReducedModel)");
   ScopedOptions scope(options);
   char          reportPath[PETSC_MAX_PATH_LEN] = "";
   Check(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   Check(rbc::CheckOutputPath(PETSC_COMM_WORLD, reportPath, "-report"));
   rbc::Report rep;
   if (stage == "offline") Check(rbc::RunOfflineFromOptions(PETSC_COMM_WORLD, &rep));
-  else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
+  else if (stage == "probe") { // the report whatever the failures (they are the answer; the command line's stage exits with an error)
+    char romPath[PETSC_MAX_PATH_LEN] = "";
+    Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
+    if (!romPath[0]) throw std::runtime_error("rbcontact.probe: give the ROM file (rom=...)");
+    Check(rbc::CheckDistinctFiles(PETSC_COMM_WORLD, {{"-report", reportPath}}, {{"-rom", romPath}}));
+    rbc::ProbeSummary ps;
+    rep.root["stage"] = "probe";
+    Check(rbc::ProbeRomFile(PETSC_COMM_WORLD, romPath, 1000, &rep.root["probe"], &ps));
+  } else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
   Check(rep.Write(PETSC_COMM_WORLD, reportPath));
   return rep.root.Dump();
 }
@@ -242,7 +251,7 @@ PYBIND11_MODULE(_rbcontact, m)
         "done with no options by the first ReducedModel");
   m.def("finalize", [] { if (liveModels == 0) Finalize(); else throw std::runtime_error("rbcontact.finalize: delete the ReducedModel objects first"); }, "Finalize PETSc/SLEPc (done at exit)");
   m.def("_run_stage", &RunStage, py::arg("stage"), py::arg("options"),
-        "Run the offline or validate stage with these command-line options; the JSON report as text");
+        "Run the offline, validate or probe stage with these command-line options; the JSON report as text");
   py::class_<Solution>(m, "Solution", "One reduced solution")
     .def_readonly("v", &Solution::v, "reduced displacement coordinates (N)")
     .def_readonly("lambda_hat", &Solution::lambda_hat, "reduced multiplier coordinates (R)")

@@ -142,6 +142,13 @@ def main():
         check(val["test"]["n"] == 3 and max(abs(a - b) for a, b in zip(eu, ec)) <= 1e-10 * max(ec) and max(eu) < 1e-3,
               "rbcontact.validate: 3 test radii, u errors %s equal to the command line's" % ", ".join("%.2e" % x for x in eu))
         raises(lambda: rbcontact.offline(options_file="runs/ring_on_block.opts", rom=d + "/bad.h5", offline_stop="bogus"), ["-offline_stop", "bogus"], "an unknown -offline_stop from Python")
+        # the probe from Python: the offline report's (same file, sample and seed) and the command line's
+        pr = rbcontact.probe(rom=pyrom)["probe"]
+        run(args.exe, 1, ["probe", "-rom", pyrom, "-report", d + "/clip.json"])
+        cp = json.load(open(d + "/clip.json"))["probe"]
+        check(pr["size"] == 1000 and pr["failed"] == 0 and pr == {**cp, "time_s": pr["time_s"]} and rep["probe"]["kacanov_iterations"] == pr["kacanov_iterations"],
+              "rbcontact.probe: 1000 parameters, none failed, the command line's report and the offline stage's iterations")
+        raises(lambda: rbcontact.probe(rom=pyrom, probe_size=0), ["-probe_size"], "-probe_size 0 from Python")
         del m
     finally:
         shutil.rmtree(d, ignore_errors=True)

@@ -14,6 +14,7 @@ command-line words) and their JSON report returned as a dict::
     rep = rbcontact.offline(options_file="runs/ring_on_block.opts", rom="rom.h5", train_size=5)
     val = rbcontact.validate(options_file="runs/ring_on_block.opts", rom="rom.h5", test_size=5)
     val["test"]["max_rel_err_u"]
+    rbcontact.probe(rom="rom.h5")["probe"]["failed"]   # the ROM at 1000 parameters of its box, no FOM
 
 PETSc options (``-rom_*``, docs/online.md) go through ``rbcontact.initialize([...])`` before the first model.
 Errors (a missing or mismatched file, a parameter outside its box, a solve that does not converge) raise
@@ -50,4 +51,11 @@ def validate(*args, **options):
     return _json.loads(_run_stage("validate", _words(args, options)))
 
 
-__all__ = ["ReducedModel", "Solution", "initialize", "finalize", "offline", "validate"]
+def probe(*args, **options):
+    """Solve a ROM file at many parameters of its box without the FOM (``rbcontact probe``; docs/online.md
+    "Probing a model"); returns the report (dict). ``probe(rom="rom.h5", probe_size=1000)["probe"]["failed"]``
+    counts the parameters where the reduced loop failed (not an exception here, unlike the command line's exit code)."""
+    return _json.loads(_run_stage("probe", _words(args, options)))
+
+
+__all__ = ["ReducedModel", "Solution", "initialize", "finalize", "offline", "validate", "probe"]
