@@ -4,6 +4,7 @@
 // use (rbcontact.initialize(options) to pass PETSc options first) and finalized at exit; every PETSc error
 // becomes a Python RuntimeError carrying PETSc's message (the file, option or value it names).
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/rom_probe.hpp"
 #include "rbcontact/offline.hpp"
 #include "rbcontact/reduced_model.hpp"
@@ -43,9 +44,15 @@ int  liveModels      = 0; // PETSc is finalized at exit once no ReducedModel (wh
 
 void Initialize(const std::vector<std::string> &options)
 {
+  // MPI cannot start again in a process: after rbcontact.finalize() every call raises (it aborted the interpreter)
+  if (PetscFinalizeCalled) throw std::runtime_error("rbcontact: PETSc was finalized (rbcontact.finalize()); it cannot be started again in this process");
   if (PetscInitializeCalled) {
     if (!options.empty()) throw std::runtime_error("rbcontact.initialize: PETSc is already initialized; pass the options before the first ReducedModel");
     return;
+  }
+  {
+    const std::string bad = rbc::CheckOptionsFiles(options);
+    if (!bad.empty()) throw std::runtime_error("rbcontact.initialize: " + bad);
   }
   // MPI and PETSc keep argv: it lives as long as the process, and ends with a null pointer (MPI_Init reads it)
   static std::vector<std::string> args;
@@ -190,6 +197,9 @@ class ScopedOptions {
 public:
   explicit ScopedOptions(const std::vector<std::string> &tokens)
   {
+    // an options file that includes itself: PETSc would recurse until the interpreter crashes
+    const std::string bad = rbc::CheckOptionsFiles(tokens);
+    if (!bad.empty()) throw std::runtime_error("rbcontact: " + bad);
     std::string line;
     for (const auto &t : tokens) {
       if (t.find('"') != std::string::npos) throw std::runtime_error("rbcontact: an option value may not hold a double quote: " + t);
@@ -227,16 +237,33 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
   Check(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   Check(rbc::CheckOutputPath(PETSC_COMM_WORLD, reportPath, "-report"));
   rbc::Report rep;
-  if (stage == "offline") Check(rbc::RunOfflineFromOptions(PETSC_COMM_WORLD, &rep));
-  else if (stage == "probe") { // the report whatever the failures (they are the answer; the command line's stage exits with an error)
-    char romPath[PETSC_MAX_PATH_LEN] = "";
-    Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
-    if (!romPath[0]) throw std::runtime_error("rbcontact.probe: give the ROM file (rom=...)");
-    Check(rbc::CheckDistinctFiles(PETSC_COMM_WORLD, {{"-report", reportPath}}, {{"-rom", romPath}}));
-    rbc::ProbeSummary ps;
-    rep.root["stage"] = "probe";
-    Check(rbc::ProbeRomFile(PETSC_COMM_WORLD, romPath, 1000, &rep.root["probe"], &ps));
-  } else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
+  try {
+    if (stage == "offline") Check(rbc::RunOfflineFromOptions(PETSC_COMM_WORLD, &rep));
+    else if (stage == "probe") { // the report whatever the failures (they are the answer; the command line's stage exits with an error)
+      char romPath[PETSC_MAX_PATH_LEN] = "";
+      Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
+      if (!romPath[0]) throw std::runtime_error("rbcontact.probe: give the ROM file (rom=...)");
+      Check(rbc::CheckDistinctFiles(PETSC_COMM_WORLD, {{"-report", reportPath}}, {{"-rom", romPath}}));
+      rbc::ProbeSummary ps;
+      rep.root["stage"] = "probe";
+      Check(rbc::ProbeRomFile(PETSC_COMM_WORLD, romPath, 1000, &rep.root["probe"], &ps));
+    } else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
+  } catch (const std::exception &e) { // as the command line: a failed run replaces an earlier report with its failure
+    PetscMPIInt rank = 0;
+    MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+    if (rank == 0 && reportPath[0]) rbc::WriteFailureReport(reportPath, stage, e.what(), 1, true);
+    throw;
+  }
+  // options of this call nobody read (a misspelled keyword: trian_size=5 ran the file's 21 points without a word)
+  std::vector<std::string> unused;
+  Check(rbc::UnusedOptions(stage, &unused));
+  if (!unused.empty()) {
+    rbc::JsonValue &w = rep.root["warnings"];
+    for (const auto &u : unused) {
+      w.Push(rbc::JsonValue::String(u));
+      PyErr_WarnEx(PyExc_UserWarning, ("rbcontact." + stage + ": " + u).c_str(), 1);
+    }
+  }
   Check(rep.Write(PETSC_COMM_WORLD, reportPath));
   return rep.root.Dump();
 }

@@ -149,7 +149,28 @@ def main():
         check(pr["size"] == 1000 and pr["failed"] == 0 and pr == {**cp, "time_s": pr["time_s"]} and rep["probe"]["kacanov_iterations"] == pr["kacanov_iterations"],
               "rbcontact.probe: 1000 parameters, none failed, the command line's report and the offline stage's iterations")
         raises(lambda: rbcontact.probe(rom=pyrom, probe_size=0), ["-probe_size"], "-probe_size 0 from Python")
+        # keywords: False turns an option off, an options file never overrides the keywords given with it (whatever their
+        # order), a misspelled keyword is warned about (it ran the file's 21 points without a word)
+        import warnings
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r5 = rbcontact.offline(train_size=5, rom=d + "/kw.h5", offline_probe=False, trian_size=3, options_file="runs/ring_on_block.opts")
+        said = [str(w.message) for w in caught if "trian_size" in str(w.message)]
+        check(r5["ntrain"] == 5 and "probe" not in r5, "keywords before options_file= win over the file (5 training points), offline_probe=False turns the probe off")
+        check(len(said) == 1 and "was not used by the offline stage" in said[0] and any("trian_size" in w for w in r5.get("warnings", [])),
+              "a misspelled keyword (trian_size): a UserWarning and the report's warnings")
+        # an options file that includes itself (crashed the interpreter); a failed call replaces an earlier report
+        with open(d + "/self.opts", "w") as f:
+            f.write("-options_file %s/self.opts\n" % d)
+        raises(lambda: rbcontact.validate(options_file=d + "/self.opts", rom=pyrom), ["includes itself"], "an options file that includes itself, from Python")
+        with open(d + "/old.json", "w") as f:
+            f.write('{"stage": "old", "converged": true}')
+        raises(lambda: rbcontact.validate(options_file="runs/ring_on_block.opts", rom=missing, report=d + "/old.json"), ["nonexistent.h5"], "validate of a missing ROM from Python")
+        check(json.load(open(d + "/old.json"))["converged"] is False, "the failed call replaced the earlier report with its failure")
         del m
+        # after finalize() PETSc cannot start again (MPI cannot): an exception, not an abort of the interpreter
+        rbcontact.finalize()
+        raises(lambda: rbcontact.ReducedModel(pyrom), ["finalized"], "a model opened after rbcontact.finalize()")
     finally:
         shutil.rmtree(d, ignore_errors=True)
     print("%d passed, %d failed" % (0 if failures else 1, 1 if failures else 0))

@@ -1082,6 +1082,9 @@ def probe(args):
         q = run(args, np_, "probe", ["-rom", d + "/bad.h5", "-report", "%s/p%d.json" % (d, np_)], expect_ok=False)
         check(q.returncode != 0 and "probe parameters; first at probe parameter" in q.stdout, "probe stage, %d rank(s): exit code and the first failure named" % np_)
         reps[np_] = q.stdout
+    r1 = report("%s/p1.json" % d)
+    check(r1["converged"] is False and r1["probe"]["failed"] == pr["failed"] and r1["probe"]["out_of_range"] == pr["out_of_range"] and "first at probe parameter" in r1["error"],
+          "probe stage with failures: the report keeps the probe's counts (failed %s, out of range %s) with the error" % (r1["probe"]["failed"], r1["probe"]["out_of_range"]))
     f1 = re.search(r"failed at (\d+) of 1000 probe parameters; first at probe parameter (\d+)", reps[1])
     f2 = re.search(r"failed at (\d+) of 1000 probe parameters; first at probe parameter (\d+)", reps[2])
     check(f1 is not None and f2 is not None and f1.groups() == f2.groups() and int(f1.group(1)) == pr["failed"],
@@ -1089,6 +1092,8 @@ def probe(args):
     # -offline_probe_fail: an error, the ROM file still written
     p = run(args, 2, "offline", opts + ["-rom", d + "/bad.h5", "-offline_probe_fail", "-report", d + "/fail.json"], expect_ok=False)
     check(p.returncode != 0 and "-offline_probe_fail" in p.stdout and os.path.exists(d + "/bad.h5"), "-offline_probe_fail: an error naming it, the ROM file kept")
+    rf = report(d + "/fail.json")
+    check(rf["converged"] is False and rf["probe"]["failed"] > 0 and "rom" in rf, "-offline_probe_fail: the offline report kept (rom, probe) with the error")
     # the shipped ring model: no failure, no projection at the edge; with an estimate, the largest one and where it is
     rom, off = offline(args, d, np_=2, extra=["-estimate", "-probe_size", "200"])
     pr = off["probe"]
@@ -1113,6 +1118,11 @@ def probe(args):
     expect_error(args, ["-rom", d + "/nosuch.h5"], ["nosuch.h5"], "probe of a missing ROM file", stage="probe")
     expect_error(args, ["-rom", rom, "-probe_size", "0"], ["-probe_size"], "-probe_size 0", stage="probe")
     expect_error(args, ["-rom", rom, "-probe_type", "bogus"], ["-probe_type", "bogus"], "unknown -probe_type", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_size", "2000000000"], ["-probe_size 2000000000", "more than 10000000"], "-probe_size 2e9 (was std::bad_alloc)", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_size"], ["-probe_size is given without a value"], "-probe_size without a value (ran 1000)", stage="probe")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-rom", d + "/eim.h5", "-rom_hyper", "eim", "-estimate"], ["-estimate needs the empirical cubature"],
+                 "offline -estimate -rom_hyper eim (failed after its FOM solves, replacing the files)", stage="offline")
+    check(not os.path.exists(d + "/eim.h5") and not os.path.exists(d + "/eim.snapshots.h5"), "offline -estimate -rom_hyper eim: refused before any file")
     expect_error(args, ["-rom", rom, "-probe_size", "5", "-probe_type", "file", "-probe_file", d + "/nosuch.txt"], ["nosuch.txt"], "missing -probe_file", stage="probe")
     shutil.rmtree(d, ignore_errors=True)
 
@@ -1182,6 +1192,16 @@ def guards(args):
             check(ok, "a ROM file with /online/contact tampered (%s), -rom_hyper %s: refused naming the file and dataset" % (name, hyper))
             if not ok:
                 print(p.stdout[-800:])
+    # /online/affine: a huge finite value (1e200 x f) and a record reading tensor entry 1e8 of body 0 (segfaults, found by a
+    # second audit)
+    for name, ds, change, words in (("f_big", "online/affine/f", lambda a: a * 1e200, ["/online/affine/f", "a corrupt file"]),
+                                    ("thetaA_entry", "online/affine/thetaA", lambda a: np.concatenate(([0, 1e8, -1, -1, -1, 1], a.flat[6:])).reshape(a.shape), ["thetaA record 0", "tensor entry 100000000 out of range"])):
+        shutil.copy(rom, d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "a") as f:
+            a = change(np.array(f[ds]))
+            del f[ds]
+            f[ds] = a
+        expect_error(args, ["-rom", d + "/%s.h5" % name, "-mu", "1.02"], words + [name + ".h5"], "a ROM file with %s tampered" % ds)
     # options files: one that includes itself, one missing; the previous report replaced by the failure's
     with open(d + "/self.opts", "w") as f:
         f.write("-options_file %s/self.opts\n" % d)

@@ -80,6 +80,16 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
 // input (option, path): -report equal to -rom, -rom_reconstruct onto the ROM it reads. Empty paths are
 // skipped; files compare by device and inode when they exist, else by their resolved directory and name.
 // Collective (rank 0 looks).
+// The report of a failed run: {"stage", "converged": false, "error", "error_code"[, "provenance"]} written to path by the
+// calling rank alone (temporary file + rename). Never onto a device, a path the run refused (ReportPathRefused), a
+// report the stage wrote itself (FailureReported) or an HDF5 file (a ROM or snapshot file named by mistake).
+void WriteFailureReport(const char *path, const std::string &stage, const std::string &error, long long code, bool provenance);
+
+// A stage that wrote its full report with "converged": false and the error before failing (the probe's failures)
+// marks it, so that the executable's generic failure report does not replace it.
+void MarkFailureReported();
+bool FailureReported();
+
 // True once CheckOutputPath or CheckDistinctFiles refused the -report path: the failure report (src/apps/main.cpp)
 // is then not written there either.
 bool ReportPathRefused();

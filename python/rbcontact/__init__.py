@@ -26,12 +26,20 @@ from ._rbcontact import ReducedModel, Solution, initialize, finalize, _run_stage
 
 
 def _words(args, kw):
-    words = [str(a) for a in args]
+    # an options file first, so that the keywords and words given with it override its values whatever their order
+    # (PETSc lets the later of two settings win); None leaves an option out, False gives "-name 0"
+    kw = dict(kw)
+    words = []
+    if kw.get("options_file") is not None:
+        words += ["-options_file", str(kw.pop("options_file"))]
+    words += [str(a) for a in args]
     for k, v in kw.items():
-        if v is None or v is False:
+        if v is None:
             continue
         words.append("-" + k)
-        if v is not True:
+        if v is False:
+            words.append("0")
+        elif v is not True:
             words.append(",".join(str(x) for x in v) if isinstance(v, (list, tuple)) else str(v))
     return words
 

@@ -4,18 +4,17 @@
 #include <slepcsys.h>
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <climits>
 #include <cstdlib>
 #include <cstring>
 #include <dlfcn.h>
-#include <fstream>
-#include <functional>
+#include <exception>
+#include <new>
 #include <sstream>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/provenance.hpp"
 #include "stages.hpp"
 
@@ -30,59 +29,14 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "  dualbasis nonnegative dual basis of imported multiplier snapshots (-snapshots f.h5:/dataset)\n"
                            "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md, eim.md, online.md).\n";
 
-// Option families a shared scene file (runs/<scene>.opts) may carry for the stages that consume them:
-// an unused option of a family this stage does not consume is not reported (no false positives from
-// the other stages' settings); any other unused option is (a misspelling: -kacanov_max_iter).
-static bool OtherStagesOption(const std::string &stage, const std::string &name)
-{
-  struct Family {
-    const char *prefix, *stages;
-  };
-  static const Family fam[] = {{"train_", "offline"},      {"snapshots", "offline dualbasis"}, {"offline_", "offline"}, {"pod_", "offline"},
-                               {"dual_", "offline dualbasis"}, {"nnls_", "offline dualbasis"}, {"mcpg_", "offline dualbasis"}, {"nmf_", "offline dualbasis"},
-                               {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate probe"}, {"online_", "online"},
-                               {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"},
-                               {"greedy_", "offline"},     {"probe_", "offline probe"}};
-  std::string skipped; // families of the offline steps -offline_stop leaves out
-  if (stage == "offline") {
-    char      stop[32] = "";
-    PetscBool set      = PETSC_FALSE;
-    (void)PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, &set);
-    if (set && !std::strcmp(stop, "snapshots")) skipped = " pod_ dual_ nnls_ mcpg_ nmf_ eim_ ecsw_ rom_ ";
-    else if (set && !std::strcmp(stop, "bases")) skipped = " eim_ ecsw_ rom_ ";
-    // a scene file may ship both trainings' settings: the greedy's (-greedy_*) with a grid run, -train_size with a greedy one
-    char type[32] = "";
-    (void)PetscOptionsGetString(NULL, NULL, "-train_type", type, sizeof type, NULL);
-    if (!std::strcmp(type, "greedy") && name != "train_type") skipped += " train_ ";
-    else skipped += " greedy_ ";
-  }
-  for (const auto &f : fam)
-    if (name.compare(0, std::strlen(f.prefix), f.prefix) == 0)
-      return (" " + std::string(f.stages) + " ").find(" " + stage + " ") == std::string::npos || skipped.find(" " + std::string(f.prefix) + " ") != std::string::npos;
-  // online, probe and dualbasis read their own families only (online: plus the scene with -rom_reconstruct)
-  if (stage == "dualbasis" || stage == "probe") return true;
-  if (stage == "online") {
-    PetscBool rec = PETSC_FALSE;
-    (void)PetscOptionsHasName(NULL, NULL, "-rom_reconstruct", &rec);
-    return !rec;
-  }
-  return false;
-}
-
 // After a successful stage: a warning per option nobody read (misspelled, or for another solver).
 static PetscErrorCode WarnUnusedOptions(const std::string &stage)
 {
-  PetscInt n;
-  char   **names, **values;
+  std::vector<std::string> unused;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
-  for (PetscInt i = 0; i < n; ++i) {
-    const std::string name = names[i][0] == '-' ? names[i] + 1 : names[i];
-    if (OtherStagesOption(stage, name)) continue;
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: warning: option -%s%s%s was not used by the %s stage (misspelled? `rbcontact %s -help` lists the options)\n", name.c_str(), values[i] ? " " : "", values[i] ? values[i] : "", stage.c_str(), stage.c_str()));
-  }
-  PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
+  PetscCall(rbc::UnusedOptions(stage, &unused));
+  for (const auto &u : unused) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: warning: %s\n", u.c_str()));
   PetscFunctionReturn(0);
 }
 
@@ -153,35 +107,6 @@ static PetscErrorCode OneBlasThreadPerRank()
 // communication here), to a temporary file then renamed. A report the stage wrote before failing
 // is replaced: the run did not finish. Never onto a device, a path the run refused (an input, another
 // output) or an HDF5 file (a ROM, snapshot or field file named by mistake).
-static void WriteFailureReport(const char *path, const std::string &stage, const std::string &error, long long code, bool provenance)
-{
-  rbc::JsonValue r = rbc::JsonValue::Object();
-  r["stage"]       = stage;
-  r["converged"]   = false;
-  r["error"]       = error;
-  r["error_code"]  = code;
-  if (provenance) r["provenance"] = rbc::ProvenanceJson(rbc::LocalProvenance());
-  const std::string target = rbc::OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
-  struct stat       st;
-  if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return; // a directory or device (refused by CheckOutputPath): never replaced
-  if (rbc::ReportPathRefused()) return;                                 // the path the run refused (an input, another output)
-  {
-    char       sig[8] = {0};
-    FILE      *h      = std::fopen(target.c_str(), "rb");
-    const bool hdf5   = h && std::fread(sig, 1, 8, h) == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
-    if (h) std::fclose(h);
-    if (hdf5) return;
-  }
-  FILE *f = std::fopen(tmp.c_str(), "w");
-  if (!f) return;
-  const std::string text = r.Dump() + "\n";
-  const bool        ok   = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), target.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    std::fprintf(stderr, "rbcontact: could not write the failure report %s\n", path);
-  }
-}
-
 static void FailureReport(const std::string &stage, PetscErrorCode ierr)
 {
   char        path[PETSC_MAX_PATH_LEN] = "";
@@ -189,51 +114,7 @@ static void FailureReport(const std::string &stage, PetscErrorCode ierr)
   PetscMPIInt rank                     = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (rank != 0 || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
-  WriteFailureReport(path, stage, firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError, (long long)ierr, true);
-}
-
-// Before PETSc reads them: every -options_file of the command line, and those the files name in turn, exists and is
-// readable, and none includes itself (PETSc 3.18 then recurses until the stack overflows: a segmentation fault with
-// no message). Files are named as given, resolved from the working directory as PETSc does. "" when all is well.
-static std::string CheckOptionsFiles(int argc, char **argv)
-{
-  std::vector<std::string>                             chain, shown;
-  std::function<std::string(const std::string &, int)> visit = [&](const std::string &file, int depth) -> std::string {
-    char buf[PATH_MAX];
-    if (!realpath(file.c_str(), buf)) return "options file " + file + " (-options_file): " + std::strerror(errno);
-    const std::string canon = buf;
-    if (std::find(chain.begin(), chain.end(), canon) != chain.end()) {
-      std::string path;
-      for (const auto &s : shown) path += s + " -> ";
-      return "options file " + file + " includes itself through -options_file (" + path + file + ")";
-    }
-    if (depth >= 16) return "options file " + file + ": -options_file nested more than 16 deep";
-    std::ifstream in(file);
-    if (!in) return "options file " + file + " (-options_file): cannot be read";
-    chain.push_back(canon);
-    shown.push_back(file);
-    for (std::string line; std::getline(in, line);) {
-      const size_t hash = line.find('#');
-      if (hash != std::string::npos) line.resize(hash);
-      std::istringstream       ls(line);
-      std::vector<std::string> tok;
-      for (std::string t; ls >> t;) tok.push_back(t);
-      for (size_t k = 0; k + 1 < tok.size(); ++k)
-        if (tok[k] == "-options_file") {
-          const std::string e = visit(tok[k + 1], depth + 1);
-          if (!e.empty()) return e;
-        }
-    }
-    chain.pop_back();
-    shown.pop_back();
-    return "";
-  };
-  for (int i = 1; i + 1 < argc; ++i)
-    if (!std::strcmp(argv[i], "-options_file")) {
-      const std::string e = visit(argv[i + 1], 0);
-      if (!e.empty()) return e;
-    }
-  return "";
+  rbc::WriteFailureReport(path, stage, firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError, (long long)ierr, true);
 }
 
 // A list value with an empty entry (-body_E ,100,100: PETSc's "String of length zero has no numerical value", naming no
@@ -268,14 +149,14 @@ int main(int argc, char **argv)
   --argc;
 
   {
-    const std::string bad = CheckOptionsFiles(argc, argv);
+    const std::string bad = rbc::CheckOptionsFiles(std::vector<std::string>(argv + 1, argv + argc));
     if (!bad.empty()) { // PETSc is not initialized: MPI only, for the rank and a clean exit under mpirun
       int rank = 0;
       MPI_Init(&argc, &argv);
       MPI_Comm_rank(MPI_COMM_WORLD, &rank);
       std::fprintf(stderr, "[%d] rbcontact error: %s\n", rank, bad.c_str());
       for (int i = 1; rank == 0 && i + 1 < argc; ++i)
-        if (!std::strcmp(argv[i], "-report") && argv[i + 1][0]) WriteFailureReport(argv[i + 1], stage, bad, (long long)PETSC_ERR_FILE_OPEN, false);
+        if (!std::strcmp(argv[i], "-report") && argv[i + 1][0]) rbc::WriteFailureReport(argv[i + 1], stage, bad, (long long)PETSC_ERR_FILE_OPEN, false);
       MPI_Finalize();
       return (int)PETSC_ERR_FILE_OPEN;
     }
@@ -288,17 +169,29 @@ int main(int argc, char **argv)
     if (!full) PetscCall(PetscPushErrorHandler(ConciseErrorHandler, NULL));
   }
   PetscErrorCode ierr = EmptyListEntries();
-  if (ierr) {
-  } else if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
-  else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
-  else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
-  else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);
-  else if (stage == "validate") ierr = rbc::StageValidate(PETSC_COMM_WORLD);
-  else if (stage == "probe") ierr = rbc::StageProbe(PETSC_COMM_WORLD);
-  else {
-    firstError = "unknown stage '" + stage + "' (known: fom, offline, online, validate, probe, dualbasis)";
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
-    ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
+  try {
+    if (ierr) {
+    } else if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
+    else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
+    else if (stage == "dualbasis") ierr = rbc::StageDualBasis(PETSC_COMM_WORLD);
+    else if (stage == "online") ierr = rbc::StageOnline(PETSC_COMM_WORLD);
+    else if (stage == "validate") ierr = rbc::StageValidate(PETSC_COMM_WORLD);
+    else if (stage == "probe") ierr = rbc::StageProbe(PETSC_COMM_WORLD);
+    else {
+      firstError = "unknown stage '" + stage + "' (known: fom, offline, online, validate, probe, dualbasis)";
+      PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
+      ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
+    }
+  } catch (const std::exception &e) { // a C++ exception through the stage (std::bad_alloc: a size beyond memory): said, reported, then
+    // MPI_Abort, since the other ranks may wait in a collective
+    const bool  mem = dynamic_cast<const std::bad_alloc *>(&e) != nullptr;
+    PetscMPIInt rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    firstError = std::string(mem ? "out of memory (std::bad_alloc): a size option too large for this machine?" : "C++ exception: ") + (mem ? "" : e.what());
+    std::fprintf(stderr, "[%d] rbcontact error: %s\n", (int)rank, firstError.c_str());
+    ierr = mem ? PETSC_ERR_MEM : PETSC_ERR_LIB;
+    FailureReport(stage, ierr);
+    MPI_Abort(MPI_COMM_WORLD, (int)ierr);
   }
   if (ierr) {
     // The error message was printed by PETSc's handler; the report says the run failed; exit non-zero.

@@ -17,6 +17,9 @@ namespace rbc {
 
 static bool reportRefused = false; // CheckOutputPath / CheckDistinctFiles refused -report (ReportPathRefused)
 bool        ReportPathRefused() { return reportRefused; }
+static bool failureReported = false; // MarkFailureReported
+void        MarkFailureReported() { failureReported = true; }
+bool        FailureReported() { return failureReported; }
 
 JsonValue JsonValue::Number(double v) { JsonValue j; j.kind_ = Kind::Number; j.num_ = v; return j; }
 JsonValue JsonValue::Integer(long long v) { JsonValue j; j.kind_ = Kind::Integer; j.int_ = v; return j; }
@@ -251,6 +254,36 @@ PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std
   PetscCall(BcastString(comm, &why));
   PetscCheck(why.empty(), comm, PETSC_ERR_ARG_WRONG, "%s (checked before any work; nothing was computed or written)", why.c_str());
   PetscFunctionReturn(0);
+}
+
+void WriteFailureReport(const char *path, const std::string &stage, const std::string &error, long long code, bool provenance)
+{
+  JsonValue r = JsonValue::Object();
+  r["stage"]       = stage;
+  r["converged"]   = false;
+  r["error"]       = error;
+  r["error_code"]  = code;
+  if (provenance) r["provenance"] = ProvenanceJson(LocalProvenance());
+  const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+  struct stat       st;
+  if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return; // a directory or device (refused by CheckOutputPath): never replaced
+  if (ReportPathRefused()) return;                                 // the path the run refused (an input, another output)
+  if (FailureReported()) return;                                   // the stage wrote its own, with the error
+  {
+    char       sig[8] = {0};
+    FILE      *h      = std::fopen(target.c_str(), "rb");
+    const bool hdf5   = h && std::fread(sig, 1, 8, h) == 8 && std::memcmp(sig, "\x89HDF\r\n\x1a\n", 8) == 0;
+    if (h) std::fclose(h);
+    if (hdf5) return;
+  }
+  FILE *f = std::fopen(tmp.c_str(), "w");
+  if (!f) return;
+  const std::string text = r.Dump() + "\n";
+  const bool        ok   = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (std::fclose(f) != 0 || !ok || std::rename(tmp.c_str(), target.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    std::fprintf(stderr, "rbcontact: could not write the failure report %s\n", path);
+  }
 }
 
 PetscErrorCode Report::Write(MPI_Comm comm, const std::string &path) const

@@ -209,6 +209,11 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   PetscCheck(type == "grid" || type == "random" || type == "lhs" || type == "file", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "Unknown value '%s' for option %s (grid, random, lhs or file%s)", type.c_str(), optType.c_str(), pre == "train_" ? "; the offline stage also takes greedy" : "");
   PetscCheck(seed >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT " must be >= 0", optSeed.c_str(), seed);
   PetscCheck(!flgSize || nsizes <= 64, comm, PETSC_ERR_ARG_SIZ, "%s takes at most 64 values, more were given", optSize.c_str());
+  {
+    PetscBool named = PETSC_FALSE; // PETSc reports a list option without a value as not set: the default ran silently
+    PetscCall(PetscOptionsHasName(NULL, prefix, "-size", &named));
+    PetscCheck(!named || (flgSize && nsizes >= 1), comm, PETSC_ERR_USER_INPUT, "option %s is given without a value", optSize.c_str());
+  }
   std::vector<PetscInt> counts;
   if (flgSize) counts.assign(sizes, sizes + nsizes);
   for (PetscInt c : counts) PetscCheck(c >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: %" PetscInt_FMT " samples; every count must be >= 1", optSize.c_str(), c);
@@ -221,11 +226,12 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
     PetscCheck(counts.size() == 1 || counts.size() == params.size(), comm, PETSC_ERR_USER_INPUT, "%s has %zu counts; give one count, or one per parameter (the scene has %zu parameters: %s)", optSize.c_str(), counts.size(), params.size(), Names(params).c_str());
     double total = 1;
     for (size_t j = 0; j < params.size(); ++j) total *= (double)(counts.size() == 1 ? counts[0] : counts[j]);
-    PetscCheck(total <= 1e7, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: the tensor grid would have %g points (more than 1e7)", optSize.c_str(), total);
+    PetscCheck(total <= 1e7, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: the tensor grid would have %.0f points (more than 10000000)", optSize.c_str(), total);
     set->points = GridSample(params, counts);
   } else if (type == "random" || type == "lhs") {
     if (counts.empty()) counts.assign(1, defSize);
     PetscCheck(counts.size() == 1, comm, PETSC_ERR_USER_INPUT, "%s: %s %s takes one number of samples (a list of counts is for %s grid)", optSize.c_str(), optType.c_str(), type.c_str(), optType.c_str());
+    PetscCheck(counts[0] <= 10000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": more than 10000000 samples", optSize.c_str(), counts[0]);
     set->points = type == "random" ? RandomSample(params, counts[0], (unsigned long long)seed) : LatinHypercubeSample(params, counts[0], (unsigned long long)seed);
   } else {
     PetscCheck(flgFile && !file.empty(), comm, PETSC_ERR_USER_INPUT, "%s file needs %s <path>", optType.c_str(), optFile.c_str());

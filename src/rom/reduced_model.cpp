@@ -65,6 +65,9 @@ PetscErrorCode ReadChecked(const std::string &file, const std::string &name, siz
   PetscCall(RomReadDataset(file, name, &dims, data));
   PetscCheck(expect == (size_t)-1 || data->size() == expect, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s has %zu entries, %zu expected (corrupt or mismatched file)", file.c_str(), name.c_str(), data->size(), expect);
   for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
+  // no value of a model comes near 1e150 (moduli, coordinates, reduced operators); such a value is a corrupt file whose
+  // products overflow to inf and NaN in the online solve (1e200 in /online/affine/f crashed it)
+  for (double v : *data) PetscCheck(std::abs(v) < 1e150, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds the value %g: a corrupt file", file.c_str(), name.c_str(), v);
   PetscFunctionReturn(0);
 }
 
@@ -155,6 +158,9 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
     for (const auto &c : *cs)
       PetscCheck(c.tensorBody < (PetscInt)bodies.size() && c.detBody < (PetscInt)bodies.size() && c.surfBody < (PetscInt)bodies.size() && c.param < (PetscInt)params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: a coefficient function refers to an unknown body or parameter", file.c_str());
   Light();
+  for (const auto *cs : {&thetaA, &thetaF}) // the entry of the effective tensor a coefficient reads
+    for (size_t q = 0; q < cs->size(); ++q)
+      PetscCheck((*cs)[q].tensorBody < 0 || ((*cs)[q].tensorEntry >= 0 && (*cs)[q].tensorEntry < light_->AuxSize()), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s record %zu: tensor entry %" PetscInt_FMT " out of range [0, %" PetscInt_FMT ")", file.c_str(), cs == &thetaA ? "/online/affine/thetaA" : "/online/affine/thetaF", q, (*cs)[q].tensorEntry, light_->AuxSize());
   PetscFunctionReturn(0);
 }
 

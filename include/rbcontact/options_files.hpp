@@ -1,0 +1,22 @@
+// rbcontact/options_files.hpp: the options of a run checked around PETSc's reading of them (the executable's main and
+// the Python module's stages): the -options_file chain before (PETSc 3.18 follows -options_file inside a file
+// recursively, so a file that includes itself overflowed the stack: a segmentation fault, no message), and the
+// options nobody read after (misspelled).
+#pragma once
+#include <petscsys.h>
+#include <string>
+#include <vector>
+
+namespace rbc {
+
+// Every "-options_file F" among words, and those the files name in turn: each exists and is readable, none includes
+// itself, nested at most 16 deep. Files are resolved from the working directory, as PETSc does. Returns "" when all is
+// well, else the message ("options file a.opts includes itself through -options_file (a.opts -> b.opts -> a.opts)").
+std::string CheckOptionsFiles(const std::vector<std::string> &words);
+
+// After a stage ran: the options of the database in use (PETSc's default one, or a pushed one) that nobody read, as
+// messages ("option -trian_size 5 was not used by the offline stage (misspelled? ...)"), leaving out the families of
+// the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...).
+PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused);
+
+} // namespace rbc

@@ -1,0 +1,112 @@
+// src/io/options_files.cpp: the -options_file chain checked before PETSc reads it (options_files.hpp).
+#include "rbcontact/options_files.hpp"
+#include <petscsys.h>
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+namespace rbc {
+
+// Option families a shared scene file (runs/<scene>.opts) may carry for the stages that consume them:
+// an unused option of a family this stage does not consume is not reported (no false positives from
+// the other stages' settings); any other unused option is (a misspelling: -kacanov_max_iter).
+static bool OtherStagesOption(const std::string &stage, const std::string &name)
+{
+  struct Family {
+    const char *prefix, *stages;
+  };
+  static const Family fam[] = {{"train_", "offline"},      {"snapshots", "offline dualbasis"}, {"offline_", "offline"}, {"pod_", "offline"},
+                               {"dual_", "offline dualbasis"}, {"nnls_", "offline dualbasis"}, {"mcpg_", "offline dualbasis"}, {"nmf_", "offline dualbasis"},
+                               {"eim_", "offline"},        {"ecsw_", "offline"},             {"rom_", "offline online validate probe"}, {"online_", "online"},
+                               {"test_", "validate"},      {"validate_", "validate"},        {"import_", "dualbasis"},
+                               {"greedy_", "offline"},     {"probe_", "offline probe"}};
+  std::string skipped; // families of the offline steps -offline_stop leaves out
+  if (stage == "offline") {
+    char      stop[32] = "";
+    PetscBool set      = PETSC_FALSE;
+    (void)PetscOptionsGetString(NULL, NULL, "-offline_stop", stop, sizeof stop, &set);
+    if (set && !std::strcmp(stop, "snapshots")) skipped = " pod_ dual_ nnls_ mcpg_ nmf_ eim_ ecsw_ rom_ ";
+    else if (set && !std::strcmp(stop, "bases")) skipped = " eim_ ecsw_ rom_ ";
+    // a scene file may ship both trainings' settings: the greedy's (-greedy_*) with a grid run, -train_size with a greedy one
+    char type[32] = "";
+    (void)PetscOptionsGetString(NULL, NULL, "-train_type", type, sizeof type, NULL);
+    if (!std::strcmp(type, "greedy") && name != "train_type") skipped += " train_ ";
+    else skipped += " greedy_ ";
+  }
+  for (const auto &f : fam)
+    if (name.compare(0, std::strlen(f.prefix), f.prefix) == 0)
+      return (" " + std::string(f.stages) + " ").find(" " + stage + " ") == std::string::npos || skipped.find(" " + std::string(f.prefix) + " ") != std::string::npos;
+  // online, probe and dualbasis read their own families only (online: plus the scene with -rom_reconstruct)
+  if (stage == "dualbasis" || stage == "probe") return true;
+  if (stage == "online") {
+    PetscBool rec = PETSC_FALSE;
+    (void)PetscOptionsHasName(NULL, NULL, "-rom_reconstruct", &rec);
+    return !rec;
+  }
+  return false;
+}
+
+PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *out)
+{
+  PetscInt n;
+  char   **names, **values;
+
+  PetscFunctionBeginUser;
+  out->clear();
+  PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
+  for (PetscInt i = 0; i < n; ++i) {
+    const std::string name = names[i][0] == '-' ? names[i] + 1 : names[i];
+    if (OtherStagesOption(stage, name)) continue;
+    out->push_back("option -" + name + (values[i] ? " " + std::string(values[i]) : std::string()) + " was not used by the " + stage + " stage (misspelled? `rbcontact " + stage + " -help` lists the options)");
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
+  PetscFunctionReturn(0);
+}
+
+std::string CheckOptionsFiles(const std::vector<std::string> &words)
+{
+  std::vector<std::string>                             chain, shown;
+  std::function<std::string(const std::string &, int)> visit = [&](const std::string &file, int depth) -> std::string {
+    char buf[PATH_MAX];
+    if (!realpath(file.c_str(), buf)) return "options file " + file + " (-options_file): " + std::strerror(errno);
+    const std::string canon = buf;
+    if (std::find(chain.begin(), chain.end(), canon) != chain.end()) {
+      std::string path;
+      for (const auto &s : shown) path += s + " -> ";
+      return "options file " + file + " includes itself through -options_file (" + path + file + ")";
+    }
+    if (depth >= 16) return "options file " + file + ": -options_file nested more than 16 deep";
+    std::ifstream in(file);
+    if (!in) return "options file " + file + " (-options_file): cannot be read";
+    chain.push_back(canon);
+    shown.push_back(file);
+    for (std::string line; std::getline(in, line);) {
+      const size_t hash = line.find('#');
+      if (hash != std::string::npos) line.resize(hash);
+      std::istringstream       ls(line);
+      std::vector<std::string> tok;
+      for (std::string t; ls >> t;) tok.push_back(t);
+      for (size_t k = 0; k + 1 < tok.size(); ++k)
+        if (tok[k] == "-options_file") {
+          const std::string e = visit(tok[k + 1], depth + 1);
+          if (!e.empty()) return e;
+        }
+    }
+    chain.pop_back();
+    shown.pop_back();
+    return "";
+  };
+  for (size_t i = 0; i + 1 < words.size(); ++i)
+    if (words[i] == "-options_file") {
+      const std::string e = visit(words[i + 1], 0);
+      if (!e.empty()) return e;
+    }
+  return "";
+}
+
+} // namespace rbc
