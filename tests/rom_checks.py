@@ -1076,6 +1076,9 @@ def probe(args):
     if m:
         q = run(args, 1, "online", ["-rom", d + "/bad.h5", "-mu", m.group(2)], expect_ok=False)
         check(q.returncode != 0 and "did not converge" in q.stdout, "online -mu %s (the parameter the probe named): the same failure" % m.group(2))
+    # the hint carries the -rom_* options of the run, which online needs to give the same answer
+    q = run(args, 1, "probe", ["-rom", d + "/bad.h5", "-probe_size", "200", "-rom_kacanov_max_it", "31"], expect_ok=False)
+    check(re.search(r"online -mu [0-9.e+-]+,[0-9.e+-]+ -rom_kacanov_max_it 31\)", q.stdout) is not None, "the probe's online -mu hint carries the run's -rom_* options")
     # the probe stage on the same file: 1 and 2 ranks count the same failures (each point is solved alone)
     reps = {}
     for np_ in (1, 2):
@@ -1192,6 +1195,11 @@ def guards(args):
             check(ok, "a ROM file with /online/contact tampered (%s), -rom_hyper %s: refused naming the file and dataset" % (name, hyper))
             if not ok:
                 print(p.stdout[-800:])
+    # a parameter box with min > max (accepted on opening; the error came later, blaming -mu)
+    shutil.copy(rom, d + "/box.h5")
+    with h5py.File(d + "/box.h5", "a") as f:
+        f["params/box"][...] = np.array(f["params/box"])[:, ::-1]
+    expect_error(args, ["-rom", d + "/box.h5"], ["box.h5", "/params/box row 0", "corrupt"], "a ROM file whose box has min > max")
     # /online/affine: a huge finite value (1e200 x f) and a record reading tensor entry 1e8 of body 0 (segfaults, found by a
     # second audit)
     for name, ds, change, words in (("f_big", "online/affine/f", lambda a: a * 1e200, ["/online/affine/f", "a corrupt file"]),

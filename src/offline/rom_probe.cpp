@@ -3,6 +3,7 @@
 #include "rbcontact/rom_probe.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/training_set.hpp"
+#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -75,6 +76,20 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   double secs = t1 - t0;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &secs, 1, MPI_DOUBLE, MPI_MAX, comm));
 
+  // the reduced model's options of this run, which `online -mu` needs too to give the same answer
+  std::string romOptions;
+  {
+    char *all = nullptr;
+    PetscCall(PetscOptionsGetAll(NULL, &all));
+    std::istringstream in(all ? all : "");
+    bool               keep = false;
+    for (std::string tok; in >> tok;) {
+      const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
+      if (isName) keep = tok.compare(0, 5, "-rom_") == 0 && tok != "-rom_basis";
+      if (keep) romOptions += " " + tok;
+    }
+    PetscCall(PetscFree(all));
+  }
   auto muText = [&](PetscInt i, bool named) {
     std::ostringstream o;
     o << std::setprecision(17);
@@ -105,7 +120,7 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   sum->failed = failed;
   sum->firstFailure.clear();
   if (failed) {
-    sum->firstFailure = "at probe parameter " + std::to_string((long long)first) + " (" + muText(first, true) + "; online -mu " + muText(first, false) + "): " + myMessage;
+    sum->firstFailure = "at probe parameter " + std::to_string((long long)first) + " (" + muText(first, true) + "; online -mu " + muText(first, false) + romOptions + "): " + myMessage;
     o["first_failure"] = sum->firstFailure;
   }
   if (nconv) {
@@ -116,7 +131,7 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   sum->outOfRange   = outside;
   sum->firstOutOfRange.clear();
   if (outside) {
-    sum->firstOutOfRange    = "probe parameter " + std::to_string((long long)firstOutside) + " (" + muText(firstOutside, true) + "; online -mu " + muText(firstOutside, false) + ")";
+    sum->firstOutOfRange    = "probe parameter " + std::to_string((long long)firstOutside) + " (" + muText(firstOutside, true) + "; online -mu " + muText(firstOutside, false) + romOptions + ")";
     o["first_out_of_range"] = sum->firstOutOfRange;
   }
   o["time_s"]       = secs;

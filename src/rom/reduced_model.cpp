@@ -134,6 +134,7 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
     params[i].min = params[i].value = box[2 * i];
     params[i].max = box[2 * i + 1];
     params[i].def = params[i].value = def[i];
+    PetscCheck(params[i].min <= params[i].max && params[i].def >= params[i].min && params[i].def <= params[i].max, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /params/box row %zu [%g, %g] with default %g is not a box holding its default: a corrupt file", file.c_str(), i, (double)params[i].min, (double)params[i].max, (double)params[i].def);
   }
   PetscCall(ReadChecked(file, "/online/dim", 1, &d));
   dim = (PetscInt)d[0];
