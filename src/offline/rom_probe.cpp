@@ -43,7 +43,18 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   PetscCall(PetscLogEventBegin(PROBE_Solves, 0, 0, 0, 0));
   for (PetscInt i = rank; i < n; i += size) {
     ReducedSolution sol;
-    PetscCall(model.Solve(pts.points[i], &sol));
+    // an error of one solve (not a non-convergence, which Solve reports in sol) is that point's failure: a PetscCall
+    // here would leave this rank while the others wait in the reductions below
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    const PetscErrorCode e = model.Solve(pts.points[i], &sol);
+    PetscCall(PetscPopErrorHandler());
+    if (e) {
+      const char *text = nullptr;
+      (void)PetscErrorMessage(e, &text, NULL);
+      sol           = ReducedSolution();
+      sol.converged = false;
+      sol.message   = "the reduced solve stopped with PETSc error " + std::to_string((int)e) + " (" + (text ? text : "?") + ")";
+    }
     ival[4 * i + 0] = sol.converged ? 1 : 0;
     ival[4 * i + 1] = sol.iterations;
     ival[4 * i + 2] = sol.outOfRange > 0 ? 1 : 0;
