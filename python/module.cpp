@@ -261,7 +261,7 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
     rbc::JsonValue &w = rep.root["warnings"];
     for (const auto &u : unused) {
       w.Push(rbc::JsonValue::String(u));
-      PyErr_WarnEx(PyExc_UserWarning, ("rbcontact." + stage + ": " + u).c_str(), 1);
+      if (PyErr_WarnEx(PyExc_UserWarning, ("rbcontact." + stage + ": " + u).c_str(), 1) < 0) throw py::error_already_set(); // warnings turned into errors
     }
   }
   Check(rep.Write(PETSC_COMM_WORLD, reportPath));
