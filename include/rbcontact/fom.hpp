@@ -111,6 +111,8 @@ struct XdmfAttribute {
 // Writes <h5file without .h5>.xmf describing the mesh (/geometry/vertices, /viz/topology/cells: PetscInt,
 // its precision sizeof(PetscInt)) and the attributes of an HDF5 file in PETSc's VIZ layout; with npoints > 0
 // also the grid "contact": npoints points at /contact/points (npoints x 3) with the attributes pattrs.
+// The XDMF file written beside an HDF5 file: <h5file without .h5>.xmf.
+std::string    XdmfPath(const std::string &h5file);
 PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim, PetscInt nverts, PetscInt ncells, PetscInt nvpc, const std::vector<XdmfAttribute> &attrs, PetscInt npoints = 0, const std::vector<XdmfAttribute> &pattrs = {});
 
 } // namespace rbc

@@ -5,6 +5,7 @@
 #pragma once
 #include <petscsys.h>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rbc {
@@ -13,6 +14,11 @@ namespace rbc {
 // itself, nested at most 16 deep. Files are resolved from the working directory, as PETSc does. Returns "" when all is
 // well, else the message ("options file a.opts includes itself through -options_file (a.opts -> b.opts -> a.opts)").
 std::string CheckOptionsFiles(const std::vector<std::string> &words);
+
+// The options database in use as (name with its dash, value) pairs, in PetscOptionsGetAll's order; a flag's value is
+// empty, a value of several words is joined by spaces. Empty when the database cannot be read (no PETSc error raised:
+// the error handler calls it).
+std::vector<std::pair<std::string, std::string>> OptionsInUse();
 
 // After a stage ran: the options of the database in use (PETSc's default one, or a pushed one) that nobody read, as
 // messages ("option -trian_size 5 was not used by the offline stage (misspelled? ...)"), leaving out the families of

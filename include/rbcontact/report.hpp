@@ -102,6 +102,9 @@ class Report {
 public:
   JsonValue root = JsonValue::Object();
   PetscErrorCode Write(MPI_Comm comm, const std::string &path) const;
+  // A stage that fails after its work (the probe's failures): "converged": false and the error added, the whole report
+  // written, and MarkFailureReported() so that the executable's generic failure report leaves it in place.
+  PetscErrorCode WriteFailed(MPI_Comm comm, const std::string &path, const std::string &error);
 };
 
 } // namespace rbc

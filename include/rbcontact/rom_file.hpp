@@ -36,6 +36,10 @@ PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, 
 PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value);
 // An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
 PetscErrorCode RomReadOptional(const std::string &path, const std::string &name, std::vector<double> *data, bool *found);
+// Every value of a dataset read from a model file (what: "ROM file x.h5", "basis file b.h5") finite and below 1e150 in
+// magnitude: no value of a model comes near (moduli, coordinates, reduced operators), and a larger one is a corrupt
+// file whose products overflow to inf and NaN online. Errors name the file, the dataset and the entry.
+PetscErrorCode RomCheckValues(const std::string &what, const std::string &name, const std::vector<double> &data);
 // The integer format_version attribute.
 PetscErrorCode RomReadVersion(const std::string &path, int *version);
 

@@ -12,6 +12,8 @@ namespace rbc {
 struct ParameterSet {
   std::vector<std::string>            names;  // parameter names (scene order)
   std::vector<std::vector<PetscReal>> points; // points[i][j]: value of parameter j in sample i
+  std::string                         type;   // grid, random, lhs or file (ParameterSetFromOptions)
+  PetscInt                            seed = 0; // of a random or lhs sample
 };
 
 // Reads -<prefix>type grid|random|lhs|file, -<prefix>size n (grid: per dimension, or a list with

@@ -52,21 +52,15 @@ static std::string OptionsHoldingValue(const char *mess)
   if (m.compare(0, a.size(), a) == 0) word = m.substr(a.size(), m.find(' ', a.size()) - a.size());
   else if (m.compare(0, b.size(), b) == 0) word = m.substr(b.size());
   if (word.empty()) return "";
-  char *all = nullptr;
-  if (PetscOptionsGetAll(NULL, &all) || !all) return "";
-  std::string found, name;
-  std::istringstream in(all);
-  for (std::string tok; in >> tok;) {
-    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
-    if (isName) {
-      name = tok;
-      continue;
-    }
-    std::istringstream vals(tok);
+  std::string found;
+  for (const auto &o : rbc::OptionsInUse()) {
+    std::istringstream vals(o.second);
     for (std::string v; std::getline(vals, v, ',');)
-      if (v == word && !name.empty()) found += (found.empty() ? "" : ", ") + name + " " + tok;
+      if (v == word) {
+        found += (found.empty() ? "" : ", ") + o.first + " " + o.second;
+        break;
+      }
   }
-  PetscFree(all);
   return found.empty() ? "" : " (option " + found + ")";
 }
 
@@ -121,18 +115,13 @@ static void FailureReport(const std::string &stage, PetscErrorCode ierr)
 // option; -body_E 100,,100 read as 100,100 without a word; a trailing comma dropped): refused, naming the option.
 static PetscErrorCode EmptyListEntries()
 {
-  char *all = nullptr;
+  std::string bad;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetAll(NULL, &all));
-  std::string        name, bad;
-  std::istringstream in(all ? all : "");
-  for (std::string tok; bad.empty() && in >> tok;) {
-    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
-    if (isName) name = tok;
-    else if (!name.empty() && (tok.front() == ',' || tok.back() == ',' || tok.find(",,") != std::string::npos)) bad = name + " " + tok;
+  for (const auto &o : rbc::OptionsInUse()) {
+    const std::string &v = o.second;
+    if (bad.empty() && !v.empty() && (v.front() == ',' || v.back() == ',' || v.find(",,") != std::string::npos)) bad = o.first + " " + v;
   }
-  PetscCall(PetscFree(all));
   PetscCheck(bad.empty(), PETSC_COMM_WORLD, PETSC_ERR_USER_INPUT, "option %s: an empty entry in the list (a comma too many?)", bad.c_str());
   PetscFunctionReturn(0);
 }

@@ -27,11 +27,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscOptionsEnd();
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, outPath, "-fom_output"));
-  {
-    std::string xmf = outPath; // written beside the HDF5 file
-    if (!xmf.empty()) xmf = (xmf.size() > 3 && xmf.compare(xmf.size() - 3, 3, ".h5") == 0 ? xmf.substr(0, xmf.size() - 3) : xmf) + ".xmf";
-    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-fom_output", outPath}, {"-fom_output's XDMF", xmf}}, {}));
-  }
+  PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-fom_output", outPath}, {"-fom_output's XDMF", outPath[0] ? XdmfPath(outPath) : ""}}, {}));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   ElasticFOM    fom;
   ContactMap    map;

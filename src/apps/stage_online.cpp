@@ -50,9 +50,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   {
     char basisPath[PETSC_MAX_PATH_LEN] = "";
     PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", basisPath, sizeof basisPath, NULL));
-    std::string xmf = recPath; // written beside the fields
-    if (!xmf.empty()) xmf = (xmf.size() > 3 && xmf.compare(xmf.size() - 3, 3, ".h5") == 0 ? xmf.substr(0, xmf.size() - 3) : xmf) + ".xmf";
-    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-rom_reconstruct", recPath}, {"-rom_reconstruct's XDMF", xmf}}, {{"-rom", romPath}, {"-rom_basis", basisPath}}));
+    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-rom_reconstruct", recPath}, {"-rom_reconstruct's XDMF", recPath[0] ? XdmfPath(recPath) : ""}}, {{"-rom", romPath}, {"-rom_basis", basisPath}}));
   }
   PetscCheck(repeat >= 1 && repeat <= 10000000, comm, PETSC_ERR_ARG_OUTOFRANGE, "-online_repeat %" PetscInt_FMT " out of range [1, 1e7]", repeat);
   PetscCall(PetscTime(&t0));

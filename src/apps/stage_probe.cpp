@@ -32,10 +32,7 @@ PetscErrorCode StageProbe(MPI_Comm comm)
   if (ps.outOfRange) PetscCall(PetscPrintf(comm, "rbcontact probe: warning: at %" PetscInt_FMT " of %" PetscInt_FMT " parameters contact projections reached the edge of the stored contact data, where the answers may be wrong (first: %s)\n", ps.outOfRange, ps.size, ps.firstOutOfRange.c_str()));
   if (ps.failed) { // the whole report (the counts, the estimates), with the error, then the exit code
     const std::string err = "probe: the reduced model " + std::string(romPath) + " failed at " + std::to_string((long long)ps.failed) + " of " + std::to_string((long long)ps.size) + " probe parameters; first " + ps.firstFailure;
-    rep.root["converged"] = false;
-    rep.root["error"]     = err;
-    PetscCall(rep.Write(comm, reportPath));
-    MarkFailureReported();
+    PetscCall(rep.WriteFailed(comm, reportPath, err));
     SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", err.c_str());
   }
   rep.root["converged"] = true;

@@ -2,6 +2,7 @@
 #include "rbcontact/options_files.hpp"
 #include <petscsys.h>
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <climits>
 #include <cstdlib>
@@ -49,6 +50,21 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name)
     return !rec;
   }
   return false;
+}
+
+std::vector<std::pair<std::string, std::string>> OptionsInUse()
+{
+  std::vector<std::pair<std::string, std::string>> out;
+  char                                            *all = nullptr;
+  if (PetscOptionsGetAll(NULL, &all) || !all) return out;
+  std::istringstream in(all);
+  for (std::string tok; in >> tok;) {
+    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.'; // not -1, -.5
+    if (isName) out.emplace_back(tok, "");
+    else if (!out.empty()) out.back().second += (out.back().second.empty() ? "" : " ") + tok;
+  }
+  (void)PetscFree(all);
+  return out;
 }
 
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *out)

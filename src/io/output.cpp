@@ -65,10 +65,14 @@ PetscErrorCode WriteXdmf(MPI_Comm comm, const std::string &h5file, PetscInt dim,
     x << "  </Grid>\n";
   }
   x << " </Domain>\n</Xdmf>\n";
-  std::string xdmf = h5file;
-  if (xdmf.size() > 3 && xdmf.substr(xdmf.size() - 3) == ".h5") xdmf = xdmf.substr(0, xdmf.size() - 3);
-  PetscCall(WriteFileAtomic(comm, xdmf + ".xmf", x.str()));
+  PetscCall(WriteFileAtomic(comm, XdmfPath(h5file), x.str()));
   PetscFunctionReturn(0);
+}
+
+std::string XdmfPath(const std::string &h5file)
+{
+  const bool h5 = h5file.size() > 3 && h5file.compare(h5file.size() - 3, 3, ".h5") == 0;
+  return (h5 ? h5file.substr(0, h5file.size() - 3) : h5file) + ".xmf";
 }
 
 PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vector<Vec> &contact, const std::vector<Vec> &fields)

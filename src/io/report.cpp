@@ -286,6 +286,16 @@ void WriteFailureReport(const char *path, const std::string &stage, const std::s
   }
 }
 
+PetscErrorCode Report::WriteFailed(MPI_Comm comm, const std::string &path, const std::string &error)
+{
+  PetscFunctionBeginUser;
+  root["converged"] = false;
+  root["error"]     = error;
+  PetscCall(Write(comm, path));
+  MarkFailureReported();
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode Report::Write(MPI_Comm comm, const std::string &path) const
 {
   PetscFunctionBeginUser;

@@ -143,8 +143,17 @@ PetscErrorCode RomReadOptional(const std::string &file, const std::string &name,
   ierr = RomReadDataset(file, name, &dims, data);
   PetscCall(PetscPopErrorHandler());
   *found = !ierr;
-  if (*found)
-    for (double v : *data) PetscCheck(std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s holds a non-finite value", file.c_str(), name.c_str());
+  if (*found) PetscCall(RomCheckValues("ROM file " + file, name, *data));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode RomCheckValues(const std::string &what, const std::string &name, const std::vector<double> &data)
+{
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < data.size(); ++i) {
+    PetscCheck(std::isfinite(data[i]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: dataset %s holds a non-finite value (entry %zu): a corrupt file", what.c_str(), name.c_str(), i);
+    PetscCheck(std::abs(data[i]) < 1e150, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: dataset %s holds the value %g (entry %zu): a corrupt file", what.c_str(), name.c_str(), data[i], i);
+  }
   PetscFunctionReturn(0);
 }
 

@@ -521,10 +521,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
             const std::string err = "offline: the reduced model " + s.rom + " failed at " + std::to_string((long long)ps.failed) + " of " + std::to_string((long long)ps.size) + " probe parameters (-offline_probe_fail); first " + ps.firstFailure;
             char reportPath[PETSC_MAX_PATH_LEN] = "";
             PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
-            rep.root["converged"] = false;
-            rep.root["error"]     = err;
-            PetscCall(rep.Write(world, reportPath));
-            MarkFailureReported();
+            PetscCall(rep.WriteFailed(world, reportPath, err));
             SETERRQ(world, PETSC_ERR_NOT_CONVERGED, "%s", err.c_str());
           }
           PetscCall(PetscPrintf(world, "rbcontact offline: warning: the reduced model %s failed at %" PetscInt_FMT " of %" PetscInt_FMT " probe parameters; first %s. The training set does not resolve that part of the box: add training parameters near it (docs/online.md \"Probing a model\")\n", romPath, ps.failed, ps.size, ps.firstFailure.c_str()));

@@ -98,11 +98,8 @@ PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const st
   PetscCheck((PetscInt)dims[1] == nmult, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /dual/basis has vectors of length %llu, the scene has %" PetscInt_FMT " contact multipliers (another scene or mesh?)", path.c_str(), dims[1], nmult);
   r = (PetscInt)dims[0];
   R = (PetscInt)dims[1];
-  for (const auto *a : {&modes, &W}) {
-    size_t bad = 0;
-    while (bad < a->size() && std::isfinite((*a)[bad])) ++bad;
-    PetscCheck(bad == a->size(), comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: %s holds a non-finite value (entry %zu): a corrupt file; rerun offline", path.c_str(), a == &modes ? "/pod/modes" : "/dual/basis", bad);
-  }
+  PetscCall(RomCheckValues("basis file " + path, "/pod/modes", modes));
+  PetscCall(RomCheckValues("basis file " + path, "/dual/basis", W));
   PetscFunctionReturn(0);
 }
 
@@ -348,10 +345,9 @@ PetscErrorCode WriteBasisView(MPI_Comm comm, const SceneSpec &scene, const std::
   PetscCall(fom.WriteOutput(path, cv, fields));
   for (Vec &f : fields) PetscCall(VecDestroy(&f));
   for (Vec &l : dual) PetscCall(VecDestroy(&l));
-  std::string xmf = path;
-  if (xmf.size() > 3 && xmf.compare(xmf.size() - 3, 3, ".h5") == 0) xmf.resize(xmf.size() - 3);
+
   rep->root["basis_view"]["file"]        = path;
-  rep->root["basis_view"]["xdmf"]        = xmf + ".xmf";
+  rep->root["basis_view"]["xdmf"]        = XdmfPath(path);
   rep->root["basis_view"]["pod_modes"]   = (long long)model.Npod;
   rep->root["basis_view"]["supremizers"] = (long long)(bases.N - model.Npod);
   rep->root["basis_view"]["dual"]        = (long long)bases.r;

@@ -1,9 +1,9 @@
 // src/offline/rom_probe.cpp: the ROM file solved at many parameters of its box, no FOM (rom_probe.hpp):
 // the points split over the ranks, the per-point results summed into arrays every rank holds.
 #include "rbcontact/rom_probe.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/training_set.hpp"
-#include <cctype>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -18,8 +18,6 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   ParameterSet   pts;
   PetscMPIInt    rank, size;
   PetscLogDouble t0, t1;
-  char           type[64] = "lhs";
-  PetscInt       seed     = 2;
 
   PetscFunctionBeginUser;
   if (!PROBE_Solves) PetscCall(PetscLogEventRegister("RBCProbe", 0, &PROBE_Solves));
@@ -30,9 +28,7 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   PetscCall(model.SetFromOptions());
   std::vector<ParamSpec> box;
   for (const auto &p : model.par.params) box.push_back(p);
-  PetscCall(ParameterSetFromOptions(comm, box, "probe_", &pts, "lhs", defSize, seed));
-  PetscCall(PetscOptionsGetString(NULL, "probe_", "-type", type, sizeof type, NULL));
-  PetscCall(PetscOptionsGetInt(NULL, "probe_", "-seed", &seed, NULL));
+  PetscCall(ParameterSetFromOptions(comm, box, "probe_", &pts, "lhs", defSize, 2)); // seed 2: apart from the test sets' and the greedy's streams
   const PetscInt n = (PetscInt)pts.points.size();
 
   // per point: converged, iterations, out-of-range projections, estimate available; the estimates
@@ -89,18 +85,8 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
 
   // the reduced model's options of this run, which `online -mu` needs too to give the same answer
   std::string romOptions;
-  {
-    char *all = nullptr;
-    PetscCall(PetscOptionsGetAll(NULL, &all));
-    std::istringstream in(all ? all : "");
-    bool               keep = false;
-    for (std::string tok; in >> tok;) {
-      const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.';
-      if (isName) keep = tok.compare(0, 5, "-rom_") == 0 && tok != "-rom_basis";
-      if (keep) romOptions += " " + tok;
-    }
-    PetscCall(PetscFree(all));
-  }
+  for (const auto &op : OptionsInUse())
+    if (op.first.compare(0, 5, "-rom_") == 0 && op.first != "-rom_basis") romOptions += " " + op.first + (op.second.empty() ? "" : " " + op.second);
   auto muText = [&](PetscInt i, bool named) {
     std::ostringstream o;
     o << std::setprecision(17);
@@ -123,9 +109,9 @@ PetscErrorCode ProbeRomFile(MPI_Comm comm, const std::string &romPath, PetscInt 
   }
   JsonValue &o = *out;
   o["rom_file"] = romPath;
-  o["type"]     = std::string(type);
+  o["type"]     = pts.type;
   o["size"]     = (long long)n;
-  if (std::string(type) == "random" || std::string(type) == "lhs") o["seed"] = (long long)seed;
+  if (pts.type == "random" || pts.type == "lhs") o["seed"] = (long long)pts.seed;
   o["failed"] = (long long)failed;
   sum->size   = n;
   sum->failed = failed;

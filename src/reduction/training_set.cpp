@@ -219,6 +219,8 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   for (PetscInt c : counts) PetscCheck(c >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: %" PetscInt_FMT " samples; every count must be >= 1", optSize.c_str(), c);
 
   set->names.clear();
+  set->type = type;
+  set->seed = seed;
   for (const auto &p : params) set->names.push_back(p.name);
   set->points.clear();
   if (type == "grid") {

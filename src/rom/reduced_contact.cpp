@@ -505,7 +505,7 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
     PetscFunctionBeginUser;
     PetscCall(RomReadDataset(file, group + "/" + name, &dims, &data));
     PetscCheck(data.size() == n, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s has %zu entries (%zu expected)", file.c_str(), group.c_str(), name.c_str(), data.size(), n);
-    for (size_t i = 0; i < n; ++i) PetscCheck(std::isfinite(data[i]) && std::abs(data[i]) < 1e150, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s entry %zu is %g: a corrupt file", file.c_str(), group.c_str(), name.c_str(), i, data[i]);
+    PetscCall(RomCheckValues("ROM file " + file, group + "/" + name, data));
     PetscFunctionReturn(0);
   };
   PetscCall(need("theta", nnode * dim * std::max<PetscInt>(N, 1)));
