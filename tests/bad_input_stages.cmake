@@ -76,3 +76,7 @@ rbc_bad_stage(list_empty_entry "option -body_E 100,,100: an empty entry in the l
 find_program(RBC_MPIRUN_STAGE NAMES mpirun)
 add_test(NAME bad_input_body_without_group_np2 COMMAND ${RBC_EXPECT_ERROR_STAGE} "Physical name 'block' [(]option -bodies[)] does not exist as a group of dimension 2 [(]its groups: slave [(]1D[)].*no Physical Surface" ${RBC_MPIRUN_STAGE} -n 2 ${RBC_EXE_STAGE} fom -options_file runs/ring_on_block.opts -mesh_file @NOBLOCK_GEO@ WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(bad_input_body_without_group_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 PROCESSORS 2 LABELS bad_input)
+# second-order (curved) gmsh elements: PETSc's reader keeps a degree-2 coordinate field, which the geometry check called
+# "inverted cells" (src/mesh/mesh_loader.cpp)
+rbc_bad_stage(mesh_order2 "has curved elements of order 2 [(]gmsh Mesh.ElementOrder or -order[)].*mesh with order 1 and use -fem_degree 2" fom -options_file runs/ring_on_block.opts -mesh_file @ORDER2_GEO@)
+rbc_bad_stage_np2(mesh_order2 "has curved elements of order 2" fom -options_file runs/ring_on_block.opts -mesh_file @ORDER2_GEO@)

@@ -10,7 +10,7 @@
 # Special arguments: the tokens @GARBAGE_MSH@ / @GARBAGE_GEO@ in the command are replaced by the path
 # of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
 # meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
-# by meshes/ring_on_block.geo without the block's Physical Surface.
+# by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -34,6 +34,10 @@ for a in "$@"; do
     # meshes/ring_on_block.geo without the block's Physical Surface (a body of -bodies with no cells in the mesh)
     grep -v 'Physical Surface("block"' "$(dirname "$0")/../meshes/ring_on_block.geo" > "$tmpdir/noblock.geo"
     args+=("$tmpdir/noblock.geo")
+  elif [ "$a" = "@ORDER2_GEO@" ]; then
+    # meshes/ring_on_block.geo meshed with second-order (curved) elements
+    { cat "$(dirname "$0")/../meshes/ring_on_block.geo"; echo 'Mesh.ElementOrder = 2;'; } > "$tmpdir/order2.geo"
+    args+=("$tmpdir/order2.geo")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

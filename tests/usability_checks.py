@@ -26,6 +26,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 import h5py
 
@@ -45,11 +46,15 @@ def workdir():
     return d
 
 
-def run(args, np_, cmd, expect_ok=True):
+def run(args, np_, cmd, expect_ok=True, timeout=None):
     full = (["mpirun", "-n", str(np_)] if np_ > 1 else []) + [args.exe] + cmd
     # errors="replace": PETSc 3.18's -help prints the default of -dm_plex_boundary_label from uninitialized
     # memory ("<now 3\x0fh\xd7...>"), not always valid UTF-8
-    p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", stdin=subprocess.DEVNULL)
+    try:
+        p = subprocess.run(full, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", stdin=subprocess.DEVNULL, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        subprocess.run(["pkill", "-f", args.exe + " " + cmd[0]])
+        sys.exit("command hung (killed after %g s): %s" % (timeout, " ".join(full)))
     if expect_ok and p.returncode != 0:
         print(p.stdout[-3000:])
         sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(full)))
@@ -123,9 +128,19 @@ def failure(args):
     cases = [(["-mesh_file", "nope.msh"], r"Mesh file 'nope\.msh' not found", "missing mesh"),
              (["-kacanov_max_it", "2"], r"Kacanov iterations did not converge in 2 iterations", "Kacanov not converged"),
              (["-contact_quadrature", "bogus"], r"-contact_quadrature: unknown value 'bogus'", "unknown option value")]
-    for extra, pattern, what in cases:
-        p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", rep] + extra, expect_ok=False)
+    # a failure on one rank only (-rbc_test_fail_rank, a test hook of src/apps/main.cpp): before, the other rank waited
+    # in the stage's first collective and the failed one in MPI_Finalize, for ever; now the failed rank waits
+    # -rbc_error_wait seconds for the others, then aborts the run after writing the report
+    one_rank = [(["-rbc_test_fail_rank", str(r), "-rbc_error_wait", "2"], r"-rbc_test_fail_rank %d: an error raised on this rank only" % r,
+                 "failure on rank %d alone" % r) for r in range(args.np)] if args.np > 1 else []
+    for extra, pattern, what in cases + one_rank:
+        t0 = time.time()
+        p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", rep, "-rbc_error_wait", "60"] + extra, expect_ok=False, timeout=120)
+        alone = "-rbc_test_fail_rank" in extra
         check(p.returncode != 0, "%s: exit %d (non-zero)" % (what, p.returncode))
+        # a collective failure ends without the wait (60 s here) and without the abort
+        check(("did not reach this failure within 2 s" in p.stdout) == alone and (alone or time.time() - t0 < 50),
+              "%s: %s in %.1f s" % (what, "aborted after the wait" if alone else "ended without waiting", time.time() - t0))
         r = load(rep)
         check(r.get("converged") is False and r.get("stage") == "fom" and "stale" not in r, "%s: report says converged false, stage fom (keys %s)" % (what, sorted(r)))
         check(re.search(pattern, r.get("error", "")) is not None, "%s: report error '%s' matches '%s'" % (what, r.get("error", "")[:160], pattern))

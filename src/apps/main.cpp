@@ -101,14 +101,66 @@ static PetscErrorCode OneBlasThreadPerRank()
 // communication here), to a temporary file then renamed. A report the stage wrote before failing
 // is replaced: the run did not finish. Never onto a device, a path the run refused (an input, another
 // output) or an HDF5 file (a ROM, snapshot or field file named by mistake).
-static void FailureReport(const std::string &stage, PetscErrorCode ierr)
+static void FailureReport(const std::string &stage, PetscErrorCode ierr, bool anyRank = false)
 {
   char        path[PETSC_MAX_PATH_LEN] = "";
   PetscBool   set                      = PETSC_FALSE;
   PetscMPIInt rank                     = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (rank != 0 || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
+  if ((rank != 0 && !anyRank) || PetscOptionsGetString(NULL, NULL, "-report", path, sizeof path, &set) || !set || !path[0]) return;
   rbc::WriteFailureReport(path, stage, firstError.empty() ? std::string("failed on another rank (its message is on stderr)") : firstError, (long long)ierr, true);
+}
+
+// A failure on some ranks only (a reader that failed on rank 0 while the others wait in its collectives, an error
+// raised by one rank's data) would leave the run hanging: the failed ranks would wait in SlepcFinalize for ranks that
+// wait for them. So a failed rank first meets the others in a barrier of its own communicator (never PETSc's, whose
+// pending collectives it must not match) and waits -rbc_error_wait seconds (default 10) for every rank to arrive:
+// all did when the failure was collective, and the run ends normally with the error. Otherwise it says so, writes
+// the failure report (rank 0 may be the one waiting) and calls MPI_Abort, which ends every rank.
+static MPI_Comm  exitComm  = MPI_COMM_NULL;
+static PetscReal errorWait = 10;
+
+static PetscErrorCode ExitCommCreate()
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-rbc_error_wait", &errorWait, NULL));
+  PetscCheck(errorWait > 0 && errorWait <= 86400, PETSC_COMM_WORLD, PETSC_ERR_ARG_OUTOFRANGE, "-rbc_error_wait %g must lie in (0, 86400] seconds", (double)errorWait);
+  PetscCallMPI(MPI_Comm_dup(PETSC_COMM_WORLD, &exitComm));
+  PetscFunctionReturn(0);
+}
+
+static void AbortUnlessAllFailed(const std::string &stage, PetscErrorCode ierr)
+{
+  PetscMPIInt size = 1, rank = 0, done = 0;
+  const double wait = errorWait;
+  MPI_Request req;
+  if (exitComm == MPI_COMM_NULL) return;
+  MPI_Comm_size(exitComm, &size);
+  if (size == 1) return;
+  MPI_Comm_rank(exitComm, &rank);
+  MPI_Ibarrier(exitComm, &req);
+  for (const double t0 = MPI_Wtime(); !done && MPI_Wtime() - t0 < wait;) {
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (!done) usleep(2000);
+  }
+  if (done) return;
+  std::fprintf(stderr, "[%d] rbcontact error: the other ranks did not reach this failure within %g s (-rbc_error_wait): it is this rank's alone, and they would wait for it; aborting the run\n", (int)rank, (double)wait);
+  FailureReport(stage, ierr, true);
+  MPI_Abort(MPI_COMM_WORLD, (int)ierr);
+}
+
+// Test hook (tests/bad_input_stages.cmake rank_failure_np2): -rbc_test_fail_rank r raises an error on rank r only,
+// before the stage, while the other ranks run it (and wait for rank r in its first collective).
+static PetscErrorCode TestFailRank()
+{
+  PetscInt    r = -1;
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-rbc_test_fail_rank", &r, NULL));
+  PetscCheck(r != rank, PETSC_COMM_SELF, PETSC_ERR_USER, "-rbc_test_fail_rank %d: an error raised on this rank only", (int)rank);
+  PetscFunctionReturn(0);
 }
 
 // A list value with an empty entry (-body_E ,100,100: PETSc's "String of length zero has no numerical value", naming no
@@ -157,7 +209,9 @@ int main(int argc, char **argv)
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-rbc_full_traceback", &full, NULL));
     if (!full) PetscCall(PetscPushErrorHandler(ConciseErrorHandler, NULL));
   }
-  PetscErrorCode ierr = EmptyListEntries();
+  PetscErrorCode ierr = ExitCommCreate();
+  if (!ierr) ierr = EmptyListEntries();
+  if (!ierr) ierr = TestFailRank();
   try {
     if (ierr) {
     } else if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
@@ -185,10 +239,13 @@ int main(int argc, char **argv)
   if (ierr) {
     // The error message was printed by PETSc's handler; the report says the run failed; exit non-zero.
     FailureReport(stage, ierr);
+    AbortUnlessAllFailed(stage, ierr);
+    if (exitComm != MPI_COMM_NULL) MPI_Comm_free(&exitComm);
     (void)SlepcFinalize();
     return (int)ierr;
   }
   PetscCall(WarnUnusedOptions(stage));
+  PetscCallMPI(MPI_Comm_free(&exitComm));
   PetscCall(SlepcFinalize());
   return 0;
 }

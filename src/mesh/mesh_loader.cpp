@@ -383,6 +383,28 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   }
   PetscCall(PetscObjectSetName((PetscObject)*dm, scene.name.c_str()));
   {
+    // Curved (second-order) gmsh elements: PETSc's reader keeps their mid-edge nodes as a coordinate field of
+    // degree 2, which the straight-simplex assembly and contact geometry do not read (the geometry check below
+    // then called them inverted). Said as what it is.
+    DM           cdm;
+    PetscObject  disc     = NULL;
+    PetscInt     cdegree  = 1;
+    PetscClassId id;
+    PetscCall(DMGetCoordinateDM(*dm, &cdm));
+    PetscInt nf;
+    PetscCall(DMGetNumFields(cdm, &nf));
+    if (nf > 0) PetscCall(DMGetField(cdm, 0, NULL, &disc));
+    if (disc) {
+      PetscCall(PetscObjectGetClassId(disc, &id));
+      if (id == PETSCFE_CLASSID) {
+        PetscSpace sp;
+        PetscCall(PetscFEGetBasisSpace((PetscFE)disc, &sp));
+        PetscCall(PetscSpaceGetDegree(sp, &cdegree, NULL));
+      }
+    }
+    PetscCheck(cdegree <= 1, comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has curved elements of order %" PetscInt_FMT " (gmsh Mesh.ElementOrder or -order): rbcontact reads straight triangles and tetrahedra; mesh with order 1 and use -fem_degree 2 for quadratic displacements", msh.c_str(), scene.mesh.file.c_str(), cdegree);
+  }
+  {
     // Inverted cells (a gmsh surface meshed clockwise) give an indefinite stiffness: refuse them.
     PetscErrorCode ierr;
     PetscInt       bad;
