@@ -157,9 +157,15 @@ public:
 
   // The contact force at every row of mus (n x p): one NumPy array of n values. A solve that does not
   // converge raises (its message names the parameter), unless nan_on_failure.
-  py::array_t<double> ContactForces(py::array_t<double, py::array::c_style | py::array::forcecast> mus, bool nanOnFailure)
+  py::array_t<double> ContactForces(py::object obj, bool nanOnFailure)
   {
-    const PetscInt np = (PetscInt)model_.par.params.size();
+    // a complex array was cast to its real part without a word (forcecast); a non-numeric one is refused by name
+    py::array in_mus = py::array::ensure(obj);
+    if (!in_mus) throw py::type_error("contact_forces: expected an array of parameter points");
+    const char kind = in_mus.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b') throw py::type_error(std::string("contact_forces: expected a real array of parameter points, got dtype ") + std::string(py::str(in_mus.dtype())));
+    auto           mus = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(in_mus);
+    const PetscInt np  = (PetscInt)model_.par.params.size();
     if (mus.ndim() == 1 && np == 1) mus = mus.reshape({mus.shape(0), (py::ssize_t)1});
     if (mus.ndim() != 2 || mus.shape(1) != np) throw std::runtime_error("contact_forces: expected an array of shape (n, " + std::to_string(np) + ") (one row per parameter point)");
     const py::ssize_t   n = mus.shape(0);

@@ -115,6 +115,13 @@ def main():
         raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["radius"], "a radius outside the box in contact_forces")
         raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
         raises(lambda: rbcontact.initialize(["-rom_kacanov_monitor"]), ["already initialized"], "options after the first model")
+        # a complex array was cast to its real part without a word (pybind11's forcecast)
+        try:
+            m.contact_forces(np.array([1.0 + 0.5j]))
+            check(False, "a complex array in contact_forces: no exception")
+        except TypeError as e:
+            check("dtype complex128" in str(e), "a complex array in contact_forces: TypeError naming its dtype (%s)" % str(e)[:120])
+        check(np.array_equal(m.contact_forces([1.02, 1.05]), m.contact_forces(np.array([[1.02], [1.05]]))), "contact_forces on a list = on an (n, 1) array")
         # options before the first model, in a fresh interpreter: they reach the reduced model
         code = ("import rbcontact; rbcontact.initialize(['-rom_kacanov_monitor', '-rom_R', '2']); m = rbcontact.ReducedModel(%r); "
                 "s = m.solve([1.02]); print('R', m.R, 'lambda_hat', len(s.lambda_hat), 'converged', s.converged)" % rom)
