@@ -1127,6 +1127,13 @@ def probe(args):
                  "offline -estimate -rom_hyper eim (failed after its FOM solves, replacing the files)", stage="offline")
     check(not os.path.exists(d + "/eim.h5") and not os.path.exists(d + "/eim.snapshots.h5"), "offline -estimate -rom_hyper eim: refused before any file")
     expect_error(args, ["-rom", rom, "-probe_size", "5", "-probe_type", "file", "-probe_file", d + "/nosuch.txt"], ["nosuch.txt"], "missing -probe_file", stage="probe")
+    # option combinations that ran without a word: a sample file with another type (ignored), the probe's failure as an
+    # error with the probe off
+    expect_error(args, ["-rom", rom, "-probe_size", "5", "-probe_file", d + "/points.txt"], ["-probe_file " + d + "/points.txt is read only with -probe_type file (here -probe_type lhs)"],
+                 "-probe_file without -probe_type file (ignored)", stage="probe")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-rom", d + "/p0.h5", "-offline_probe", "0", "-offline_probe_fail"],
+                 ["-offline_probe_fail makes the probe's failures an error, but -offline_probe 0 turns the probe off"], "-offline_probe_fail -offline_probe 0", stage="offline")
+    check(not os.path.exists(d + "/p0.h5"), "-offline_probe_fail -offline_probe 0: refused before any file")
     shutil.rmtree(d, ignore_errors=True)
 
 

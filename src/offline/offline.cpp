@@ -82,6 +82,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   PetscCall(PetscOptionsBool("-offline_probe", "after writing the ROM, solve it at -probe_size parameters of its box (no FOM; -probe_type, -probe_seed) and warn where the reduced loop fails (docs/online.md \"Probing a model\")", "", probe, &probe, NULL));
   PetscCall(PetscOptionsBool("-offline_probe_fail", "a failure of the probe is an error (exit code), not a warning; the ROM file stays written", "", probeFail, &probeFail, NULL));
   PetscOptionsEnd();
+  PetscCheck(probe || !probeFail, comm, PETSC_ERR_USER_INPUT, "-offline_probe_fail makes the probe's failures an error, but -offline_probe 0 turns the probe off");
   PetscCheck(!strcmp(guess, "zero") || !strcmp(guess, "nearest"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-snapshots_initial_guess %s: unknown (zero or nearest)", guess);
   PetscCheck(!strcmp(stop, "snapshots") || !strcmp(stop, "bases") || !strcmp(stop, "rom"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-offline_stop %s: unknown step (snapshots, bases or rom, the default: every step)", stop);
   s->stop      = !strcmp(stop, "rom") ? OfflineStop::Rom : !strcmp(stop, "bases") ? OfflineStop::Bases : OfflineStop::Snapshots;

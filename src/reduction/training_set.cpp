@@ -208,6 +208,8 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
 
   PetscCheck(type == "grid" || type == "random" || type == "lhs" || type == "file", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "Unknown value '%s' for option %s (grid, random, lhs or file%s)", type.c_str(), optType.c_str(), pre == "train_" ? "; the offline stage also takes greedy" : "");
   PetscCheck(seed >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT " must be >= 0", optSeed.c_str(), seed);
+  // a file given with another type was ignored without a word (the user meant those points)
+  PetscCheck(!flgFile || type == "file", comm, PETSC_ERR_USER_INPUT, "%s %s is read only with %s file (here %s %s)", optFile.c_str(), file.c_str(), optType.c_str(), optType.c_str(), type.c_str());
   PetscCheck(!flgSize || nsizes <= 64, comm, PETSC_ERR_ARG_SIZ, "%s takes at most 64 values, more were given", optSize.c_str());
   {
     PetscBool named = PETSC_FALSE; // PETSc reports a list option without a value as not set: the default ran silently
