@@ -133,14 +133,18 @@ def failure(args):
     # -rbc_error_wait seconds for the others, then aborts the run after writing the report
     one_rank = [(["-rbc_test_fail_rank", str(r), "-rbc_error_wait", "2"], r"-rbc_test_fail_rank %d: an error raised on this rank only" % r,
                  "failure on rank %d alone" % r) for r in range(args.np)] if args.np > 1 else []
+    # a C++ exception out of a stage (std::bad_alloc of a size beyond memory): said, reported, MPI_Abort (src/apps/main.cpp)
+    cases.append((["-rbc_test_fail_rank", str(args.np - 1), "-rbc_test_fail_throw"], r"C\+\+ exception: -rbc_test_fail_rank with -rbc_test_fail_throw", "C++ exception"))
     for extra, pattern, what in cases + one_rank:
         t0 = time.time()
         p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", rep, "-rbc_error_wait", "60"] + extra, expect_ok=False, timeout=120)
-        alone = "-rbc_test_fail_rank" in extra
+        alone = "-rbc_test_fail_rank" in extra and "-rbc_test_fail_throw" not in extra
         check(p.returncode != 0, "%s: exit %d (non-zero)" % (what, p.returncode))
         # a collective failure ends without the wait (60 s here) and without the abort
         check(("did not reach this failure within 2 s" in p.stdout) == alone and (alone or time.time() - t0 < 50),
               "%s: %s in %.1f s" % (what, "aborted after the wait" if alone else "ended without waiting", time.time() - t0))
+        if "-rbc_test_fail_throw" in extra:
+            check("MPI_ABORT" in p.stdout or args.np == 1, "%s: the run aborted (the other ranks may wait in a collective)" % what)
         r = load(rep)
         check(r.get("converged") is False and r.get("stage") == "fom" and "stale" not in r, "%s: report says converged false, stage fom (keys %s)" % (what, sorted(r)))
         check(re.search(pattern, r.get("error", "")) is not None, "%s: report error '%s' matches '%s'" % (what, r.get("error", "")[:160], pattern))

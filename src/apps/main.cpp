@@ -10,6 +10,7 @@
 #include <exception>
 #include <new>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -149,17 +150,21 @@ static void AbortUnlessAllFailed(const std::string &stage, PetscErrorCode ierr)
   MPI_Abort(MPI_COMM_WORLD, (int)ierr);
 }
 
-// Test hook (tests/bad_input_stages.cmake rank_failure_np2): -rbc_test_fail_rank r raises an error on rank r only,
-// before the stage, while the other ranks run it (and wait for rank r in its first collective).
-static PetscErrorCode TestFailRank()
+// Test hook (tests/usability_checks.py failure): -rbc_test_fail_rank r raises an error on rank r only, before the
+// stage, while the other ranks run it (and wait for rank r in its first collective); with -rbc_test_fail_throw, a C++
+// exception instead (the catch in main).
+static PetscErrorCode TestFailRank(bool *doThrow)
 {
   PetscInt    r = -1;
   PetscMPIInt rank;
+  PetscBool   thr = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-rbc_test_fail_rank", &r, NULL));
-  PetscCheck(r != rank, PETSC_COMM_SELF, PETSC_ERR_USER, "-rbc_test_fail_rank %d: an error raised on this rank only", (int)rank);
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-rbc_test_fail_throw", &thr, NULL));
+  *doThrow = thr && r == rank;
+  PetscCheck(thr || r != rank, PETSC_COMM_SELF, PETSC_ERR_USER, "-rbc_test_fail_rank %d: an error raised on this rank only", (int)rank);
   PetscFunctionReturn(0);
 }
 
@@ -211,8 +216,10 @@ int main(int argc, char **argv)
   }
   PetscErrorCode ierr = ExitCommCreate();
   if (!ierr) ierr = EmptyListEntries();
-  if (!ierr) ierr = TestFailRank();
+  bool doThrow = false;
+  if (!ierr) ierr = TestFailRank(&doThrow);
   try {
+    if (doThrow) throw std::runtime_error("-rbc_test_fail_rank with -rbc_test_fail_throw: an exception thrown on this rank only");
     if (ierr) {
     } else if (stage == "fom") ierr = rbc::StageFom(PETSC_COMM_WORLD);
     else if (stage == "offline") ierr = rbc::StageOffline(PETSC_COMM_WORLD);
@@ -233,7 +240,7 @@ int main(int argc, char **argv)
     firstError = std::string(mem ? "out of memory (std::bad_alloc): a size option too large for this machine?" : "C++ exception: ") + (mem ? "" : e.what());
     std::fprintf(stderr, "[%d] rbcontact error: %s\n", (int)rank, firstError.c_str());
     ierr = mem ? PETSC_ERR_MEM : PETSC_ERR_LIB;
-    FailureReport(stage, ierr);
+    FailureReport(stage, ierr, true); // by this rank: rank 0 may be waiting elsewhere
     MPI_Abort(MPI_COMM_WORLD, (int)ierr);
   }
   if (ierr) {
