@@ -320,6 +320,25 @@ def greedy(args):
     r3 = off(1, "g3", 6)
     check(r3["resumed"] == 4 and r3["fom_solves"] == 2, "budget 4 then 6 on the same file: 4 resumed, 2 solved (%d, %d)" % (r3["resumed"], r3["fom_solves"]))
     check(r3["greedy"]["training_indices"] == g1["training_indices"], "the resumed run ends with the same picks as the straight one")
+    # a run killed inside a round (its first pick written, the second not): the resumed run finishes that round's picks
+    # before it builds the next model. Before, the model of the partial round picked other parameters (a different ROM,
+    # exit 0; found by an audit with real kills, 2026-11-29). The kill is made exact by clearing the last pick's done flag
+    # in a copy of the straight run's snapshot file, which keeps the round's picks (attribute greedy_pending).
+    last = [int(i) for i in g1["rounds"][-1]["picked"]]
+    shutil.copy(d + "/g1.snapshots.h5", d + "/g4.snapshots.h5")
+    with h5py.File(d + "/g4.snapshots.h5", "r+") as f:
+        pending = sorted(int(i) for i in f.attrs.get("greedy_pending", []))
+        f["snapshots/done"][last[1]] = 0
+    check(pending == sorted(last), "the snapshot file keeps the last round's picks %s (greedy_pending %s)" % (last, pending))
+    r4 = off(1, "g4", 6)
+    check(r4["resumed"] == 5 and r4["fom_solves"] == 1 and r4["greedy"]["training_indices"] == g1["training_indices"]
+          and r4["greedy"]["rounds"][0].get("resumed_picks") == [last[1]],
+          "killed inside a round: the resumed run solves the round's missing pick %d first and ends with the straight run's picks (%s)" % (last[1], r4["greedy"]["training_indices"]))
+    with h5py.File(d + "/g1.h5", "r") as a, h5py.File(d + "/g4.h5", "r") as b:
+        names = []
+        a["online"].visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
+        diff = [n for n in names if n not in b["online"] or not np.array_equal(np.array(a["online"][n]), np.array(b["online"][n]))]
+    check(len(names) > 10 and not diff, "killed inside a round: the resumed ROM's %d /online datasets equal the straight run's (differ: %s)" % (len(names), diff[:5]))
     # the ROM the greedy built, validated on the test set of the ROM-accuracy targets
     p = subprocess.run(["mpirun", "-n", "2", args.exe, "validate", "-options_file", "runs/ring_on_block.opts", "-rom", d + "/g2.h5", "-report", d + "/v.json"],
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

@@ -62,6 +62,12 @@ public:
   // Rank 0 of comm writes s (others pass through): data, then H5Fflush, then the done flag, flush.
   PetscErrorCode Write(const Snapshot &s);
   PetscErrorCode Close();
+  // Greedy training: the picks of the round about to be solved, stored (attribute greedy_pending, flushed) before
+  // they are solved, so that a run killed inside a round resumes by finishing the same picks before it builds the
+  // next model (the model of a partial round would pick other parameters). Collective; rank 0 writes.
+  PetscErrorCode SetPending(const std::vector<PetscInt> &picks);
+  // The picks stored by the last SetPending (read by Open on a restart; empty when none), on every rank.
+  const std::vector<PetscInt> &Pending() const { return pending_; }
   // Copies into this open file the done snapshots of another snapshot file of the same problem (every header
   // field Open compares but the training set) whose parameters are points of this file's training set (to 1e-14)
   // not done here yet; the others are counted in *outside. extras: the extra arrays this run writes with every
@@ -90,6 +96,7 @@ private:
   SnapshotHeader header_;
   bool        open_ = false;         // on every rank of comm_ after a successful Open
   std::vector<signed char> done_;    // done flags (ntrain), kept identical on every rank
+  std::vector<PetscInt>    pending_; // the greedy round's picks (SetPending), on every rank
 };
 
 // (Added) Compares the header of a file with the one of the current run: empty if they match, else

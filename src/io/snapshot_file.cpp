@@ -219,7 +219,48 @@ bool ReadDone(Ctx &c, hid_t f, hsize_t ntrain, std::vector<signed char> *done)
   if (dims != std::vector<hsize_t>{ntrain}) return c.Fail("dataset /snapshots/done has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)ntrain), false);
   done->assign(ntrain, 0);
   if (ntrain > 0 && H5Dread(d.get(), H5T_NATIVE_SCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, done->data()) < 0) return c.Fail("cannot read dataset /snapshots/done");
+  for (hsize_t i = 0; i < ntrain; ++i) // a flag of 5 or -1 counted as done
+    if ((*done)[i] != 0 && (*done)[i] != 1) return c.Fail("dataset /snapshots/done has the value " + std::to_string((int)(*done)[i]) + " at row " + std::to_string((unsigned long long)i) + " (0 or 1): a corrupt file", false);
   return true;
+}
+
+// The greedy round's picks being solved (attribute greedy_pending, int64 indices into the training set; absent when
+// none). Read: every index checked against ntrain.
+constexpr const char *kPendingAttr = "greedy_pending";
+
+bool ReadPending(Ctx &c, hid_t f, hsize_t ntrain, std::vector<PetscInt> *pending)
+{
+  bool exists = false;
+  pending->clear();
+  if (!AttrExists(c, f, kPendingAttr, &exists)) return false;
+  if (!exists) return true;
+  H5Id a(H5Aopen(f, kPendingAttr, H5P_DEFAULT), H5Aclose);
+  if (!a.ok()) return c.Fail(std::string("cannot open attribute ") + kPendingAttr);
+  H5Id sp(H5Aget_space(a.get()), H5Sclose);
+  const hssize_t n = sp.ok() ? H5Sget_simple_extent_npoints(sp.get()) : -1;
+  if (n < 0 || n > (hssize_t)ntrain) return c.Fail(std::string("attribute ") + kPendingAttr + " has " + std::to_string((long long)n) + " entries for " + std::to_string((unsigned long long)ntrain) + " training points: a corrupt file", false);
+  std::vector<long long> v((size_t)n);
+  if (n > 0 && H5Aread(a.get(), H5T_NATIVE_LLONG, v.data()) < 0) return c.Fail(std::string("cannot read attribute ") + kPendingAttr);
+  for (long long i : v) {
+    if (i < 0 || i >= (long long)ntrain) return c.Fail(std::string("attribute ") + kPendingAttr + " names training point " + std::to_string(i) + " of " + std::to_string((unsigned long long)ntrain) + ": a corrupt file", false);
+    pending->push_back((PetscInt)i);
+  }
+  return true;
+}
+
+bool WritePending(Ctx &c, hid_t f, const std::vector<PetscInt> &pending)
+{
+  bool exists = false;
+  if (!AttrExists(c, f, kPendingAttr, &exists)) return false;
+  if (exists && H5Adelete(f, kPendingAttr) < 0) return c.Fail(std::string("cannot delete attribute ") + kPendingAttr);
+  if (!pending.empty()) {
+    const hsize_t          n = pending.size();
+    std::vector<long long> v(pending.begin(), pending.end());
+    H5Id                   sp(H5Screate_simple(1, &n, nullptr), H5Sclose);
+    H5Id                   a(sp.ok() ? H5Acreate2(f, kPendingAttr, H5T_STD_I64LE, sp.get(), H5P_DEFAULT, H5P_DEFAULT) : -1, H5Aclose);
+    if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_LLONG, v.data()) < 0) return c.Fail(std::string("cannot write attribute ") + kPendingAttr);
+  }
+  return FlushSync(c, f);
 }
 
 bool CloseFile(Ctx &c, H5Id *file)
@@ -260,8 +301,9 @@ PetscErrorCode BcastReals(MPI_Comm comm, PetscReal *v, size_t n)
 }
 
 // Rank 0's part of Open: create (temp file + rename) or reopen and check. Returns the open file.
-bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool restart, H5Id *file, std::vector<signed char> *done)
+bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool restart, H5Id *file, std::vector<signed char> *done, std::vector<PetscInt> *pending)
 {
+  pending->clear();
   if (restart && FileExists(path)) {
     int version = 0;
     if (!OpenExisting(c, path, true, file, &version)) return false;
@@ -280,7 +322,7 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
       a.Reset();
       if (!FlushSync(c, file->get())) return false;
     }
-    return ReadDone(c, file->get(), h.trainingPoints.size(), done);
+    return ReadDone(c, file->get(), h.trainingPoints.size(), done) && ReadPending(c, file->get(), h.trainingPoints.size(), pending);
   }
   const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
@@ -431,11 +473,12 @@ PetscErrorCode SnapshotFile::Open(MPI_Comm comm, const std::string &path, const 
 
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   std::vector<signed char> done(header.trainingPoints.size(), 0);
+  std::vector<PetscInt>    pending;
   H5Id                     file;
   if (rank == 0) {
     H5Quiet q;
     Ctx     c = FileCtx(path);
-    if (!OpenOnRoot(c, path, header, restart, &file, &done)) {
+    if (!OpenOnRoot(c, path, header, restart, &file, &done, &pending)) {
       err = c.err;
       file.Reset();
     }
@@ -443,6 +486,13 @@ PetscErrorCode SnapshotFile::Open(MPI_Comm comm, const std::string &path, const 
   PetscCall(BcastString(comm, &err));
   PetscCheck(err.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "%s", err.c_str());
   PetscCallMPI(MPI_Bcast(done.data(), (PetscMPIInt)done.size(), MPI_SIGNED_CHAR, 0, comm));
+  {
+    PetscInt np = (PetscInt)pending.size();
+    PetscCallMPI(MPI_Bcast(&np, 1, MPIU_INT, 0, comm));
+    pending.resize(np);
+    if (np) PetscCallMPI(MPI_Bcast(pending.data(), (PetscMPIInt)np, MPIU_INT, 0, comm));
+  }
+  pending_ = pending;
   comm_   = comm;
   path_   = path;
   header_ = header;
@@ -487,6 +537,26 @@ PetscErrorCode SnapshotFile::Write(const Snapshot &s)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode SnapshotFile::SetPending(const std::vector<PetscInt> &picks)
+{
+  PetscMPIInt rank;
+  std::string err;
+
+  PetscFunctionBeginUser;
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::SetPending: no snapshot file is open");
+  for (PetscInt i : picks) PetscCheck(i >= 0 && i < (PetscInt)done_.size(), comm_, PETSC_ERR_ARG_OUTOFRANGE, "SnapshotFile::SetPending: index %" PetscInt_FMT " outside the training set", i);
+  PetscCallMPI(MPI_Comm_rank(comm_, &rank));
+  if (rank == 0) {
+    H5Quiet q;
+    Ctx     c = FileCtx(path_);
+    if (!WritePending(c, (hid_t)file_, picks)) err = c.err;
+  }
+  PetscCall(BcastString(comm_, &err));
+  PetscCheck(err.empty(), comm_, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
+  pending_ = picks;
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SnapshotFile::Close()
 {
   PetscMPIInt rank;
@@ -506,6 +576,7 @@ PetscErrorCode SnapshotFile::Close()
   open_         = false;
   comm_         = MPI_COMM_NULL;
   done_.clear();
+  pending_.clear();
   PetscCall(BcastString(comm, &err));
   PetscCheck(err.empty(), comm, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
   PetscFunctionReturn(0);

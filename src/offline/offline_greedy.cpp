@@ -95,6 +95,23 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
       stop = "max_solves";
       break;
     }
+    {
+      // a run killed inside a round (some of its picks solved): finish that round's picks first. The model of a
+      // partial round would rank the candidates otherwise and the resumed run would not give the uninterrupted ROM.
+      std::vector<PetscInt> unfinished;
+      for (PetscInt i : file.Pending())
+        if (!std::binary_search(done.begin(), done.end(), i) && (PetscInt)unfinished.size() < go.maxSolves - nsolved) unfinished.push_back(i);
+      if (!unfinished.empty()) {
+        if (go.monitor && wrank == 0) PetscCall(PetscPrintf(PETSC_COMM_SELF, "  greedy: the interrupted round's %zu unsolved pick(s) first\n", unfinished.size()));
+        JsonValue r = JsonValue::Object();
+        r["round"]           = (long long)round;
+        r["solves"]          = (long long)nsolved;
+        r["resumed_picks"]   = std::vector<double>(unfinished.begin(), unfinished.end());
+        rounds.Push(r);
+        PetscCall(solve(unfinished));
+        continue;
+      }
+    }
     // the done snapshots, as a restart would read them
     std::vector<Snapshot> snaps;
     PetscCall(file.Close());
@@ -204,6 +221,7 @@ PetscErrorCode GreedyRounds(MPI_Comm world, const GreedyOptions &go, PetscInt ng
     const std::vector<PetscInt> picks = GreedyPick(eta, pool.points, fom.scene.params, std::min(batch, go.maxSolves - nsolved), go.separation * spacing);
     r["picked"] = std::vector<double>(picks.begin(), picks.end());
     rounds.Push(r);
+    PetscCall(file.SetPending(picks));
     PetscCall(solve(picks));
   }
   std::vector<PetscInt> done;
