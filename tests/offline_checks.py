@@ -5,7 +5,10 @@
               subcommunicators: identical snapshot files (u, lambda, contact data).
   half_disks  2 parameters (lower radius, imposed displacement) on a 5 x 5 grid, 2 ranks.
   resume      a run killed (SIGKILL) after a few snapshots, resumed with -snapshots_restart: only the
-              missing ones are solved and the file equals a clean run's.
+              missing ones are solved and the file equals a clean run's; the same command again without
+              -snapshots_restart refused (it replaced the finished snapshots).
+  concurrent  two jobs on one snapshot file: replacing the file another job writes is refused (HDF5's lock),
+              and a writer whose file was replaced under it stops with an error.
   mismatch    a snapshot file from another scene / parameter box is refused with a clear error.
   greedy      -train_type greedy on ring_on_block: the same picks on 1 and 2 ranks, each round's first pick
               the largest indicator, the separation, the snapshot file holding exactly the picks, a
@@ -151,12 +154,67 @@ def resume(args):
     with h5py.File(path, "r") as f:
         kept = int(np.sum(np.array(f["snapshots/done"])))
     check(kept >= ndone, "the killed file is readable and keeps its %d finished snapshots" % kept)
+    # the killed job resubmitted with its own command (-offline_stop snapshots, no -snapshots_restart): until 2026-11-29
+    # the file was replaced and every finished snapshot solved again, without a word; now refused, the file untouched
+    p = run(args, 1, "runs/ring_on_block.opts", base + ["-snapshots", path], expect_ok=False)
+    with h5py.File(path, "r") as f:
+        still = int(np.sum(np.array(f["snapshots/done"])))
+    check(p.returncode != 0 and ("holds %d finished snapshots (of 21): resume it with -snapshots_restart" % kept) in p.stdout and "-snapshots_restart 0" in p.stdout and still == kept,
+          "the same command again: refused, naming -snapshots_restart and -snapshots_restart 0; the %d snapshots kept" % still)
     run(args, 2, "runs/ring_on_block.opts", base + ["-snapshots", path, "-snapshots_restart", "-report", d + "/r.json"])
     r = report(d + "/r.json")
     check(r["resumed"] == kept and r["fom_solves"] == 21 - kept, "restart solved only the missing %d (resumed %d)" % (r["fom_solves"], r["resumed"]))
     compare(arrays(d + "/clean.h5"), arrays(path), 1e-10, "resumed vs clean run")
     leftovers = [f for f in os.listdir(d) if ".tmp." in f]
     check(not leftovers, "no temporary files left (%s)" % leftovers)
+
+
+def concurrent(args):
+    """Two jobs given the same snapshot file (found by an audit, 2026-11-29): a job creating the file replaced it under
+    one that was writing it, which went on writing into the unlinked file and ended with exit 0, its snapshots lost.
+    HDF5's file lock is on for the jobs here (this script turns it off for its own reads)."""
+    d = workdir("rbc_off_")
+    env = dict(os.environ)
+    env.pop("HDF5_USE_FILE_LOCKING", None)
+    path = d + "/busy.h5"
+    base = ["-train_type", "grid", "-train_size", "400", "-snapshots", path]
+
+    def start():
+        c = cmd(args, 1, "runs/ring_on_block.opts", base)[3:]  # singleton MPI: the process that writes
+        p = subprocess.Popen(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+        t0, n = time.time(), 0
+        while time.time() - t0 < 120 and p.poll() is None and n < 1:
+            try:
+                with h5py.File(path, "r") as f:
+                    n = int(np.sum(np.array(f["snapshots/done"])))
+            except Exception:
+                n = 0
+            time.sleep(0.05)
+        return p, n
+
+    # a second job asked to replace the file (-snapshots_restart 0) while the first writes it: refused
+    a, n = start()
+    c = cmd(args, 1, "runs/ring_on_block.opts", ["-train_type", "grid", "-train_size", "3", "-snapshots", path, "-snapshots_restart", "0"])
+    b = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+    running = a.poll() is None
+    a.kill()
+    a.wait()
+    with h5py.File(path, "r") as f:
+        ntrain = len(f["train/points"])
+    check(n >= 1 and running and b.returncode != 0 and "another job is writing it (HDF5's file lock): not replaced under that job" in b.stdout and ntrain == 400,
+          "a job replacing the file another job writes: refused (exit %d), the writer's file kept (%d training points)" % (b.returncode, ntrain))
+    # the file replaced under the writer by another process (a rename): the writer stops at its next snapshot
+    os.remove(path)
+    a, n = start()
+    shutil.copy(path, d + "/copy.h5")
+    os.replace(d + "/copy.h5", path)
+    try:
+        out, _ = a.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        a.kill()
+        out, _ = a.communicate()
+    check(n >= 1 and a.returncode != 0 and "was replaced or removed while this run was writing it" in out,
+          "the file replaced under the writer: it stops with an error naming that (exit %s)" % a.returncode)
 
 
 def mismatch(args):
@@ -185,12 +243,13 @@ def mismatch(args):
                                "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
 
     # a finished row holding a NaN (or inf): the bases step names the file, the dataset and the row
-    for ds, row, val in (("u", 1, np.nan), ("lambda", 2, np.inf)):
+    # (a huge finite value, 1e300: the POD said "the snapshots are all zero", validate printed "max rel err u -nan", exit 0)
+    for ds, row, val, word in (("u", 1, np.nan, "non-finite"), ("lambda", 2, np.inf, "non-finite"), ("u", 2, 1e300, "huge (>= 1e150)")):
         p = bases_from_tampered("bad_" + ds, ds, row, val)
         msg = [l for l in p.stdout.splitlines() if "error" in l.lower()][:1]
-        print("  non-finite row of %s -> exit %d: %s" % (ds, p.returncode, msg[0] if msg else p.stdout[-300:]))
-        check(p.returncode != 0 and ("bad_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and "non-finite" in p.stdout,
-              "non-finite value in a done row of /snapshots/%s: refused naming the file, the row and the dataset" % ds)
+        print("  %s row of %s -> exit %d: %s" % (word, ds, p.returncode, msg[0] if msg else p.stdout[-300:]))
+        check(p.returncode != 0 and ("bad_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and word in p.stdout,
+              "%s value in a done row of /snapshots/%s: refused naming the file, the row and the dataset" % (word, ds))
         check(not os.path.exists(d + "/never.h5"), "no ROM written from the corrupt %s row" % ds)
     # a finished row whose parameter is not its training point, or with a negative multiplier (resumed without a word
     # before 2026-11-29; the negative one failed later in the dual basis without naming the file)
@@ -529,7 +588,7 @@ def initial_guess(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -21,6 +21,7 @@ struct OfflineSettings {
   std::string basis;                   // -rom_basis (default: the ROM's stem + .basis.h5, rom step)
   std::string snapshots;               // -snapshots (default: the ROM's stem + .snapshots.h5, rom step)
   bool        restart = true;          // -snapshots_restart (default: false when stopping after the snapshots)
+  bool        restartGiven = false;    // -snapshots_restart given explicitly (without it, -offline_stop snapshots refuses to replace a file holding done snapshots)
   bool        monitor = false;         // -snapshots_monitor: one line per solved snapshot with an ETA
   std::string trainType = "grid";      // -train_type grid|random|lhs|file|greedy
   PetscInt    subcomms  = 0;           // -snapshots_subcomm: groups of ranks (0: one per rank below 200k dofs, else 1)

@@ -84,6 +84,10 @@ public:
   // of header (every field Import compares). Collective; rank 0 reads the header only. Errors name the file.
   static PetscErrorCode CheckImport(MPI_Comm comm, const std::string &from, const SnapshotHeader &header);
 
+  // The done snapshots of an existing snapshot file at path (*ndone, of *ntrain), or *ndone = -1 when there is no
+  // readable snapshot file there. Collective; rank 0 reads.
+  static PetscErrorCode DoneCount(MPI_Comm comm, const std::string &path, PetscInt *ndone, PetscInt *ntrain);
+
   // Reading (any rank, independent; for the basis builders and the tests).
   static PetscErrorCode ReadHeader(const std::string &path, SnapshotHeader *header);
   // All done snapshots, ordered by training index; the contact matrix compacted (CompactContactMatrix) as each is read.

@@ -144,7 +144,12 @@ bool OpenExisting(Ctx &c, const std::string &path, bool rdwr, H5Id *file, int *v
   H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   if (!fapl.ok() || (!rdwr && H5Pset_file_locking(fapl.get(), 0, 1) < 0)) return c.Fail("cannot create a file access property list");
   *file = H5Id(H5Fopen(path.c_str(), rdwr ? H5F_ACC_RDWR : H5F_ACC_RDONLY, fapl.get()), H5Fclose);
-  if (!file->ok()) return c.Fail(rdwr ? "cannot be opened for writing (is another job writing it?)" : "cannot be opened");
+  if (!file->ok() && rdwr) { // locked by another writer, or unreadable (a truncated file was blamed on another job)
+    H5Id ro(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    const bool readable = ro.ok() && H5Pset_file_locking(ro.get(), 0, 1) >= 0 && H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, ro.get()), H5Fclose).ok();
+    return c.Fail(readable ? "cannot be opened for writing: another job is writing it (HDF5's file lock), or it is read-only" : "cannot be opened (truncated or corrupt?)");
+  }
+  if (!file->ok()) return c.Fail("cannot be opened");
   bool exists = false;
   if (!AttrExists(c, file->get(), "format", &exists)) return false;
   if (!exists) return c.Fail("is an HDF5 file but not an rbcontact snapshot file (no 'format' attribute)", false);
@@ -300,6 +305,29 @@ PetscErrorCode BcastReals(MPI_Comm comm, PetscReal *v, size_t n)
   PetscFunctionReturn(0);
 }
 
+// The file this run writes is no longer the one at path (another job created the same -snapshots over it, or it
+// was removed): its writes would go to an unlinked file and be lost with exit 0.
+bool CheckNotReplaced(Ctx &c, hid_t f, const std::string &path)
+{
+  void       *h = nullptr;
+  struct stat a, b;
+  if (H5Fget_vfd_handle(f, H5P_DEFAULT, &h) < 0 || !h || fstat(*static_cast<int *>(h), &a) != 0) return true; // (not the sec2 driver: no check)
+  if (stat(path.c_str(), &b) == 0 && a.st_ino == b.st_ino && a.st_dev == b.st_dev) return true;
+  return c.Fail("was replaced or removed while this run was writing it (another job given the same file?): this run's snapshots since then are not in the file at that path; stopping", false);
+}
+
+// Before a file is created over path: a snapshot file another job holds open for writing (HDF5's lock) is not replaced
+// under it (that job would go on writing into the unlinked file and end with exit 0, its snapshots lost).
+bool CheckNotLocked(Ctx &c, const std::string &path)
+{
+  if (!FileExists(path)) return true;
+  if (H5Id(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose).ok()) return true;
+  H5Id ro(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  const bool readable = ro.ok() && H5Pset_file_locking(ro.get(), 0, 1) >= 0 && H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, ro.get()), H5Fclose).ok();
+  if (!readable || access(path.c_str(), W_OK) != 0) return true; // not an HDF5 file we could open, or read-only: replaced as asked
+  return c.Fail("exists and another job is writing it (HDF5's file lock): not replaced under that job; wait for it to end, or give another file", false);
+}
+
 // Rank 0's part of Open: create (temp file + rename) or reopen and check. Returns the open file.
 bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool restart, H5Id *file, std::vector<signed char> *done, std::vector<PetscInt> *pending)
 {
@@ -326,6 +354,7 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
   }
   const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
+  if (!CheckNotLocked(c, target)) return false;
   {
     H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
     bool ok = f.ok() || ct.Fail("cannot create the file (directory missing or not writable?)");
@@ -355,11 +384,12 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
 }
 
 // Rank 0's part of Write. *doneState: the done flag of s.index in the file afterwards.
-bool WriteOnRoot(Ctx &c, hid_t f, const SnapshotHeader &h, bool wasDone, const Snapshot &s, signed char *doneState)
+bool WriteOnRoot(Ctx &c, hid_t f, const std::string &path, const SnapshotHeader &h, bool wasDone, const Snapshot &s, signed char *doneState)
 {
   const PetscInt ntrain = (PetscInt)h.trainingPoints.size();
   const size_t   np     = h.paramNames.size();
   *doneState            = wasDone ? 1 : 0;
+  if (!CheckNotReplaced(c, f, path)) return false;
   std::ostringstream m;
   if (s.index < 0 || s.index >= ntrain) m << "Write: snapshot index " << s.index << " outside the training set [0, " << ntrain << ")";
   else if (s.u.size() != (size_t)h.ndofs) m << "Write: snapshot " << s.index << " has " << s.u.size() << " values of u; the file stores ndofs = " << h.ndofs;
@@ -526,7 +556,7 @@ PetscErrorCode SnapshotFile::Write(const Snapshot &s)
     Ctx         c  = FileCtx(path_);
     const bool  ok = s.index >= 0 && s.index < (PetscInt)done_.size();
     signed char st = ok ? done_[s.index] : 0;
-    if (!WriteOnRoot(c, (hid_t)file_, header_, ok && done_[s.index], s, &st)) err = c.err;
+    if (!WriteOnRoot(c, (hid_t)file_, path_, header_, ok && done_[s.index], s, &st)) err = c.err;
     state[0] = ok ? s.index : -1;
     state[1] = st;
   }
@@ -570,7 +600,8 @@ PetscErrorCode SnapshotFile::Close()
     Ctx     c = FileCtx(path_);
     H5Id    f((hid_t)file_, H5Fclose);
     file_ = -1;
-    if (!CloseFile(c, &f)) err = c.err;
+    if (!CheckNotReplaced(c, f.get(), path_)) err = c.err;
+    if (!CloseFile(c, &f)) err = err.empty() ? c.err : err;
   }
   MPI_Comm comm = comm_;
   open_         = false;
@@ -579,6 +610,30 @@ PetscErrorCode SnapshotFile::Close()
   pending_.clear();
   PetscCall(BcastString(comm, &err));
   PetscCheck(err.empty(), comm, PETSC_ERR_FILE_WRITE, "%s", err.c_str());
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode SnapshotFile::DoneCount(MPI_Comm comm, const std::string &path, PetscInt *ndone, PetscInt *ntrain)
+{
+  PetscMPIInt rank;
+  PetscInt    v[2] = {-1, 0};
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0 && FileExists(path)) {
+    H5Quiet                  q;
+    Ctx                      c = FileCtx(path);
+    H5Id                     f;
+    SnapshotHeader           h;
+    std::vector<signed char> done;
+    if (OpenExisting(c, path, false, &f) && ReadHeaderH5(c, f.get(), &h) && ReadDone(c, f.get(), h.trainingPoints.size(), &done)) {
+      v[0] = (PetscInt)std::count(done.begin(), done.end(), (signed char)1);
+      v[1] = (PetscInt)done.size();
+    }
+  }
+  PetscCallMPI(MPI_Bcast(v, 2, MPIU_INT, 0, comm));
+  *ndone  = v[0];
+  *ntrain = v[1];
   PetscFunctionReturn(0);
 }
 
@@ -680,12 +735,13 @@ bool ReadAllH5(Ctx &c, const std::string &path, SnapshotHeader *hOut, std::vecto
         x.resize(extras[k].second);
         ok = RowIO(c, f.get(), "/snapshots/extra/" + extras[k].first, H5T_NATIVE_DOUBLE, i, x.size(), x.data(), false);
       }
-      // a finished row must be finite: name the row, the dataset and the entry (never NaN into a basis)
+      // a finished row must be finite and below 1e150 (as a ROM file's values: a 1e300 made a validate error NaN and
+      // the POD call the snapshots zero): name the row, the dataset and the entry (never NaN into a basis)
       auto finite = [&](const std::string &name, const std::vector<PetscReal> &x) {
         for (size_t k = 0; k < x.size(); ++k)
-          if (!std::isfinite(x[k])) {
+          if (!std::isfinite(x[k]) || std::fabs(x[k]) >= 1e150) {
             std::ostringstream m;
-            m << "row " << i << " (training point " << i + 1 << " of " << done.size() << ") of " << name << " holds a non-finite value (entry " << k << ", " << x[k]
+            m << "row " << i << " (training point " << i + 1 << " of " << done.size() << ") of " << name << " holds a " << (std::isfinite(x[k]) ? "huge (>= 1e150)" : "non-finite") << " value (entry " << k << ", " << x[k]
               << ") although the row is marked done: the file is corrupt; recompute that snapshot (-snapshots_restart 0 recomputes all, or clear /snapshots/done[" << i << "])";
             return c.Fail(m.str(), false);
           }

@@ -34,6 +34,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   char      romPath[PETSC_MAX_PATH_LEN], basisPath[PETSC_MAX_PATH_LEN] = "", viewPath[PETSC_MAX_PATH_LEN], snapPath[PETSC_MAX_PATH_LEN] = "", stop[64] = "rom", trainType[64], guess[64];
   PetscBool restart, monitor = s->monitor ? PETSC_TRUE : PETSC_FALSE, sens = s->sensitivities ? PETSC_TRUE : PETSC_FALSE;
   PetscBool probe = s->probe ? PETSC_TRUE : PETSC_FALSE, probeFail = s->probeFail ? PETSC_TRUE : PETSC_FALSE;
+  PetscBool restartSet = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(romPath, s->rom.c_str(), sizeof romPath));
@@ -61,7 +62,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   PetscCall(PetscOptionsString("-snapshots", "the snapshot file, checkpointed and resumable (default: the ROM's stem + .snapshots.h5)", "", snapPath, snapPath, sizeof snapPath, NULL));
   // the bases step reuses an existing snapshot file of this problem (and completes it if needed)
   restart = strcmp(stop, "snapshots") ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscOptionsBool("-snapshots_restart", "resume from an existing snapshot file of this problem", "", restart, &restart, NULL));
+  PetscCall(PetscOptionsBool("-snapshots_restart", "resume from an existing snapshot file of this problem", "", restart, &restart, &restartSet));
   PetscCall(PetscOptionsBool("-snapshots_monitor", "print one line per solved snapshot", "", monitor, &monitor, NULL));
   PetscCall(PetscOptionsBool("-snapshots_sensitivities", "store du/dmu_i, dlambda/dmu_i with every contact snapshot (linear solves with its factor) for the POD and the dual greedy (docs/greedy_training.md)", "", sens, &sens, NULL));
   PetscCall(PetscOptionsString("-train_type", "training set: grid, random, lhs, file (prefix train_) or greedy (prefix greedy_)", "", trainType, trainType, sizeof trainType, NULL));
@@ -90,6 +91,7 @@ PetscErrorCode OfflineSettingsFromOptions(MPI_Comm comm, OfflineSettings *s)
   s->basis     = basisPath;
   s->snapshots = snapPath;
   s->restart   = restart;
+  s->restartGiven = restartSet;
   s->monitor   = monitor;
   s->sensitivities = sens;
   s->trainType = trainType;
@@ -272,6 +274,13 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     }
     SnapshotFile file;
     for (const auto &from : s.from) PetscCall(SnapshotFile::CheckImport(world, from, h)); // before Open may replace the file
+    if (!restart && !s.restartGiven) {
+      // -offline_stop snapshots run again with its own command (a killed job resubmitted): the finished snapshots were
+      // thrown away without a word. Replacing a file that holds some is now asked for explicitly.
+      PetscInt ndone, nold;
+      PetscCall(SnapshotFile::DoneCount(world, snapPath, &ndone, &nold));
+      PetscCheck(ndone <= 0, world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' exists and holds %" PetscInt_FMT " finished snapshots (of %" PetscInt_FMT "): resume it with -snapshots_restart (it is checked to belong to this problem first), or replace it with -snapshots_restart 0", snapPath, ndone, nold);
+    }
     PetscCall(file.Open(world, snapPath, h, restart));
     PetscInt                 imported = 0;
     std::vector<std::string> extras; // what this run writes with every snapshot (the packing below)

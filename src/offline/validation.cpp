@@ -543,6 +543,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
       E->outOfRange.push_back((double)sol.outOfRange);
       double eu, el, ef;
       PetscCall(Compare(m, bases, order, *sysAt[j], dim, fom.affine, F[j], sol, work, work2, lwork, &eu, &el, &ef));
+      // a NaN error was printed as the maximum or silently left out of it (std::max_element), exit 0
+      PetscCheck(std::isfinite(eu) && std::isfinite(el) && std::isfinite(ef), comm, PETSC_ERR_FP, "validate: the relative error at test parameter %" PetscInt_FMT " is not finite (u %g, lambda %g, force %g): the test solution or the reduced one holds non-finite or huge values", j, eu, el, ef);
       E->u.push_back(eu);
       E->lambda.push_back(el);
       E->force.push_back(ef);
