@@ -36,7 +36,9 @@ std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map)
     (void)PetscOptionsGetString(NULL, NULL, "-contact_multiplier", mult, sizeof mult, NULL);
     o << "|multiplier " << mult;
   }
-  for (const char *opt : {"-contact_quadrature", "-contact_quadrature_points", "-contact_normal"}) {
+  // (the options that change the discrete problem; only when given, so that the files of the defaults keep their hash.
+  // -contact_quadrature_subdivisions was missing until 2026-11-29: a resumed file mixed two composite rules)
+  for (const char *opt : {"-contact_quadrature", "-contact_quadrature_points", "-contact_quadrature_subdivisions", "-contact_normal"}) {
     char      v[256] = "";
     PetscBool set;
     if (!PetscOptionsGetString(NULL, NULL, opt, v, sizeof v, &set) && set) o << "|" << opt << " " << v;
