@@ -368,6 +368,11 @@ def bad_input(args):
     expect_error(args, ["-rom", rom, "-rom_kacanov_relaxation", "1.5"], ["-rom_kacanov_relaxation", "1.5"], "-rom_kacanov_relaxation out of range")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
     expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")
+    # scene options that contradict the ROM were ignored without a word (the ROM's own answer, exit 0; audit 2026-11-29)
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-body_E", "200,100"], ["option -body_E is a scene option", "-options_file runs/<scene>.opts"], "online -body_E without the scene")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-body_E", "200,100"], ["was built for another configuration of scene 'ring_on_block'"],
+                 "online with the scene's options and another -body_E")
+    run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts"])  # the scene it was built with: accepted
     expect_error(args, ["-rom", rom, "-rom_kacanov_anderson", "11"], ["-rom_kacanov_anderson", "11"], "-rom_kacanov_anderson out of range")
     expect_error(args, ["-rom", rom, "-rom_warm_start_degree", "3"], ["-rom_warm_start_degree", "3"], "-rom_warm_start_degree out of range")
     # Anderson mixing (default depth 3) and the plain fixed point reach the same reduced solution
