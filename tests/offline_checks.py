@@ -10,6 +10,7 @@
   concurrent  two jobs on one snapshot file: replacing the file another job writes is refused (HDF5's lock),
               and a writer whose file was replaced under it stops with an error.
   mismatch    a snapshot file from another scene / parameter box is refused with a clear error.
+  early_options  the bases' options (-pod_*, -dual_*) refused before the first snapshot.
   greedy      -train_type greedy on ring_on_block: the same picks on 1 and 2 ranks, each round's first pick
               the largest indicator, the separation, the snapshot file holding exactly the picks, a
               resumed run continuing where the budget stopped, the ROM validated against the targets.
@@ -259,6 +260,21 @@ def mismatch(args):
         p = bases_from_tampered("odd_" + ds, ds, row, val)
         check(p.returncode != 0 and ("odd_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and words in p.stdout and not os.path.exists(d + "/never.h5"),
               "a done row of /snapshots/%s with %s: refused naming the file and the row, no ROM" % (ds, words))
+
+
+def early_options(args):
+    """The bases' options refused before any snapshot is solved (hours on a real scene): until 2026-11-29 -pod_tol,
+    -pod_n, -pod_inner, -dual_type and -dual_tol were refused only after the last snapshot, and -dual_tol 1 with
+    -dual_tol_relative gave "supremizers: 0 supremizers for 0 dual vectors"."""
+    d = workdir("rbc_off_")
+    cases = [(["-pod_tol", "2"], "-pod_tol 2. must lie in [0, 1)"), (["-pod_n", "0"], "-pod_n 0 must be >= 1"),
+             (["-pod_inner", "bogus"], "Unknown option bogus for -pod_inner"), (["-dual_type", "bogus"], "Unknown option bogus for -dual_type"),
+             (["-dual_tol", "1"], "-dual_tol 1. with -dual_tol_relative must be < 1"), (["-pod_method", "svd"], "-pod_method svd computes the l2 POD only")]
+    for extra, words in cases:
+        c = ["mpirun", "-n", "2", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-snapshots_monitor", "-rom", d + "/r.h5"] + extra
+        p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and words in p.stdout and "  snapshot " not in p.stdout and not os.path.exists(d + "/r.snapshots.h5"),
+              "%s: refused before any snapshot, naming it (%s)" % (" ".join(extra), words))
 
 
 def bases(args):
@@ -590,7 +606,7 @@ def initial_guess(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "early_options", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

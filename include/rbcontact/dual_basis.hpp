@@ -128,6 +128,16 @@ struct DualBasisResult {
 PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res, PetscReal tolOverride = -1);
 // -dual_tol's default (read by BuildDualBasis, and by offline -estimate).
 constexpr PetscReal kDualDefaultTol = 1e-3;
+static const char *const kDualTypes[] = {"nmf", "angle", "cpg", "mcpg"};
+static const char *const kDualNorms[] = {"linf", "l2"};
+// The -dual_* options of BuildDualBasis, checked where they do not depend on the snapshots (the offline stage calls it
+// before the snapshots: hours on a real scene).
+struct DualBasisOptions {
+  PetscInt  type = 2, norm = 0, r = 5, seed = 1, nmfMaxIt = 2000, maxR = -1; // type, norm: indices of kDualTypes, kDualNorms; maxR -1: all
+  PetscReal tol = kDualDefaultTol, nmfRtol = 1e-6, feasTol = 1e-12, maxCond = 1e12;
+  PetscBool tolRelative = PETSC_FALSE, monitor = PETSC_FALSE;
+};
+PetscErrorCode DualBasisOptionsFromOptions(MPI_Comm comm, DualBasisOptions *o);
 
 // Projection errors of every column of L onto the cone of W (NNLS), in l-infinity or l2.
 // solver: a configured NNLSSolver to use (null: a local one, configured from the options: collective).

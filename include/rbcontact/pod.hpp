@@ -37,6 +37,9 @@ struct PODResult {
 // energy -> the reference stiffness A_ref, h1 -> an H1 Gram matrix, l2 -> M = nullptr.
 enum class PODInner { Energy, H1, L2 };
 PetscErrorCode PODInnerFromOptions(MPI_Comm comm, PODInner *inner);
+// The -pod_* options ComputePOD reads, checked where they do not depend on the snapshots (their values, names and
+// ranges; -pod_n against the snapshot count is ComputePOD's): the offline stage calls it before the snapshots.
+PetscErrorCode PODCheckOptions(MPI_Comm comm);
 const char    *PODInnerName(PODInner inner);
 
 // snapshots: columns = snapshot vectors (same layout as M's rows, e.g. DMCreateGlobalVector), M the

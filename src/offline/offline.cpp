@@ -186,10 +186,14 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
   } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
-  { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
-    PetscReal supRatio, step;
+  if (bases) { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
+    // (-pod_tol, -pod_n, -pod_inner, -dual_type, -dual_tol were refused only after every snapshot was solved)
+    PetscReal        supRatio, step;
+    DualBasisOptions dbo;
     PetscCall(SupremizerRatioFromOptions(world, &supRatio));
     PetscCall(DualSensitivityStepFromOptions(world, &step));
+    PetscCall(PODCheckOptions(world));
+    PetscCall(DualBasisOptionsFromOptions(world, &dbo));
   }
   if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
     EIMOptions  eo;

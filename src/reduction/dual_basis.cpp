@@ -350,39 +350,54 @@ static PetscErrorCode BuildNMF(const DenseMatrix &L, PetscInt r, PetscInt seed, 
 
 // --- BuildDualBasis --------------------------------------------------------------------------------
 
+PetscErrorCode DualBasisOptionsFromOptions(MPI_Comm comm, DualBasisOptions *o)
+{
+  PetscFunctionBeginUser;
+  *o = DualBasisOptions();
+  PetscOptionsBegin(comm, "dual_", "Dual (multiplier) basis", "BuildDualBasis");
+  PetscCall(PetscOptionsEList("-type", "Basis construction", "BuildDualBasis", kDualTypes, 4, kDualTypes[o->type], &o->type, NULL));
+  PetscCall(PetscOptionsEList("-norm", "Norm of the projection errors (greedy selection, tolerance, trainMaxErr)", "BuildDualBasis", kDualNorms, 2, kDualNorms[o->norm], &o->norm, NULL));
+  PetscCall(PetscOptionsReal("-tol", "Greedy tolerance on the largest projection error", "BuildDualBasis", o->tol, &o->tol, NULL));
+  PetscCall(PetscOptionsBool("-tol_relative", "-dual_tol is relative to the largest snapshot norm", "BuildDualBasis", o->tolRelative, &o->tolRelative, NULL));
+  PetscCall(PetscOptionsInt("-max_r", "Largest greedy basis size (default: the number of snapshots)", "BuildDualBasis", o->maxR, &o->maxR, NULL));
+  PetscCall(PetscOptionsInt("-r", "NMF rank", "BuildDualBasis", o->r, &o->r, NULL));
+  PetscCall(PetscOptionsInt("-seed", "NMF initialization seed (splitmix64)", "BuildDualBasis", o->seed, &o->seed, NULL));
+  PetscCall(PetscOptionsReal("-nmf_rtol", "NMF: stop when the relative change of ||L - W H||_F is below", "BuildDualBasis", o->nmfRtol, &o->nmfRtol, NULL));
+  PetscCall(PetscOptionsInt("-nmf_max_it", "NMF: maximum multiplicative updates", "BuildDualBasis", o->nmfMaxIt, &o->nmfMaxIt, NULL));
+  PetscCall(PetscOptionsReal("-mcpg_feas_tol", "mcpg: accepted violation of theta - Upsilon >= 0, relative to ||theta||", "BuildDualBasis", o->feasTol, &o->feasTol, NULL));
+  PetscCall(PetscOptionsReal("-max_cond", "Greedy: a pick that would make cond(W^T W) exceed this is skipped (a vector in the span of W but outside its cone)", "BuildDualBasis", o->maxCond, &o->maxCond, NULL));
+  PetscCall(PetscOptionsBool("-monitor", "Print step, selected snapshot, largest error, cond(W^T W)", "BuildDualBasis", o->monitor, &o->monitor, NULL));
+  PetscOptionsEnd();
+  // (-dual_tol 1 with -dual_tol_relative kept no vector, and the error came later from the supremizers: "0 supremizers
+  // for 0 dual vectors", naming no option)
+  PetscCheck(o->tol >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be >= 0", (double)o->tol);
+  PetscCheck(!o->tolRelative || o->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g with -dual_tol_relative must be < 1 (a fraction of the largest multiplier snapshot's norm: 1 keeps no dual vector)", (double)o->tol);
+  PetscCheck(o->maxCond >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_cond %g must be >= 1", (double)o->maxCond);
+  PetscCheck(o->maxR == -1 || o->maxR >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_r %" PetscInt_FMT " must be >= 1", o->maxR);
+  PetscCheck(o->r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_r %" PetscInt_FMT " must be >= 1", o->r);
+  PetscCheck(o->nmfRtol >= 0 && o->nmfMaxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_nmf_rtol %g must be >= 0 and -dual_nmf_max_it %" PetscInt_FMT " >= 1", (double)o->nmfRtol, o->nmfMaxIt);
+  PetscCheck(o->seed >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_seed %" PetscInt_FMT " must be >= 0", o->seed);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res, PetscReal tolOverride)
 {
-  const char *types[] = {"nmf", "angle", "cpg", "mcpg"};
-  const char *norms[] = {"linf", "l2"};
-  PetscInt    type = 2, norm = 0, r = 5, seed = 1, nmfMaxIt = 2000, maxR = L.cols;
-  PetscReal   tol = kDualDefaultTol, nmfRtol = 1e-6, feasTol = 1e-12, maxCond = 1e12;
-  PetscBool   tolRelative = PETSC_FALSE, monitor = PETSC_FALSE;
-  const PetscInt R = L.rows, m = L.cols;
+  static const char *const *types = kDualTypes, *const *norms = kDualNorms;
+  DualBasisOptions          o;
+  const PetscInt            R = L.rows, m = L.cols;
 
   PetscFunctionBeginUser;
   if (!DUAL_Build) PetscCall(PetscLogEventRegister("RBCDualBasis", TAO_CLASSID, &DUAL_Build));
-  PetscOptionsBegin(PETSC_COMM_WORLD, "dual_", "Dual (multiplier) basis", "BuildDualBasis");
-  PetscCall(PetscOptionsEList("-type", "Basis construction", "BuildDualBasis", types, 4, types[type], &type, NULL));
-  PetscCall(PetscOptionsEList("-norm", "Norm of the projection errors (greedy selection, tolerance, trainMaxErr)", "BuildDualBasis", norms, 2, norms[norm], &norm, NULL));
-  PetscCall(PetscOptionsReal("-tol", "Greedy tolerance on the largest projection error", "BuildDualBasis", tol, &tol, NULL));
-  PetscCall(PetscOptionsBool("-tol_relative", "-dual_tol is relative to the largest snapshot norm", "BuildDualBasis", tolRelative, &tolRelative, NULL));
-  PetscCall(PetscOptionsInt("-max_r", "Largest greedy basis size", "BuildDualBasis", maxR, &maxR, NULL));
-  PetscCall(PetscOptionsInt("-r", "NMF rank", "BuildDualBasis", r, &r, NULL));
-  PetscCall(PetscOptionsInt("-seed", "NMF initialization seed (splitmix64)", "BuildDualBasis", seed, &seed, NULL));
-  PetscCall(PetscOptionsReal("-nmf_rtol", "NMF: stop when the relative change of ||L - W H||_F is below", "BuildDualBasis", nmfRtol, &nmfRtol, NULL));
-  PetscCall(PetscOptionsInt("-nmf_max_it", "NMF: maximum multiplicative updates", "BuildDualBasis", nmfMaxIt, &nmfMaxIt, NULL));
-  PetscCall(PetscOptionsReal("-mcpg_feas_tol", "mcpg: accepted violation of theta - Upsilon >= 0, relative to ||theta||", "BuildDualBasis", feasTol, &feasTol, NULL));
-  PetscCall(PetscOptionsReal("-max_cond", "Greedy: a pick that would make cond(W^T W) exceed this is skipped (a vector in the span of W but outside its cone)", "BuildDualBasis", maxCond, &maxCond, NULL));
-  PetscCall(PetscOptionsBool("-monitor", "Print step, selected snapshot, largest error, cond(W^T W)", "BuildDualBasis", monitor, &monitor, NULL));
-  PetscOptionsEnd();
+  PetscCall(DualBasisOptionsFromOptions(PETSC_COMM_SELF, &o));
+  const PetscInt  type = o.type, norm = o.norm, r = o.r, seed = o.seed, nmfMaxIt = o.nmfMaxIt;
+  PetscInt        maxR = o.maxR > 0 ? o.maxR : L.cols;
+  PetscReal       tol  = o.tol;
+  const PetscReal nmfRtol = o.nmfRtol, feasTol = o.feasTol, maxCond = o.maxCond;
+  const PetscBool tolRelative = o.tolRelative, monitor = o.monitor;
   if (tolOverride >= 0) tol = tolOverride; // the caller's tolerance (offline -estimate's enriched space), relative with -dual_tol_relative
   PetscCheck(R > 0 && m > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Dual basis: empty snapshot matrix (%" PetscInt_FMT " x %" PetscInt_FMT ")", R, m);
-  PetscCheck(tol >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be >= 0", (double)tol);
-  PetscCheck(maxCond >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_cond %g must be >= 1", (double)maxCond);
-  PetscCheck(maxR >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_r %" PetscInt_FMT " must be >= 1", maxR);
+  PetscCheck(tol >= 0 && (!tolRelative || tol < 1), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "dual basis tolerance %g must be >= 0 (and < 1 with -dual_tol_relative)", (double)tol);
   PetscCheck(type != 0 || (r >= 1 && r <= std::min(R, m)), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_r %" PetscInt_FMT " must lie in [1, min(R, m)] = [1, %" PetscInt_FMT "]", r, std::min(R, m));
-  PetscCheck(nmfRtol >= 0 && nmfMaxIt >= 1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_nmf_rtol %g must be >= 0 and -dual_nmf_max_it %" PetscInt_FMT " >= 1", (double)nmfRtol, nmfMaxIt);
-  PetscCheck(seed >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-dual_seed %" PetscInt_FMT " must be >= 0", seed);
   for (PetscReal v : L.a) PetscCheck(v >= 0 && std::isfinite(v), PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Dual basis: the multiplier snapshots must be finite and >= 0 (found %g)", (double)v);
   maxR = std::min(maxR, m);
 

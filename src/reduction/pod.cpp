@@ -48,7 +48,7 @@ PetscErrorCode ReadOptions(MPI_Comm comm, PetscInt m, Mat M, PODOptions *o)
   PetscFunctionBeginUser;
   // Relative noise level of the correlation eigenvalues is ~ m eps (lambda_i = s_i^2), so singular
   // values below ~ sqrt(m eps) s_0 are not resolved by the method of snapshots; 10x margin.
-  o->rankTol = 10 * PetscSqrtReal((PetscReal)m * PETSC_MACHINE_EPSILON);
+  o->rankTol = 10 * PetscSqrtReal((PetscReal)std::max<PetscInt>(m, 1) * PETSC_MACHINE_EPSILON);
   PetscOptionsBegin(comm, "pod_", "Proper orthogonal decomposition", "ComputePOD");
   PetscCall(PetscOptionsEList("-method", "bv: method of snapshots with BV (any inner product); svd: SLEPc SVD of the snapshot matrix (l2 only)", "ComputePOD", kMethods, 2, kMethods[o->method], &o->method, NULL));
   PetscCall(PetscOptionsEList("-inner", "Inner product of the POD (the caller builds M accordingly)", "PODInnerFromOptions", kInners, 3, kInners[o->inner], &o->inner, &o->innerSet));
@@ -61,10 +61,15 @@ PetscErrorCode ReadOptions(MPI_Comm comm, PetscInt m, Mat M, PODOptions *o)
   PetscCall(PetscOptionsBool("-view", "Print a summary of the POD", "ComputePOD", o->view, &o->view, NULL));
   PetscOptionsEnd();
 
-  if (o->nSet) PetscCheck(o->n >= 1 && o->n <= m, comm, PETSC_ERR_USER_INPUT, "-pod_n %" PetscInt_FMT " must lie in [1, %" PetscInt_FMT "] (the number of snapshots)", o->n, m);
-  PetscCheck(o->svdNsv >= 1 && o->svdNsv <= m, comm, PETSC_ERR_USER_INPUT, "-pod_svd_nsv %" PetscInt_FMT " must lie in [1, %" PetscInt_FMT "] (the number of snapshots)", o->svdNsv, m);
   PetscCheck(o->tol >= 0 && o->tol < 1, comm, PETSC_ERR_USER_INPUT, "-pod_tol %g must lie in [0, 1)", (double)o->tol);
   PetscCheck(o->rankTol > 0 && o->rankTol < 1, comm, PETSC_ERR_USER_INPUT, "-pod_rank_tol %g must lie in (0, 1)", (double)o->rankTol);
+  if (m < 0) { // before the snapshots (PODCheckOptions): what does not depend on them
+    PetscCheck(!o->nSet || o->n >= 1, comm, PETSC_ERR_USER_INPUT, "-pod_n %" PetscInt_FMT " must be >= 1", o->n);
+    PetscCheck(!(o->method == 1 && o->inner != 2), comm, PETSC_ERR_USER_INPUT, "-pod_method svd computes the l2 POD only (-pod_inner l2), not -pod_inner %s", kInners[o->inner]);
+    PetscFunctionReturn(0);
+  }
+  if (o->nSet) PetscCheck(o->n >= 1 && o->n <= m, comm, PETSC_ERR_USER_INPUT, "-pod_n %" PetscInt_FMT " must lie in [1, %" PetscInt_FMT "] (the number of snapshots)", o->n, m);
+  PetscCheck(o->svdNsv >= 1 && o->svdNsv <= m, comm, PETSC_ERR_USER_INPUT, "-pod_svd_nsv %" PetscInt_FMT " must lie in [1, %" PetscInt_FMT "] (the number of snapshots)", o->svdNsv, m);
   PetscCheck(!(o->method == 1 && M), comm, PETSC_ERR_USER_INPUT, "-pod_method svd computes the l2 POD only (-pod_inner l2), but an inner-product matrix M was given (-pod_inner %s)", kInners[o->inner]);
   if (o->innerSet) {
     PetscCheck(!(o->inner == 2 && M), comm, PETSC_ERR_USER_INPUT, "-pod_inner l2 but an inner-product matrix M was given to ComputePOD");
@@ -322,6 +327,15 @@ PODResult::~PODResult()
 const char *PODInnerName(PODInner inner)
 {
   return kInners[(int)inner];
+}
+
+PetscErrorCode PODCheckOptions(MPI_Comm comm)
+{
+  PODOptions o;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadOptions(comm, -1, nullptr, &o));
+  PetscFunctionReturn(0);
 }
 
 PetscErrorCode PODInnerFromOptions(MPI_Comm comm, PODInner *inner)
