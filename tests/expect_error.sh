@@ -10,7 +10,8 @@
 # Special arguments: the tokens @GARBAGE_MSH@ / @GARBAGE_GEO@ in the command are replaced by the path
 # of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
 # meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
-# by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2.
+# by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
+# @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -38,6 +39,33 @@ for a in "$@"; do
     # meshes/ring_on_block.geo meshed with second-order (curved) elements
     { cat "$(dirname "$0")/../meshes/ring_on_block.geo"; echo 'Mesh.ElementOrder = 2;'; } > "$tmpdir/order2.geo"
     args+=("$tmpdir/order2.geo")
+  elif [ "$a" = "@PIN_MSH22BIN@" ]; then
+    # meshes/pin_in_hole.geo in binary gmsh format 2.2 (the tag clash of @PIN_MSH22@, unreadable as text)
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/pin_in_hole.geo" -format msh22 -bin -v 0 -o "$tmpdir/pin_in_hole.22bin.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    args+=("$tmpdir/pin_in_hole.22bin.msh")
+  elif [ "$a" = "@DUPPHYS_MSH@" ]; then
+    # meshes/ring_on_block.geo (format 4.1) with the name "ring_top" given a second physical tag, 15, on one of its two
+    # curves (a mesh merged from several files)
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/ring_on_block.geo" -format msh41 -v 0 -o "$tmpdir/ring.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    /usr/bin/python3 - "$tmpdir/ring.msh" "$tmpdir/dupphys.msh" <<'PY' || { echo "expect_error: the mesh edit failed"; exit 2; }
+import sys
+L = open(sys.argv[1]).read().split("\n")
+i = L.index("$PhysicalNames")
+L[i + 1] = str(int(L[i + 1]) + 1)
+L.insert(L.index('1 12 "ring_top"') + 1, '1 15 "ring_top"')
+e = L.index("$Entities")
+npts, ncur = map(int, L[e + 1].split()[:2])
+for k in range(e + 2 + npts, e + 2 + npts + ncur):  # the second curve of ring_top gets tag 15
+    f = L[k].split()
+    if f[7] == "1" and f[8] == "12" and f[0] != "5":
+        f[8] = "15"
+        L[k] = " ".join(f) + " "
+        break
+else:
+    sys.exit("no second ring_top curve")
+open(sys.argv[2], "w").write("\n".join(L))
+PY
+    args+=("$tmpdir/dupphys.msh")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

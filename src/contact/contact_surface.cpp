@@ -43,6 +43,25 @@ PetscErrorCode ContactSurface::Build(const Elasticity &elas, const std::string &
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMGetLocalSection(cdm, &csec));
+  {
+    // Facets inside a body (two cells): the body's name given for its surface (-contact_master block), or a curve
+    // embedded in a body. Counted on every rank first: checked on the ranks that hold such facets alone, the others
+    // waited for them in the next collective (a hang on 2 ranks).
+    PetscInt    bad[2] = {0, -1}, all[2];
+    PetscMPIInt rank;
+    MPI_Comm    comm;
+    PetscCall(PetscObjectGetComm((PetscObject)dm, &comm));
+    PetscCallMPI(MPI_Comm_rank(comm, &rank));
+    for (PetscInt p = fStart; p < fEnd && dmlabel; ++p) {
+      PetscInt val, nsupp;
+      PetscCall(DMLabelGetValue(dmlabel, p, &val));
+      if (val < 0) continue;
+      PetscCall(DMPlexGetSupportSize(dm, p, &nsupp));
+      if (nsupp != 1) ++bad[0];
+    }
+    PetscCallMPI(MPI_Allreduce(bad, all, 1, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(all[0] == 0, comm, PETSC_ERR_USER_INPUT, "Contact surface '%s': %" PetscInt_FMT " of its facets lie inside a body (two cells each), not on its boundary: name a boundary curve of the body (surface in 3D) as the contact surface, not the body itself or a curve embedded in it", label.c_str(), all[0]);
+  }
   for (PetscInt p = fStart; p < fEnd && dmlabel; ++p) {
     PetscInt val;
     PetscCall(DMLabelGetValue(dmlabel, p, &val));
@@ -51,7 +70,6 @@ PetscErrorCode ContactSurface::Build(const Elasticity &elas, const std::string &
     PetscInt        nsupp;
     PetscCall(DMPlexGetSupportSize(dm, p, &nsupp));
     PetscCall(DMPlexGetSupport(dm, p, &support));
-    PetscCheck(nsupp == 1, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Contact surface '%s': facet %" PetscInt_FMT " is not on the boundary (%" PetscInt_FMT " cells)", label.c_str(), p, nsupp);
     SurfaceFacet f;
     f.nv = dim;
     // Vertex coordinates in closure order
