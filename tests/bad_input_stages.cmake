@@ -88,3 +88,15 @@ rbc_bad_stage_np2(physical_name_two_tags "Physical name 'ring_top' [(]option -di
 # a body's name given as a contact surface: its interior facets were refused on the rank holding them only (a hang on 2 ranks)
 rbc_bad_stage(contact_label_interior "Contact surface 'block': [0-9]+ of its facets lie inside a body" fom -options_file runs/ring_on_block.opts -contact_master block)
 rbc_bad_stage_np2(contact_label_interior "Contact surface 'block': [0-9]+ of its facets lie inside a body" fom -options_file runs/ring_on_block.opts -contact_master block -rbc_error_wait 60)
+# -mesh_geo_set / -mu_geo_set (src/fom/scene.cpp, src/mesh/mesh_loader.cpp): a non-finite value went to gmsh (a wrong mesh,
+# exit 0); a name went unquoted into a shell command (any command ran); a name the .geo does not define was ignored by
+# gmsh (the default mesh, exit 0)
+rbc_bad_stage(geo_set_inf "-mesh_geo_set: value 'inf' of 'lc_slave' is not a finite number" fom -options_file runs/ring_on_block.opts -mesh_geo_set lc_slave=inf)
+rbc_bad_stage(geo_set_name "-mesh_geo_set: 'g0[|]true' is not a gmsh variable name" fom -options_file runs/ring_on_block.opts -mesh_geo_set "g0|true=0.005")
+rbc_bad_stage(geo_set_unknown "'lc_slavee' is not a variable of '.*ring_on_block[.]geo' [(]nor of the files it includes[)]" fom -options_file runs/ring_on_block.opts -mesh_geo_set lc_slavee=0.0125)
+# a parameter named twice (one -mu value dropped without a word); a default outside the box (was blamed on -mu)
+rbc_bad_stage(mu_names_twice "-mu_names: the parameter name 'radius' appears twice" fom -options_file runs/ring_on_block.opts -mu_names radius,radius -mu_min 0.95,0.95 -mu_max 1.15,1.15 -mu_default 1,1)
+rbc_bad_stage(mu_default_outside "-mu_default: parameter 'radius' = 1.2 is outside its box" fom -options_file runs/ring_on_block.opts -mu_default 1.2)
+# the mesh cache's key holds the files a .geo includes (tests/mesh_cache_check.sh)
+add_test(NAME mesh_cache_include COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/mesh_cache_check.sh $<TARGET_FILE:rbcontact_exe> ${PROJECT_SOURCE_DIR} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(mesh_cache_include PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 LABELS bad_input)

@@ -31,6 +31,16 @@ void LameFromYoung(PetscReal E, PetscReal nu, PetscReal *L, PetscReal *G)
 // PetscOptionsObject, in scope).
 static const char kMan[] = "README.md: Options";
 
+// A gmsh variable name, as -mesh_geo_set and -mu_geo_set give it to gmsh -setnumber (it went to a shell command line
+// unquoted: a name could run any command).
+static bool GeoIdentifier(const std::string &n)
+{
+  if (n.empty() || std::isdigit((unsigned char)n[0])) return false;
+  for (char c : n)
+    if (!std::isalnum((unsigned char)c) && c != '_') return false;
+  return true;
+}
+
 static PetscErrorCode GetString(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::string *value, PetscBool *set)
 {
   char      buf[PETSC_MAX_PATH_LEN];
@@ -161,6 +171,9 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     const std::string val = kv.substr(eq + 1);
     double    x           = std::strtod(val.c_str(), &end);
     PetscCheck(end != val.c_str() && *end == 0, comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: value '%s' of '%s' is not a number", val.c_str(), kv.substr(0, eq).c_str());
+    // (nan and inf went to gmsh: 3 slave nodes, force 0.904 for 0.4996, exit 0)
+    PetscCheck(std::isfinite(x), comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: value '%s' of '%s' is not a finite number", val.c_str(), kv.substr(0, eq).c_str());
+    PetscCheck(GeoIdentifier(kv.substr(0, eq)), comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set: '%s' is not a gmsh variable name (letters, digits and _, not starting with a digit)", kv.substr(0, eq).c_str());
     scene->mesh.geoNumbers.emplace_back(kv.substr(0, eq), x);
   }
 
@@ -168,6 +181,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   s.clear();
   PetscCall(GetString(PetscOptionsObject, "-mu_names", "Parameter names, comma separated", &s, NULL));
   const std::vector<std::string> pnames = SplitList(s);
+  for (size_t i = 0; i < pnames.size(); ++i) // (a repeated name: one of the -mu values was dropped without a word)
+    for (size_t j = 0; j < i; ++j) PetscCheck(pnames[i] != pnames[j], comm, PETSC_ERR_USER_INPUT, "-mu_names: the parameter name '%s' appears twice", pnames[i].c_str());
   if (!pnames.empty()) {
     std::vector<PetscReal> lo, hi, def, val;
     PetscCall(GetRealArray(PetscOptionsObject, "-mu_min", "Parameter box: lower bounds, one per parameter", &lo, NULL));
@@ -191,8 +206,10 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
       p.def   = def.empty() ? 0.5 * (lo[i] + hi[i]) : def[i];
       p.value = flg ? val[i] : p.def;
       PetscCheck(lo[i] <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu_min %g > -mu_max %g for parameter '%s'", (double)lo[i], (double)hi[i], p.name.c_str());
+      PetscCheck(p.def >= lo[i] && p.def <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu_default: %s", OutOfBoxMessage(p, p.def).c_str()); // (was blamed on -mu)
       PetscCheck(p.value >= lo[i] && p.value <= hi[i], comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: %s", OutOfBoxMessage(p, p.value).c_str());
       if (i < geo.size() && geo[i] != "-") p.geoName = geo[i];
+      PetscCheck(p.geoName.empty() || GeoIdentifier(p.geoName), comm, PETSC_ERR_USER_INPUT, "-mu_geo_set: '%s' is not a gmsh variable name (letters, digits and _, not starting with a digit)", p.geoName.c_str());
       if (!p.geoName.empty()) scene->mesh.geoNumbers.emplace_back(p.geoName, p.value);
       scene->params.push_back(p);
     }

@@ -4,6 +4,11 @@
 #include "rbcontact/partition.hpp"
 #include "rbcontact/report.hpp"
 #include <petscsf.h>
+#include <fcntl.h>
+#include <spawn.h>
+#include <cerrno>
+#include <cstring>
+#include <cctype>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +19,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include <vector>
+
+extern char **environ;
 
 #ifndef RBC_GMSH_EXECUTABLE
   #define RBC_GMSH_EXECUTABLE "gmsh"
@@ -86,6 +93,80 @@ PetscErrorCode ResolveDataFile(MPI_Comm comm, const std::string &file, std::stri
 
 static bool EndsWith(const std::string &s, const std::string &suf) { return s.size() >= suf.size() && s.compare(s.size() - suf.size(), suf.size(), suf) == 0; }
 
+// The text of a .geo and of every file it pulls in (Include "f", Merge "f", relative to the including file's directory,
+// recursively): the mesh cache key (an edited included file reused the stale mesh), and where -mesh_geo_set's names
+// are looked for. A file that cannot be read adds its name only (gmsh then says what is wrong).
+static void GeoSources(const std::string &path, int depth, std::string *text)
+{
+  std::ifstream f(path);
+  if (!f) {
+    *text += "|unreadable";
+    return;
+  }
+  std::ostringstream all;
+  all << f.rdbuf();
+  const std::string t   = all.str();
+  const auto        cut = path.find_last_of('/');
+  const std::string dir = cut == std::string::npos ? "" : path.substr(0, cut + 1);
+  *text += (depth ? "|include\n" : "") + t; // (not the paths: a clone elsewhere shares the cache)
+  if (depth >= 16) return;
+  for (const char *kw : {"Include", "Merge"})
+    for (size_t at = t.find(kw); at != std::string::npos; at = t.find(kw, at + 1)) {
+      const size_t q0 = t.find('"', at), q1 = q0 == std::string::npos ? q0 : t.find('"', q0 + 1);
+      if (q1 == std::string::npos || t.find_first_not_of(" \t", at + std::strlen(kw)) != q0) continue;
+      const std::string inc = t.substr(q0 + 1, q1 - q0 - 1);
+      GeoSources(!inc.empty() && inc[0] == '/' ? inc : dir + inc, depth + 1, text);
+    }
+}
+
+// Whether the .geo sources assign the variable name (NAME = ... or a DefineConstant entry NAME = {...}): gmsh
+// -setnumber of an unknown name only defines an unused variable, so a misspelled -mesh_geo_set left the default mesh.
+static bool GeoAssigns(const std::string &text, const std::string &name)
+{
+  for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
+    const bool startOk = at == 0 || !(std::isalnum((unsigned char)text[at - 1]) || text[at - 1] == '_');
+    size_t     k       = at + name.size();
+    if (!startOk || (k < text.size() && (std::isalnum((unsigned char)text[k]) || text[k] == '_'))) continue;
+    while (k < text.size() && (text[k] == ' ' || text[k] == '\t')) ++k;
+    if (k < text.size() && text[k] == '=' && (k + 1 >= text.size() || text[k + 1] != '=')) return true;
+  }
+  return false;
+}
+
+// Runs argv[0] with argv (no shell: the names and paths are passed as they are), its output to log; the exit code, or
+// -1 when it could not be started or did not exit.
+static int RunLogged(const std::vector<std::string> &args, const std::string &log)
+{
+  std::vector<char *> argv;
+  for (const auto &a : args) argv.push_back(const_cast<char *>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  if (posix_spawn_file_actions_init(&fa) != 0) return -1;
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  posix_spawn_file_actions_addclose(&fa, 0);
+  pid_t pid;
+  const int rc = posix_spawnp(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// mkdir -p
+static bool MakeDirs(const std::string &dir)
+{
+  for (size_t at = dir.find('/', 1);; at = dir.find('/', at + 1)) {
+    const std::string d = dir.substr(0, at);
+    if (!d.empty() && mkdir(d.c_str(), 0755) != 0 && errno != EEXIST) return false;
+    if (at == std::string::npos) break;
+  }
+  struct stat st;
+  return stat(dir.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+}
+
 PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *mshPath)
 {
   PetscMPIInt rank;
@@ -102,12 +183,13 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   }
   PetscCall(PetscLogEventBegin(MESH_Generate, 0, 0, 0, 0));
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  // Cache key: geo text + numbers + clscale + gmsh version string.
+  // Cache key: the text of the .geo and of the files it includes + numbers + clscale + output format.
   std::ostringstream key;
-  {
-    std::ifstream f(src);
-    key << f.rdbuf();
-  }
+  std::string        sources;
+  GeoSources(src, 0, &sources);
+  key << sources;
+  for (const auto &kv : spec.geoNumbers)
+    PetscCheck(GeoAssigns(sources, kv.first), comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set / -mu_geo_set: '%s' is not a variable of '%s' (nor of the files it includes): gmsh would ignore it and mesh the default geometry", kv.first.c_str(), src.c_str());
   char scale[64];
   std::snprintf(scale, sizeof scale, "%.12g", (double)spec.clscale);
   key << "|clscale=" << scale;
@@ -115,12 +197,12 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   // (entity) tag equals a physical tag into that physical group (measured: pin_in_hole.geo's "pin_core",
   // tag 13, received the master arc Circle(13)); 4.1 keeps entities and physical groups apart
   key << "|format=msh41";
-  std::string setnum;
+  std::vector<std::string> setnum;
   for (const auto &kv : spec.geoNumbers) {
     char v[64];
     std::snprintf(v, sizeof v, "%.17g", (double)kv.second);
     key << "|" << kv.first << "=" << v;
-    setnum += " -setnumber " + kv.first + " " + v;
+    setnum.insert(setnum.end(), {"-setnumber", kv.first, v});
   }
   std::string base = src.substr(src.find_last_of('/') == std::string::npos ? 0 : src.find_last_of('/') + 1);
   base             = base.substr(0, base.size() - 4);
@@ -128,21 +210,33 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   std::snprintf(hash, sizeof hash, "%016llx", Fnv1a(key.str()));
   *mshPath = spec.cacheDir + "/" + base + "-" + hash + ".msh";
   if (rank == 0 && !FileExists(*mshPath)) {
-    std::string mk = "mkdir -p '" + spec.cacheDir + "'";
-    if (std::system(mk.c_str()) != 0) {
+    if (!MakeDirs(spec.cacheDir)) {
       ok = 0;
       std::snprintf(msg, sizeof msg, "cannot create mesh cache directory '%s' (-mesh_cache_dir or RBC_MESH_CACHE)", spec.cacheDir.c_str());
     } else {
       const std::string tmp = *mshPath + ".tmp." + std::to_string((long)getpid()) + ".msh";
       const std::string log = *mshPath + ".log";
-      const std::string cmd = std::string(RBC_GMSH_EXECUTABLE) + " -3 '" + src + "' -clscale " + scale + setnum + " -format msh41 -v 2 -o '" + tmp + "' > '" + log + "' 2>&1";
-      const int         rc  = std::system(cmd.c_str());
+      std::vector<std::string> args = {RBC_GMSH_EXECUTABLE, "-3", src, "-clscale", scale};
+      args.insert(args.end(), setnum.begin(), setnum.end());
+      args.insert(args.end(), {"-format", "msh41", "-v", "2", "-o", tmp});
+      std::string cmd; // (shown in the message)
+      for (const auto &a : args) cmd += (cmd.empty() ? "" : " ") + a;
+      // no shell (std::system before 2026-11-29: a -mesh_geo_set name ran as a command, a ' in a path broke the line)
+      const int rc = RunLogged(args, log);
+      {
+        // gmsh exits 0 after some errors (an unknown -setnumber, a file it cannot read): its log decides too
+        std::ifstream lf(log);
+        std::string   line;
+        bool          err = false;
+        while (!err && std::getline(lf, line)) err = line.rfind("Error", 0) == 0;
+        if (rc == 0 && err) std::remove(tmp.c_str());
+      }
       if (rc != 0 || !FileExists(tmp)) {
         ok = 0;
         std::remove(tmp.c_str());
-        // std::system returns a wait status: report gmsh's exit code, and its first error line
+        // gmsh's exit code (-1: it could not be started), and its first error line
         // (e.g. "Error : 'x.geo', line 2: syntax error") so the user need not open the log.
-        const int   code = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : rc;
+        const int   code = rc;
         std::string first;
         {
           std::ifstream lf(log);
