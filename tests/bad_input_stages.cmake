@@ -100,3 +100,6 @@ rbc_bad_stage(mu_default_outside "-mu_default: parameter 'radius' = 1.2 is outsi
 # the mesh cache's key holds the files a .geo includes (tests/mesh_cache_check.sh)
 add_test(NAME mesh_cache_include COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/mesh_cache_check.sh $<TARGET_FILE:rbcontact_exe> ${PROJECT_SOURCE_DIR} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(mesh_cache_include PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 LABELS bad_input)
+# slave and master the same group, or on one body (a Kacanov failure or a wrong answer with exit 0 before)
+rbc_bad_stage(contact_same_group "-contact_slave and -contact_master name the same group 'slave'" fom -options_file runs/ring_on_block.opts -contact_master slave)
+rbc_bad_stage_np2(contact_same_body "-contact_slave 'slave' and -contact_master 'ring_top' both lie on body 'ring'" fom -options_file runs/ring_on_block.opts -contact_master ring_top)

@@ -128,8 +128,26 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   }
   PetscOptionsEnd();
 
+  // (the same label on both sides: a Kacanov failure on 1 rank, "Dual QP: diagonal entry 2 of S ... is 0" on 2; both
+  // sides on one body: converged, force 21 for 0.5, exit 0)
+  PetscCheck(slave != master, comm, PETSC_ERR_USER_INPUT, "-contact_slave and -contact_master name the same group '%s': contact is between two surfaces of two bodies", slave.c_str());
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));
+  {
+    PetscInt nb = 0;
+    for (const auto *S : {&slave_, &master_})
+      for (const auto &F : S->facets) nb = std::max(nb, F.body + 1);
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nb, 1, MPIU_INT, MPI_MAX, comm));
+    std::vector<PetscInt> on(2 * (size_t)nb, 0); // body b has facets on the slave (b) or on the master (nb + b)
+    for (const auto &F : slave_.facets)
+      if (F.body >= 0) on[F.body] = 1;
+    for (const auto &F : master_.facets)
+      if (F.body >= 0) on[nb + F.body] = 1;
+    if (nb) PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, on.data(), (PetscMPIInt)on.size(), MPIU_INT, MPI_MAX, comm));
+    for (PetscInt b = 0; b < nb; ++b)
+      PetscCheck(!(on[b] && on[nb + b]), comm, PETSC_ERR_USER_INPUT, "-contact_slave '%s' and -contact_master '%s' both lie on body '%s': contact is between two bodies, the slave surface on one, the master on the other", slave.c_str(), master.c_str(),
+                 b < (PetscInt)elas.scene.bodies.size() ? elas.scene.bodies[b].name.c_str() : std::to_string((long long)b).c_str());
+  }
   PetscCall(NumberMultipliers(elas));
   for (size_t s = 0; s < slave_.facets.size(); ++s) {
     PetscInt *closure = NULL, ncl, k = 0;
