@@ -103,3 +103,10 @@ set_tests_properties(mesh_cache_include PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" 
 # slave and master the same group, or on one body (a Kacanov failure or a wrong answer with exit 0 before)
 rbc_bad_stage(contact_same_group "-contact_slave and -contact_master name the same group 'slave'" fom -options_file runs/ring_on_block.opts -contact_master slave)
 rbc_bad_stage_np2(contact_same_body "-contact_slave 'slave' and -contact_master 'ring_top' both lie on body 'ring'" fom -options_file runs/ring_on_block.opts -contact_master ring_top)
+# geometry maps against the mesh (src/fem/geometry_map.cpp): a center with fewer coordinates (padded with 0: another map,
+# exit 0), a stretch axis the mesh does not have (the parameter did nothing), a non-finite center (the option unnamed), an
+# unknown block named first
+rbc_bad_stage(map_center_short "-map_ring_dilation_center has 1 coordinate[(]s[)]; the mesh is 2D: give 2" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center 0 -mu 1.1)
+rbc_bad_stage(map_stretch_axis "-map_ring_stretch_axis 2: the mesh is 2D" fom -options_file runs/ring_on_block.opts -map_ring stretch -map_ring_stretch_param radius -map_ring_stretch_axis 2)
+rbc_bad_stage(map_center_inf "-map_ring_dilation_center: coordinate 1 is not a finite number" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center inf,0.005)
+rbc_bad_stage(map_unknown_block "-map_ring: unknown map block 'bogus'" fom -options_file runs/ring_on_block.opts -map_ring bogus)

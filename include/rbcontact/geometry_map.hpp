@@ -86,7 +86,18 @@ public:
   // Serialization: one row {body, Record()} per block (8 values), and back.
   std::vector<PetscReal> Records() const;
   PetscErrorCode         FromRecords(PetscInt nbodies, const std::vector<PetscReal> &rec);
+  // The options of SetFromOptions against the mesh's dimension: a center or direction with fewer coordinates, a
+  // stretch axis beyond it. Collective.
+  PetscErrorCode CheckDimension(MPI_Comm comm, PetscInt dim) const;
   std::vector<BodyMap> bodies;
+
+private:
+  struct DimNeed {
+    std::string option;
+    PetscInt    value;       // the number of coordinates given, or the axis
+    bool        coordinates; // value >= dim needed, else value < dim
+  };
+  std::vector<DimNeed> needs_;
 };
 
 // The parameter values of a scene as a vector (scene order).

@@ -174,6 +174,7 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
 {
   PetscFunctionBeginUser;
   bodies.clear();
+  needs_.clear();
   bodies.resize(scene.bodies.size());
   PetscOptionsBegin(comm, NULL, "Geometry maps of the reference configuration, per body (docs/reference_configuration.md)", "GeometryMap");
   for (size_t b = 0; b < scene.bodies.size(); ++b) {
@@ -185,6 +186,7 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
     for (const auto &kind : SplitList(buf)) {
       const std::string bp = pre + "_" + kind;
       char              pname[128] = "";
+      PetscCheck(kind == "dilation" || kind == "stretch" || kind == "translation", comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "%s: unknown map block '%s' (dilation, stretch, translation)", pre.c_str(), kind.c_str());
       PetscCall(PetscOptionsString((bp + "_param").c_str(), "Parameter (of -mu_names) driving this block", "docs/reference_configuration.md", pname, pname, sizeof pname, &flg));
       PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s lists '%s' but %s_param (the driving parameter) is missing", pre.c_str(), kind.c_str(), bp.c_str());
       PetscInt p = -1;
@@ -193,7 +195,7 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
       PetscCheck(scene.params[p].geoName.empty(), comm, PETSC_ERR_USER_INPUT, "Parameter '%s' both remeshes (-mu_geo_set) and drives %s: choose one", pname, pre.c_str());
       PetscReal ref = scene.params[p].def;
       PetscCall(PetscOptionsReal((bp + "_ref").c_str(), "Parameter value of the mesh (default: -mu_default)", "docs/reference_configuration.md", ref, &ref, NULL));
-      PetscCheck(ref != 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_ref must be nonzero", bp.c_str());
+      PetscCheck(ref != 0 && std::isfinite(ref), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_ref must be a finite nonzero number", bp.c_str());
       if (kind == "dilation" || kind == "translation") {
         PetscReal v[4] = {0, 0, 0, 0}; // (room for a fourth value: PETSc drops the values beyond the buffer silently)
         PetscInt  n    = 4;
@@ -201,6 +203,8 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
         PetscCall(PetscOptionsRealArray(opt.c_str(), kind == "dilation" ? "Fixed point of the dilation" : "Direction of the translation", "docs/reference_configuration.md", v, &n, &flg));
         PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "%s is required", opt.c_str());
         PetscCheck(n <= 3, comm, PETSC_ERR_ARG_SIZ, "%s takes at most 3 coordinates, more were given", opt.c_str());
+        for (PetscInt i = 0; i < n; ++i) PetscCheck(std::isfinite(v[i]), comm, PETSC_ERR_USER_INPUT, "%s: coordinate %" PetscInt_FMT " is not a finite number", opt.c_str(), i + 1);
+        needs_.push_back({opt, n, true}); // (fewer coordinates than the mesh's dimension were padded with 0: another map, exit 0)
         const std::array<PetscReal, 3> a = {v[0], v[1], v[2]};
         if (kind == "dilation") bodies[b].blocks.push_back(std::make_unique<Dilation>(p, ref, a));
         else bodies[b].blocks.push_back(std::make_unique<Translation>(p, ref, a));
@@ -210,11 +214,23 @@ PetscErrorCode GeometryMap::SetFromOptions(MPI_Comm comm, const SceneSpec &scene
         PetscCall(PetscOptionsInt((bp + "_axis").c_str(), "Stretched axis (0, 1, 2)", "docs/reference_configuration.md", axis, &axis, NULL));
         PetscCall(PetscOptionsReal((bp + "_center").c_str(), "Fixed coordinate of the stretch", "docs/reference_configuration.md", c, &c, NULL));
         PetscCheck(axis >= 0 && axis < 3, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s_axis %" PetscInt_FMT " must be 0, 1 or 2", bp.c_str(), axis);
+        PetscCheck(std::isfinite(c), comm, PETSC_ERR_USER_INPUT, "%s_center is not a finite number", bp.c_str());
+        needs_.push_back({bp + "_axis", axis, false}); // (axis 2 of a 2D mesh: the parameter did nothing, exit 0)
         bodies[b].blocks.push_back(std::make_unique<Stretch>(p, ref, axis, c));
-      } else SETERRQ(comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "%s: unknown map block '%s' (dilation, stretch, translation)", pre.c_str(), kind.c_str());
+      }
     }
   }
   PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode GeometryMap::CheckDimension(MPI_Comm comm, PetscInt dim) const
+{
+  PetscFunctionBeginUser;
+  for (const auto &n : needs_) {
+    if (n.coordinates) PetscCheck(n.value >= dim, comm, PETSC_ERR_USER_INPUT, "%s has %" PetscInt_FMT " coordinate(s); the mesh is %" PetscInt_FMT "D: give %" PetscInt_FMT, n.option.c_str(), n.value, dim, dim);
+    else PetscCheck(n.value < dim, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": the mesh is %" PetscInt_FMT "D (axes 0 to %" PetscInt_FMT ")", n.option.c_str(), n.value, dim, dim - 1);
+  }
   PetscFunctionReturn(0);
 }
 

@@ -59,6 +59,11 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   mu    = ParamValues(scene);
   PetscCall(PetscObjectReference((PetscObject)dm));
   PetscCall(map.SetFromOptions(PetscObjectComm((PetscObject)dm), scene));
+  {
+    PetscInt dim;
+    PetscCall(DMGetDimension(dm, &dim));
+    PetscCall(map.CheckDimension(PetscObjectComm((PetscObject)dm), dim));
+  }
   elas.SetGeometryMap(&map);
   PetscCall(elas.Setup(dm, scene));
   PetscCall(CheckBodiesHeld());
