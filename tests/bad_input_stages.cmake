@@ -110,3 +110,8 @@ rbc_bad_stage(map_center_short "-map_ring_dilation_center has 1 coordinate[(]s[)
 rbc_bad_stage(map_stretch_axis "-map_ring_stretch_axis 2: the mesh is 2D" fom -options_file runs/ring_on_block.opts -map_ring stretch -map_ring_stretch_param radius -map_ring_stretch_axis 2)
 rbc_bad_stage(map_center_inf "-map_ring_dilation_center: coordinate 1 is not a finite number" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center inf,0.005)
 rbc_bad_stage(map_unknown_block "-map_ring: unknown map block 'bogus'" fom -options_file runs/ring_on_block.opts -map_ring bogus)
+# a user's mesh whose element points at an undefined node (PETSc's reader: a segmentation fault or "inverted cells"), or
+# with a non-finite coordinate (was "inverted cells ... reverse its Curve Loop")
+rbc_bad_stage(mesh_undefined_node "element [0-9]+ uses node 99999, which the file does not define" fom -options_file runs/ring_on_block.opts -mesh_file @MISSING_NODE_MSH@)
+rbc_bad_stage_np2(mesh_undefined_node "element [0-9]+ uses node 99999, which the file does not define" fom -options_file runs/ring_on_block.opts -mesh_file @MISSING_NODE_MSH@)
+rbc_bad_stage(mesh_inf_coordinate "has non-finite node coordinates" fom -options_file runs/ring_on_block.opts -mesh_file @INF_NODE_MSH@)

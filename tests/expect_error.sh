@@ -11,7 +11,8 @@
 # of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
 # meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
 # by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
-# @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags.
+# @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
+# @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -66,6 +67,27 @@ else:
 open(sys.argv[2], "w").write("\n".join(L))
 PY
     args+=("$tmpdir/dupphys.msh")
+  elif [ "$a" = "@MISSING_NODE_MSH@" ] || [ "$a" = "@INF_NODE_MSH@" ]; then
+    # ring_on_block's mesh (format 4.1) with the first triangle pointing at node 99999, which does not exist (PETSc's
+    # reader indexed with it: a segmentation fault), or with the first node's x coordinate inf
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/ring_on_block.geo" -format msh41 -v 0 -o "$tmpdir/ring.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    /usr/bin/python3 - "$tmpdir/ring.msh" "$tmpdir/edited.msh" "$a" <<'PY' || { echo "expect_error: the mesh edit failed"; exit 2; }
+import sys
+L = open(sys.argv[1]).read().split("\n")
+if sys.argv[3] == "@MISSING_NODE_MSH@":
+    i = L.index("$Elements") + 2
+    while L[i].split()[0] != "2":  # the first block of triangles
+        i += 1 + int(L[i].split()[3])
+    f = L[i + 1].split()
+    L[i + 1] = " ".join([f[0], "99999"] + f[2:])
+else:
+    i = L.index("$Nodes") + 2
+    n = int(L[i].split()[3])
+    f = L[i + 1 + n].split()
+    L[i + 1 + n] = " ".join(["inf"] + f[1:])
+open(sys.argv[2], "w").write("\n".join(L))
+PY
+    args+=("$tmpdir/edited.msh")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <cctype>
+#include <cmath>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -410,6 +411,86 @@ static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, con
   PetscFunctionReturn(0);
 }
 
+// Before the reader, for a user's ASCII .msh (4.1 or 2.2): an element pointing at a node tag the file does not define.
+// PETSc 3.18's reader indexes with it unchecked (a segmentation fault, or a mesh it then called inverted). "" when every
+// reference is defined, or when the file says nothing that can be read here (binary: left to the reader).
+static std::string UndefinedNodeRefs(const std::string &msh)
+{
+  std::ifstream      f(msh);
+  std::string        line;
+  double             version = 0;
+  std::vector<char>  defined; // by node tag
+  auto define = [&](long long t) {
+    if (t < 0 || t > 100000000) return false;
+    if ((size_t)t >= defined.size()) defined.resize((size_t)t + 1, 0);
+    defined[(size_t)t] = 1;
+    return true;
+  };
+  auto known = [&](long long t) { return t >= 0 && (size_t)t < defined.size() && defined[(size_t)t]; };
+  auto bad   = [&](long long e, long long t) { return "element " + std::to_string(e) + " uses node " + std::to_string(t) + ", which the file does not define (a corrupt or hand-edited mesh)"; };
+  while (std::getline(f, line)) {
+    if (line.rfind("$MeshFormat", 0) == 0) {
+      int binary = 0;
+      if (!(f >> version >> binary) || binary != 0) return "";
+    } else if (line.rfind("$Nodes", 0) == 0) {
+      if (version >= 4) {
+        long long nb, nn, lo, hi;
+        if (!(f >> nb >> nn >> lo >> hi)) return "";
+        for (long long b = 0; b < nb; ++b) {
+          long long d, e, par, n;
+          if (!(f >> d >> e >> par >> n)) return "";
+          for (long long k = 0; k < n; ++k) {
+            long long t;
+            if (!(f >> t) || !define(t)) return "";
+          }
+          std::getline(f, line);
+          for (long long k = 0; k < n; ++k) std::getline(f, line); // coordinates
+        }
+      } else {
+        long long n;
+        if (!(f >> n)) return "";
+        std::getline(f, line);
+        for (long long k = 0; k < n && std::getline(f, line); ++k) {
+          std::istringstream in(line);
+          long long          t;
+          if (!(in >> t) || !define(t)) return "";
+        }
+      }
+    } else if (line.rfind("$Elements", 0) == 0) {
+      if (version >= 4) {
+        long long nb, ne, lo, hi;
+        if (!(f >> nb >> ne >> lo >> hi)) return "";
+        for (long long b = 0; b < nb; ++b) {
+          long long d, e, type, n;
+          if (!(f >> d >> e >> type >> n)) return "";
+          std::getline(f, line);
+          for (long long k = 0; k < n && std::getline(f, line); ++k) {
+            std::istringstream in(line);
+            long long          id, t;
+            in >> id;
+            while (in >> t)
+              if (!known(t)) return bad(id, t);
+          }
+        }
+      } else {
+        long long n;
+        if (!(f >> n)) return "";
+        std::getline(f, line);
+        for (long long k = 0; k < n && std::getline(f, line); ++k) {
+          std::istringstream in(line);
+          long long          id, type, ntags, t;
+          if (!(in >> id >> type >> ntags)) return "";
+          for (long long j = 0; j < ntags; ++j) in >> t;
+          while (in >> t)
+            if (!known(t)) return bad(id, t);
+        }
+      }
+      return "";
+    }
+  }
+  return "";
+}
+
 // Before the reader: the bodies of -bodies with no physical group of the mesh's dimension in the $PhysicalNames of
 // an ASCII .msh ("" when every body has one, or when the file says nothing that can be read).
 static std::string BodiesWithoutGroup(const std::string &msh, const SceneSpec &scene)
@@ -463,6 +544,7 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     PetscMPIInt r0;
     PetscCallMPI(MPI_Comm_rank(comm, &r0));
     if (r0 == 0) missing = BodiesWithoutGroup(msh, scene);
+    if (r0 == 0 && missing.empty() && !EndsWith(scene.mesh.file, ".geo")) missing = UndefinedNodeRefs(msh); // (a user's file)
     PetscCall(BcastString(comm, &missing));
     PetscCheck(missing.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "Mesh '%s' (from -mesh_file %s): %s", msh.c_str(), scene.mesh.file.c_str(), missing.c_str());
   }
@@ -520,15 +602,44 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     PetscCheck(cdegree <= 1, comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has curved elements of order %" PetscInt_FMT " (gmsh Mesh.ElementOrder or -order): rbcontact reads straight triangles and tetrahedra; mesh with order 1 and use -fem_degree 2 for quadratic displacements", msh.c_str(), scene.mesh.file.c_str(), cdegree);
   }
   {
-    // Inverted cells (a gmsh surface meshed clockwise) give an indefinite stiffness: refuse them.
-    PetscErrorCode ierr;
-    PetscInt       bad;
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    ierr = DMPlexCheckGeometry(*dm);
-    PetscCall(PetscPopErrorHandler());
-    bad = ierr ? 1 : 0;
-    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
-    PetscCheck(!bad, comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has inverted (negatively oriented) cells: orient every gmsh surface counter-clockwise (reverse its Curve Loop) and regenerate", msh.c_str(), scene.mesh.file.c_str());
+    // Each cell's Jacobian: inverted cells (a gmsh surface meshed clockwise) give an indefinite stiffness; degenerate
+    // ones (coincident nodes, an element pointing at a wrong node) a singular one; non-finite coordinates anything. All
+    // three were called "inverted" (DMPlexCheckGeometry's failure), with the advice to reverse a Curve Loop.
+    PetscInt dim, cStart, cEnd, count[3] = {0, 0, 0}; // non-finite, degenerate, inverted
+    PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {-PETSC_MAX_REAL, -PETSC_MAX_REAL, -PETSC_MAX_REAL};
+    Vec       coords;
+    PetscCall(DMGetDimension(*dm, &dim));
+    PetscCall(DMGetCoordinatesLocal(*dm, &coords));
+    {
+      const PetscScalar *x;
+      PetscInt           n;
+      PetscCall(VecGetLocalSize(coords, &n));
+      PetscCall(VecGetArrayRead(coords, &x));
+      for (PetscInt i = 0; i < n; ++i) {
+        if (!std::isfinite(PetscRealPart(x[i]))) ++count[0];
+        else {
+          lo[i % dim] = std::min(lo[i % dim], PetscRealPart(x[i]));
+          hi[i % dim] = std::max(hi[i % dim], PetscRealPart(x[i]));
+        }
+      }
+      PetscCall(VecRestoreArrayRead(coords, &x));
+    }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPIU_REAL, MPIU_MIN, comm));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPIU_REAL, MPIU_MAX, comm));
+    PetscReal ext = 0; // the mesh's extent: a cell whose |J| is below 1e-12 ext^dim has (nearly) no volume
+    for (PetscInt d = 0; d < dim; ++d) ext = std::max(ext, hi[d] - lo[d]);
+    PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
+    for (PetscInt c = cStart; c < cEnd && !count[0]; ++c) {
+      PetscReal v0[3], J[9], invJ[9], detJ;
+      PetscCall(DMPlexComputeCellGeometryAffineFEM(*dm, c, v0, J, invJ, &detJ));
+      if (!std::isfinite(detJ)) ++count[0];
+      else if (std::fabs(detJ) <= 1e-12 * std::pow(ext, (PetscReal)dim)) ++count[1];
+      else if (detJ < 0) ++count[2];
+    }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count, 3, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(!count[0], comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has non-finite node coordinates (%" PetscInt_FMT " values or cells): a corrupt file", msh.c_str(), scene.mesh.file.c_str(), count[0]);
+    PetscCheck(!count[1], comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has %" PetscInt_FMT " degenerate cells (no area or volume): coincident nodes, or elements that point at wrong nodes", msh.c_str(), scene.mesh.file.c_str(), count[1]);
+    PetscCheck(!count[2], comm, PETSC_ERR_USER_INPUT, "Mesh '%s' (from -mesh_file %s) has %" PetscInt_FMT " inverted (negatively oriented) cells: orient every gmsh surface counter-clockwise (reverse its Curve Loop) and regenerate", msh.c_str(), scene.mesh.file.c_str(), count[2]);
   }
   // Every physical name the scene uses must exist.
   for (const auto &b : scene.bodies)
