@@ -115,3 +115,4 @@ rbc_bad_stage(map_unknown_block "-map_ring: unknown map block 'bogus'" fom -opti
 rbc_bad_stage(mesh_undefined_node "element [0-9]+ uses node 99999, which the file does not define" fom -options_file runs/ring_on_block.opts -mesh_file @MISSING_NODE_MSH@)
 rbc_bad_stage_np2(mesh_undefined_node "element [0-9]+ uses node 99999, which the file does not define" fom -options_file runs/ring_on_block.opts -mesh_file @MISSING_NODE_MSH@)
 rbc_bad_stage(mesh_inf_coordinate "has non-finite node coordinates" fom -options_file runs/ring_on_block.opts -mesh_file @INF_NODE_MSH@)
+rbc_bad_stage(bodies_twice "-bodies: the body 'ring' appears twice" fom -options_file runs/ring_on_block.opts -bodies ring,block,ring -body_E 100,100,50)

@@ -223,6 +223,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscCall(GetString(PetscOptionsObject, "-bodies", "Body names = physical surface (volume) groups of the mesh, comma separated", &s, NULL));
   std::vector<std::string> names = SplitList(s);
   if (names.empty()) names.push_back("all");
+  for (size_t i = 0; i < names.size(); ++i) // (a repeated body: its cells went to the last entry, and the first was said to float)
+    for (size_t j = 0; j < i; ++j) PetscCheck(names[i] != names[j], comm, PETSC_ERR_USER_INPUT, "-bodies: the body '%s' appears twice", names[i].c_str());
   std::vector<PetscReal> E, nu;
   PetscCall(GetRealArray(PetscOptionsObject, "-body_E", "Young's modulus: one value, or one per body", &E, NULL));
   PetscCall(GetRealArray(PetscOptionsObject, "-body_nu", "Poisson ratio: one value, or one per body", &nu, NULL));
