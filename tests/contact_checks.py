@@ -383,6 +383,31 @@ def warnings(args):
           "initial overlap 0.01: one warning, initial_overlap.max_penetration %.3g (0.01), %d nodes" % (r["initial_overlap"]["max_penetration"], r["initial_overlap"]["nodes"]))
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-mu", "1.0", "-mesh_geo_set", "g0=0", "-map_ring_dilation_center", "0,0"] + args.extra, "zero_gap")
     check(r["initial_overlap"]["nodes"] == 0 and not any("overlap" in s for s in r["warnings"]), "zero initial gap (touching at one node): no overlap warning")
+    # two bodies sharing one mesh vertex (the top block's corner is a point of the bottom block): glued there without a
+    # word until 2026-11-29 (pulled apart: energy 2.6e-3 instead of 0); the same blocks with their own points: no warning
+    d = workdir("rbc_contact_")
+    geo = ["lc = 0.05;",
+           "Point(1) = {-1,-1,0,lc}; Point(2) = {1,-1,0,lc}; Point(3) = {1,0,0,lc}; Point(4) = {0.5,0,0,lc}; Point(7) = {-0.4,0,0,lc}; Point(5) = {-0.5,0,0,lc}; Point(6) = {-1,0,0,lc};",
+           "Line(1) = {1,2}; Line(2) = {2,3}; Line(3) = {3,4}; Line(4) = {4,7}; Line(7) = {7,5}; Line(5) = {5,6}; Line(6) = {6,1};",
+           "Curve Loop(1) = {1,2,3,4,7,5,6}; Plane Surface(1) = {1};",
+           "Point(15) = {-0.4,0,0,lc}; Point(12) = {0.5,0,0,lc}; Point(13) = {0.5,0.5,0,lc}; Point(14) = {-0.5,0.5,0,lc}; CORNER",
+           "Line(10) = {C,15}; Line(11) = {15,12}; Line(12) = {12,13}; Line(13) = {13,14}; Line(14) = {14,C};",
+           "Curve Loop(2) = {10,11,12,13,14}; Plane Surface(2) = {2};",
+           'Physical Surface("bottom", 1) = {1}; Physical Surface("top", 2) = {2}; Physical Curve("slave", 21) = {11};',
+           'Physical Curve("master", 22) = {4}; Physical Curve("top_top", 23) = {13}; Physical Curve("bottom_bottom", 24) = {1};']
+    with open(os.path.join(d, "twoblocks.opts"), "w") as f:
+        f.write("-scene twoblocks\n-bodies top,bottom\n-body_E 100,100\n-body_nu 0.3,0.3\n-dirichlet top_top,bottom_bottom\n"
+                "-dirichlet_top_top_u 0,0.02\n-dirichlet_bottom_bottom_u 0,0\n-contact_slave slave\n-contact_master master\n")
+    for tag, corner, c in (("shared", "", "5"), ("apart", "Point(16) = {-0.5,0,0,lc};", "16")):
+        with open(os.path.join(d, tag + ".geo"), "w") as f:
+            f.write("\n".join(geo).replace("CORNER", corner).replace("{C,", "{%s," % c).replace(",C}", ",%s}" % c) + "\n")
+        r, _ = run(args, args.np, os.path.join(d, "twoblocks.opts"), ["-mesh_file", os.path.join(d, tag + ".geo")] + args.extra, tag)
+        w = [s for s in r["warnings"] if "mesh vertices belong to cells of two bodies" in s]
+        if tag == "shared":
+            check(len(w) == 1 and "1 mesh vertices" in w[0] and ("'top' and 'bottom'" in w[0] or "'bottom' and 'top'" in w[0]),
+                  "two blocks sharing one vertex: one warning naming them (%s)" % w)
+        else:
+            check(not w and abs(r["energy"]) < 1e-12, "the same blocks apart, lifted: no warning, energy %.1e (a rigid lift)" % r["energy"])
 
 
 def paths(args):

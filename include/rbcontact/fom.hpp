@@ -72,6 +72,8 @@ public:
   // A clear error for a body with no Dirichlet value in some component (it floats: its translation in
   // that direction is a null mode of A; frictionless contact cannot hold it). Collective.
   PetscErrorCode CheckBodiesHeld() const;
+  // Bodies that share mesh vertices are glued there (contact acts between the contact surfaces only): a warning.
+  PetscErrorCode CheckBodiesApart();
   // A warning: printed once (rank 0 of the mesh's communicator) and kept for the report (key warnings).
   PetscErrorCode Warn(const std::string &msg);
   std::vector<std::string> warnings;

@@ -2,6 +2,8 @@
 #include "rbcontact/fom.hpp"
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/partition.hpp"
+#include <petscsf.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -67,6 +69,7 @@ PetscErrorCode ElasticFOM::CreateOnDM(DM dmIn, const SceneSpec &sc)
   elas.SetGeometryMap(&map);
   PetscCall(elas.Setup(dm, scene));
   PetscCall(CheckBodiesHeld());
+  PetscCall(CheckBodiesApart());
   for (const auto &b : scene.bodies) // P1 locks as nu -> 1/2 (measured: nu 0.499999, contact force +52 % against P2)
     if (elas.degree == 1 && b.nu > 0.49) {
       std::ostringstream o;
@@ -345,6 +348,63 @@ PetscErrorCode ElasticFOM::Warn(const std::string &msg)
   PetscFunctionBeginUser;
   warnings.push_back(msg);
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm), "rbcontact: warning: %s\n", msg.c_str()));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ElasticFOM::CheckBodiesApart()
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  PetscInt        pStart, pEnd, cStart, cEnd, vStart, vEnd;
+  PetscSF         sf;
+  const PetscInt *cb = elas.CellBody().data();
+
+  PetscFunctionBeginUser;
+  if (scene.bodies.size() < 2) PetscFunctionReturn(0);
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  // per vertex: the smallest body of its cells and minus the largest (both reduced with MIN to the owner)
+  std::vector<PetscInt> lo(pEnd - pStart, PETSC_MAX_INT), nhi(pEnd - pStart, PETSC_MAX_INT);
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    const PetscInt b = cb[c - cStart];
+    if (b < 0) continue;
+    PetscInt *cl = NULL, ncl;
+    PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    for (PetscInt k = 0; k < ncl; ++k) {
+      const PetscInt p = cl[2 * k];
+      if (p < vStart || p >= vEnd) continue;
+      lo[p - pStart]  = std::min(lo[p - pStart], b);
+      nhi[p - pStart] = std::min(nhi[p - pStart], -b);
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+  }
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFReduceBegin(sf, MPIU_INT, lo.data(), lo.data(), MPI_MIN));
+  PetscCall(PetscSFReduceEnd(sf, MPIU_INT, lo.data(), lo.data(), MPI_MIN));
+  PetscCall(PetscSFReduceBegin(sf, MPIU_INT, nhi.data(), nhi.data(), MPI_MIN));
+  PetscCall(PetscSFReduceEnd(sf, MPIU_INT, nhi.data(), nhi.data(), MPI_MIN));
+  const PetscInt  nb        = (PetscInt)scene.bodies.size();
+  PetscInt        shared[2] = {0, PETSC_MAX_INT}; // count, and the first pair of bodies (lo * nb + hi)
+  PetscInt        nleaves;
+  const PetscInt *leaves;
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
+  std::vector<char> isLeaf(pEnd - pStart, 0);
+  for (PetscInt l = 0; l < std::max<PetscInt>(nleaves, 0); ++l) isLeaf[(leaves ? leaves[l] : l) - pStart] = 1;
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt i = v - pStart;
+    if (isLeaf[i] || lo[i] == PETSC_MAX_INT || lo[i] == -nhi[i]) continue;
+    ++shared[0];
+    shared[1] = std::min(shared[1], lo[i] * nb - nhi[i]);
+  }
+  PetscInt all[2];
+  PetscCallMPI(MPI_Allreduce(shared, all, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCallMPI(MPI_Allreduce(shared + 1, all + 1, 1, MPIU_INT, MPI_MIN, comm));
+  if (all[0] > 0) {
+    std::ostringstream o;
+    o << all[0] << " mesh vertices belong to cells of two bodies (e.g. '" << scene.bodies[all[1] / nb].name << "' and '" << scene.bodies[all[1] % nb].name
+      << "'): the bodies are glued there, and contact acts between the contact surfaces only. Give each body its own points in the .geo if they are to be apart";
+    PetscCall(Warn(o.str()));
+  }
   PetscFunctionReturn(0);
 }
 
