@@ -116,3 +116,7 @@ rbc_bad_stage(mesh_undefined_node "element [0-9]+ uses node 99999, which the fil
 rbc_bad_stage_np2(mesh_undefined_node "element [0-9]+ uses node 99999, which the file does not define" fom -options_file runs/ring_on_block.opts -mesh_file @MISSING_NODE_MSH@)
 rbc_bad_stage(mesh_inf_coordinate "has non-finite node coordinates" fom -options_file runs/ring_on_block.opts -mesh_file @INF_NODE_MSH@)
 rbc_bad_stage(bodies_twice "-bodies: the body 'ring' appears twice" fom -options_file runs/ring_on_block.opts -bodies ring,block,ring -body_E 100,100,50)
+# a generated mesh PETSc's reader refuses on rank 0 (a physical curve in no surface): "not a valid gmsh file?" on 1 rank,
+# a hang on 2 (the other rank waited in the reader); now named, and on 2 ranks ended by the failed rank's abort
+rbc_bad_stage(generated_mesh_refused "PETSc's reader refused the mesh gmsh made of .*freecurve[.]geo" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@)
+rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this failure within 3 s" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@ -rbc_error_wait 3)

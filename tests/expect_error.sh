@@ -12,7 +12,8 @@
 # meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
 # by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
 # @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
-# @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf.
+# @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf;
+# @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -88,6 +89,11 @@ else:
 open(sys.argv[2], "w").write("\n".join(L))
 PY
     args+=("$tmpdir/edited.msh")
+  elif [ "$a" = "@FREECURVE_GEO@" ]; then
+    # meshes/ring_on_block.geo with a physical curve that lies in no surface (PETSc's reader refuses the mesh on rank 0)
+    { cat "$(dirname "$0")/../meshes/ring_on_block.geo"
+      echo 'Point(301) = {-0.6,-0.001,0,0.0167}; Point(302) = {0.6,-0.001,0,0.0167}; Line(301) = {301,302}; Physical Curve("freeline",16) = {301};'; } > "$tmpdir/freecurve.geo"
+    args+=("$tmpdir/freecurve.geo")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

@@ -575,6 +575,8 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     if (ierr) {
       const char *what = NULL;
       PetscCall(PetscErrorMessage(ierr, &what, NULL));
+      if (generated) // (gmsh wrote it: "not a valid gmsh file?" pointed at the wrong cause)
+        SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "PETSc's reader refused the mesh gmsh made of %s ('%s'; PETSc error %d: %s): a physical group of curves (surfaces in 3D) that bound no body, a .geo that meshes nothing, or a Mesh.MshFileVersion other than 4.1 set in the .geo?", scene.mesh.file.c_str(), msh.c_str(), (int)ierr, what ? what : "?");
       SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "Cannot read mesh '%s' (from -mesh_file %s): not a valid gmsh file? (PETSc error %d: %s)", msh.c_str(), scene.mesh.file.c_str(), (int)ierr, what ? what : "?");
     }
   }
