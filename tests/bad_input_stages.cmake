@@ -120,3 +120,6 @@ rbc_bad_stage(bodies_twice "-bodies: the body 'ring' appears twice" fom -options
 # a hang on 2 (the other rank waited in the reader); now named, and on 2 ranks ended by the failed rank's abort
 rbc_bad_stage(generated_mesh_refused "PETSc's reader refused the mesh gmsh made of .*freecurve[.]geo" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@)
 rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this failure within 3 s" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@ -rbc_error_wait 3)
+# offline values that ran without a word: a negative number of groups (ran as 0), a greedy budget below its initial set
+rbc_bad_stage(snapshots_subcomm_negative "-snapshots_subcomm -2 must be >= 0" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm -2)
+rbc_bad_stage(greedy_max_solves_initial "-greedy_max_solves 1 is below the 2 points of the initial set" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 1 -rom /tmp/rbc_never.h5)

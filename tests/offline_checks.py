@@ -275,6 +275,13 @@ def early_options(args):
         p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         check(p.returncode != 0 and words in p.stdout and "  snapshot " not in p.stdout and not os.path.exists(d + "/r.snapshots.h5"),
               "%s: refused before any snapshot, naming it (%s)" % (" ".join(extra), words))
+    # a file solved without sensitivities, resumed with them: refused before the remaining snapshots (was after them)
+    run(args, 1, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/s3.h5"])
+    with h5py.File(d + "/s3.h5", "r+") as f:  # one snapshot left to solve
+        f["snapshots/done"][2] = 0
+    p = run(args, 1, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/s3.h5", "-snapshots_restart", "-snapshots_sensitivities", "-snapshots_monitor"], expect_ok=False)
+    check(p.returncode != 0 and "the 2 finished snapshots of" in p.stdout and "solved without sensitivities" in p.stdout and "  snapshot " not in p.stdout,
+          "-snapshots_sensitivities on a file solved without them: refused before any snapshot")
 
 
 def bases(args):

@@ -66,6 +66,8 @@ public:
   // they are solved, so that a run killed inside a round resumes by finishing the same picks before it builds the
   // next model (the model of a partial round would pick other parameters). Collective; rank 0 writes.
   PetscErrorCode SetPending(const std::vector<PetscInt> &picks);
+  // Whether the open file has the extra array name (/snapshots/extra/<name>), on every rank. Collective.
+  PetscErrorCode HasExtra(const std::string &name, bool *has) const;
   // The picks stored by the last SetPending (read by Open on a restart; empty when none), on every rank.
   const std::vector<PetscInt> &Pending() const { return pending_; }
   // Copies into this open file the done snapshots of another snapshot file of the same problem (every header

@@ -567,6 +567,23 @@ PetscErrorCode SnapshotFile::Write(const Snapshot &s)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode SnapshotFile::HasExtra(const std::string &name, bool *has) const
+{
+  PetscMPIInt rank;
+  int         h = 0;
+
+  PetscFunctionBeginUser;
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::HasExtra: no snapshot file is open");
+  PetscCallMPI(MPI_Comm_rank(comm_, &rank));
+  if (rank == 0) {
+    H5Quiet q;
+    h = H5Lexists((hid_t)file_, "/snapshots/extra", H5P_DEFAULT) > 0 && H5Lexists((hid_t)file_, ("/snapshots/extra/" + name).c_str(), H5P_DEFAULT) > 0;
+  }
+  PetscCallMPI(MPI_Bcast(&h, 1, MPI_INT, 0, comm_));
+  *has = h != 0;
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode SnapshotFile::SetPending(const std::vector<PetscInt> &picks)
 {
   PetscMPIInt rank;

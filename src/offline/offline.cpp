@@ -184,6 +184,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(GreedyOptionsFromOptions(world, &gopt));
     gopt.sensitivities = s.sensitivities;
     PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
+    // (a budget below the initial set solved the initial set anyway, without a word)
+    PetscCheck(gopt.maxSolves >= ninitial, world, PETSC_ERR_ARG_OUTOFRANGE, "-greedy_max_solves %" PetscInt_FMT " is below the %" PetscInt_FMT " points of the initial set (-greedy_initial_type, -greedy_initial_size), which are always solved", gopt.maxSolves, ninitial);
   } else PetscCall(ParameterSetFromOptions(world, scene.params, "train_", &train));
   const PetscInt ntrain = (PetscInt)train.points.size(), np = (PetscInt)scene.params.size();
   if (bases) { // the bases' options, checked before the snapshots (hours on a real scene); read again by OfflineBases
@@ -225,6 +227,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   unsigned long long checksum = 0;
   PetscInt           nnodes   = 0;
   PetscCall(MeshFacts(world, scene, &checksum, &nnodes));
+  PetscCheck(s.subcomms >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-snapshots_subcomm %" PetscInt_FMT " must be >= 0 (0: automatic)", s.subcomms); // (-2 ran as 0)
   PetscInt k = s.subcomms > 0 ? s.subcomms : (nnodes * 3 < 200000) ? wsize : 1;
   PetscCheck(k >= 1 && k <= wsize, world, PETSC_ERR_ARG_OUTOFRANGE, "-snapshots_subcomm %" PetscInt_FMT " must lie in [1, %d] (the number of ranks)", k, (int)wsize);
   PetscSubcomm psub;
@@ -302,6 +305,12 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     for (PetscInt i = 0; i < ntrain; ++i)
       if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
     if (!restart) PetscCheck((PetscInt)done.size() == imported, world, PETSC_ERR_PLIB, "new snapshot file with done entries");
+    if (s.sensitivities && (PetscInt)done.size() > imported) {
+      // (a file solved without them was refused only by the bases step, after every remaining snapshot was solved)
+      bool has;
+      PetscCall(file.HasExtra("sensitivity_u", &has));
+      PetscCheck(has, world, PETSC_ERR_FILE_UNEXPECTED, "-snapshots_sensitivities: the %zu finished snapshots of %s were solved without sensitivities: drop the option, or solve them again in a new file (-snapshots_restart 0)", done.size() - (size_t)imported, snapPath);
+    }
 
     // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], and with
     // -snapshots_sensitivities the scaled derivatives (mu_i range) du/dmu_i [np*ndofs], dlambda/dmu_i [np*R]
@@ -545,7 +554,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscCall(PetscTime(&t1));
       rep.root["time_s"]["total"] = (double)(t1 - t0);
     }
-    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed), %" PetscInt_FMT " group%s of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size(), k, k == 1 ? "" : "s", (double)(t1 - t0), bases ? romPath : snapPath));
+    const std::string imp = imported ? ", " + std::to_string((long long)imported) + " imported" : std::string(); // (were counted as resumed)
+    PetscCall(PetscPrintf(world, "rbcontact offline: %s, %" PetscInt_FMT " training parameters (%zu solved now, %zu resumed%s), %" PetscInt_FMT " group%s of ranks, %.2f s -> %s\n", scene.name.c_str(), ntrain, allIts.size(), done.size() - (size_t)imported, imp.c_str(), k, k == 1 ? "" : "s", (double)(t1 - t0), bases ? romPath : snapPath));
   }
   PetscCall(PetscSubcommDestroy(&psub));
   PetscFunctionReturn(0);
