@@ -360,6 +360,18 @@ def dualbasis_import(args):
     check(p.returncode != 0 and "negative" in p.stdout, "negative multipliers are refused with a clear error")
     p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/nosuch"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "nosuch" in p.stdout, "a missing dataset is an error naming it")
+    # a tolerance the basis misses is said (exit 0 and no word before, audit 2026-11-29): the report's dual.tol_reached
+    check(r["dual"]["tol_reached"] is True, "cpg at 1e-3: dual.tol_reached true")
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/lambda", "-dual_type", "nmf", "-dual_r", "3", "-dual_tol", "1e-6", "-report", d + "/n.json"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode == 0 and "warning: the basis misses its tolerance" in p.stdout and "nmf has the fixed rank -dual_r" in p.stdout and report(d + "/n.json")["dual"]["tol_reached"] is False,
+          "nmf (rank 3) with -dual_tol 1e-6: a warning naming why, dual.tol_reached false")
+    # multipliers whose squares overflow or underflow (r = 0 and exit 0 before), or all zero: refused
+    for scale, words in ((1e160, "outside [1e-150, 1e150]"), (1e-200, "outside [1e-150, 1e150]"), (0.0, "every multiplier snapshot is zero")):
+        with h5py.File(d + "/s.h5", "w") as f:
+            f["lambda"] = L * scale
+        p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/s.h5:/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and words in p.stdout, "multipliers scaled by %g: refused (%s)" % (scale, words))
 
 
 def greedy(args):

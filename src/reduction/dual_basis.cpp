@@ -412,6 +412,13 @@ PetscErrorCode BuildDualBasis(const DenseMatrix &L, DualBasisResult *res, PetscR
   std::vector<PetscReal> snapNorm(m), err(m);
   for (PetscInt j = 0; j < m; ++j) snapNorm[j] = VecNormOf(&L.a[(size_t)j * R], R, linf);
   res->initialMaxErr = *std::max_element(snapNorm.begin(), snapNorm.end());
+  {
+    // (entries whose squares overflow or underflow in the cone projections gave r = 0 with exit 0; snapshots all zero
+    // a later error naming no cause)
+    const PetscReal big = *std::max_element(L.a.begin(), L.a.end());
+    PetscCheck(big > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Dual basis: every multiplier snapshot is zero (no contact at any training parameter?)");
+    PetscCheck(big < 1e150 && big > 1e-150, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Dual basis: the largest multiplier is %g, outside [1e-150, 1e150] where the cone projections' squares stay finite and nonzero: scale the snapshots", (double)big);
+  }
   res->tolAbs        = tolRelative ? tol * res->initialMaxErr : tol;
   res->W.Resize(R, 0);
 
