@@ -234,6 +234,12 @@ def mismatch(args):
         check("Segmentation" not in p.stdout and "SEGV" not in p.stdout, "%s: no crash" % what)
     with h5py.File(d + "/s.h5", "r") as f:
         check(int(np.sum(np.array(f["snapshots/done"]))) == 3, "the refused file is untouched")
+    # dualbasis on an unfinished snapshot file: said (it was used without a word)
+    shutil.copy(d + "/s.h5", d + "/s2.h5")
+    with h5py.File(d + "/s2.h5", "r+") as f:
+        f["snapshots/done"][1] = 0
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/s2.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode == 0 and "holds 2 of its 3 snapshots (an unfinished run)" in p.stdout, "dualbasis on an unfinished snapshot file: a warning naming the count")
     def bases_from_tampered(name, ds, row, val):
         """The bases step on a copy of s.h5 whose done row `row` of /snapshots/<ds> has `val` in its middle entry."""
         bad = d + "/%s.h5" % name
@@ -589,7 +595,7 @@ def sensitivities(args):
     run(args, 1, "runs/half_disks.opts", ["-train_size", "2", "-snapshots", d + "/old.h5"])
     c_ = ["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/half_disks.opts", "-train_size", "2", "-snapshots", d + "/old.h5", "-rom", d + "/x.h5", "-snapshots_sensitivities"]
     p = subprocess.run(c_, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    check(p.returncode != 0 and "old.h5" in p.stdout and "without -snapshots_sensitivities" in p.stdout, "a snapshot file solved without the option is refused, naming the file")
+    check(p.returncode != 0 and "old.h5" in p.stdout and "solved without sensitivities" in p.stdout, "a snapshot file solved without the option is refused, naming the file")
     c_ = ["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/half_disks.opts", "-train_size", "2", "-snapshots", d + "/bad.h5", "-rom", d + "/y.h5", "-snapshots_sensitivities", "-dual_sensitivity_step", "2"]
     p = subprocess.run(c_, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "-dual_sensitivity_step 2" in p.stdout, "-dual_sensitivity_step 2 is refused, naming the option")

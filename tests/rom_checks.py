@@ -287,6 +287,10 @@ def pipeline(args):
     run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-offline_stop", "snapshots", "-train_size", "2", "-body_E", "200,100", "-snapshots", other])
     p = run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_snapshots", other], expect_ok=False)
     check(p.returncode != 0 and "another configuration" in p.stdout and other in p.stdout, "validate -test_snapshots solved with other materials: refused naming the file")
+    with open(d + "/pts.txt", "w") as f:
+        f.write("1.0\n1.1\n")
+    p = run(args, 1, "validate", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_snapshots", ts, "-test_type", "file", "-test_file", d + "/pts.txt"], expect_ok=False)
+    check(p.returncode != 0 and "-test_file and -test_snapshots both give the test set" in p.stdout, "validate -test_file with -test_snapshots: refused (the file's 2 points were dropped without a word)")
     # the best approximation of u in the primal basis (energy norm): no reduced solution in the basis is closer
     best, ru = np.array(val[1]["test_best_approximation"]["rel_err_u"]), np.array(t["rel_err_u"])
     check(len(best) == 20 and np.all(best <= ru * (1 + 1e-8) + 1e-12) and best.max() > 0,

@@ -589,6 +589,9 @@ PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatr
     std::vector<Snapshot> snaps;
     PetscCall(SnapshotFile::ReadAll(s, &snaps));
     for (const auto &sn : snaps) cols.push_back(sn.lambda);
+    SnapshotHeader h; // (an unfinished file was used without a word)
+    PetscCall(SnapshotFile::ReadHeader(s, &h));
+    if (snaps.size() < h.trainingPoints.size()) PetscCall(PetscPrintf(comm, "rbcontact dualbasis: warning: snapshot file %s holds %zu of its %zu snapshots (an unfinished run): the basis is built from those\n", s.c_str(), snaps.size(), h.trainingPoints.size()));
   } else PetscCall(ImportSnapshotMatrix(comm, s, &cols));
   PetscCheck(!cols.empty() && !cols[0].empty(), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds no snapshots", s.c_str());
   DenseMatrix &L    = *Lout;

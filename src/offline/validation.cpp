@@ -837,6 +837,11 @@ PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &report
       PetscBool has;
       PetscCall(PetscOptionsHasName(NULL, NULL, o, &has));
     }
+    // but not a sample file: the scene files set -test_type, -test_size and -test_seed, never -test_file, so one
+    // given is the user's own test set (it was dropped without a word for the snapshot file's)
+    PetscBool file;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-test_file", &file));
+    PetscCheck(!file, comm, PETSC_ERR_ARG_INCOMP, "-test_file and -test_snapshots both give the test set: the snapshot file's parameters are its test set; give one of them");
     SnapshotHeader h;
     PetscCall(SnapshotFile::ReadHeader(s.testSnapshots, &h));
     test.points = h.trainingPoints;
