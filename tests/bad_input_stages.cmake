@@ -123,3 +123,7 @@ rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this fai
 # offline values that ran without a word: a negative number of groups (ran as 0), a greedy budget below its initial set
 rbc_bad_stage(snapshots_subcomm_negative "-snapshots_subcomm -2 must be >= 0" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm -2)
 rbc_bad_stage(greedy_max_solves_initial "-greedy_max_solves 1 is below the 2 points of the initial set" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 1 -rom /tmp/rbc_never.h5)
+# every contact dof fixed by a Dirichlet condition (LAPACK's "illegal value" and "not SPD"); moduli 1e14 apart (the hint named
+# the Dirichlet conditions only)
+rbc_bad_stage(contact_all_fixed "the contact surfaces have no free degree of freedom" fom -options_file runs/ring_on_block.opts -dirichlet ring_top,block_bottom,slave,master -dirichlet_slave_u 0,-0.1 -dirichlet_master_u 0,0)
+rbc_bad_stage(moduli_apart "or moduli too far apart for double precision [(]-body_E from 1e-12 to 100[)]" fom -options_file runs/ring_on_block.opts -body_E 1e-12,100)

@@ -17,6 +17,8 @@ static PetscErrorCode InverseOfSchur(Mat S, std::vector<PetscReal> *G)
 
   PetscFunctionBeginUser;
   PetscCall(MatGetSize(S, &n, NULL));
+  // (no free contact dof: LAPACK said "parameter number 4 had an illegal value" and the message "not SPD")
+  PetscCheck(n > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Contact compliance: the contact surfaces have no free degree of freedom: Dirichlet conditions fix all of them (does -dirichlet list the slave or master surface?)");
   const PetscBLASInt nb = (PetscBLASInt)n;
   PetscCall(MatDenseGetLDA(S, &lda));
   PetscCall(MatDenseGetArrayRead(S, &s));

@@ -281,7 +281,20 @@ PetscErrorCode ElasticFOM::FactorWithSchur(bool *done)
   PetscInt failed = err != MAT_FACTOR_NOERROR ? (PetscInt)err : 0;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
   err = (MatFactorError)failed;
-  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs%s) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet); out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), local ? ", each rank its bodies" : "", err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure");
+  std::string moduli; // (moduli 1e14 apart gave the Dirichlet hint alone)
+  {
+    PetscReal emin = PETSC_MAX_REAL, emax = 0;
+    for (const auto &b : scene.bodies) {
+      emin = std::min(emin, b.E);
+      emax = std::max(emax, b.E);
+    }
+    if (emin > 0 && emax / emin > 1e8) {
+      std::ostringstream o;
+      o << ", or moduli too far apart for double precision (-body_E from " << emin << " to " << emax << ")";
+      moduli = o.str();
+    }
+  }
+  PetscCheck(err == MAT_FACTOR_NOERROR, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The MUMPS Cholesky factorization of the stiffness (with the Schur complement on the %zu contact dofs%s) failed: %s. A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet)%s; out of memory: raise -fom_mat_mumps_icntl_14", schurDofs_.size(), local ? ", each rank its bodies" : "", err == MAT_FACTOR_OUTMEMORY ? "out of memory" : err == MAT_FACTOR_NUMERIC_ZEROPIVOT ? "zero pivot" : "numerical failure", moduli.c_str());
   PetscCall(MatDestroy(&schurS_));
   if (schurRank_ > 0) PetscCall(MatFactorCreateSchurComplement(schurFactor_, &schurS_, &status));
   *done = true;
