@@ -127,3 +127,5 @@ rbc_bad_stage(greedy_max_solves_initial "-greedy_max_solves 1 is below the 2 poi
 # the Dirichlet conditions only)
 rbc_bad_stage(contact_all_fixed "the contact surfaces have no free degree of freedom" fom -options_file runs/ring_on_block.opts -dirichlet ring_top,block_bottom,slave,master -dirichlet_slave_u 0,-0.1 -dirichlet_master_u 0,0)
 rbc_bad_stage(moduli_apart "or moduli too far apart for double precision [(]-body_E from 1e-12 to 100[)]" fom -options_file runs/ring_on_block.opts -body_E 1e-12,100)
+# a gross initial overlap: the Kacanov failure now says the bodies overlapped before any load (the relaxation hint alone before)
+rbc_bad_stage(overlap_not_converged "the bodies overlapped before any load: [0-9]+ slave points inside the master, by up to 0[.]5" fom -options_file runs/ring_on_block.opts -mesh_geo_set g0=-0.5)
