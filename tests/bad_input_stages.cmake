@@ -92,6 +92,7 @@ rbc_bad_stage_np2(contact_label_interior "Contact surface 'block': [0-9]+ of its
 # exit 0); a name went unquoted into a shell command (any command ran); a name the .geo does not define was ignored by
 # gmsh (the default mesh, exit 0)
 rbc_bad_stage(geo_set_inf "-mesh_geo_set: value 'inf' of 'lc_slave' is not a finite number" fom -options_file runs/ring_on_block.opts -mesh_geo_set lc_slave=inf)
+rbc_bad_stage(mesh_clscale_inf "-mesh_clscale inf[.]? must be a finite number > 0" fom -options_file runs/ring_on_block.opts -mesh_clscale inf)
 rbc_bad_stage(geo_set_name "-mesh_geo_set: 'g0[|]true' is not a gmsh variable name" fom -options_file runs/ring_on_block.opts -mesh_geo_set "g0|true=0.005")
 rbc_bad_stage(geo_set_unknown "'lc_slavee' is not a variable of '.*ring_on_block[.]geo' [(]nor of the files it includes[)]" fom -options_file runs/ring_on_block.opts -mesh_geo_set lc_slavee=0.0125)
 # a parameter named twice (one -mu value dropped without a word); a default outside the box (was blamed on -mu)

@@ -156,7 +156,7 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)");
   PetscCall(PetscOptionsReal("-mesh_clscale", "gmsh characteristic length factor (.geo)", kMan, scene->mesh.clscale, &scene->mesh.clscale, NULL));
   PetscCall(PetscOptionsInt("-mesh_refine", "Halve the mesh size this many times (.geo: -mesh_clscale x 0.5^n)", kMan, refine, &refine, NULL));
-  PetscCheck(scene->mesh.clscale > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_clscale %g must be > 0", (double)scene->mesh.clscale);
+  PetscCheck(scene->mesh.clscale > 0 && std::isfinite(scene->mesh.clscale), comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_clscale %g must be a finite number > 0", (double)scene->mesh.clscale); // (inf crashed gmsh)
   PetscCheck(refine >= 0 && refine <= 8, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_refine %" PetscInt_FMT " out of range [0, 8]", refine);
   scene->mesh.clscale *= std::pow(0.5, (double)refine);
   if (const char *env = std::getenv("RBC_MESH_CACHE")) scene->mesh.cacheDir = env;
