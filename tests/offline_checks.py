@@ -425,13 +425,13 @@ def greedy(args):
     # a run killed inside a round (its first pick written, the second not): the resumed run finishes that round's picks
     # before it builds the next model. Before, the model of the partial round picked other parameters (a different ROM,
     # exit 0; found by an audit with real kills, 2026-11-29). The kill is made exact by clearing the last pick's done flag
-    # in a copy of the straight run's snapshot file, which keeps the round's picks (attribute greedy_pending).
+    # in a copy of the straight run's snapshot file, which keeps the round's picks (dataset /snapshots/pending).
     last = [int(i) for i in g1["rounds"][-1]["picked"]]
     shutil.copy(d + "/g1.snapshots.h5", d + "/g4.snapshots.h5")
     with h5py.File(d + "/g4.snapshots.h5", "r+") as f:
-        pending = sorted(int(i) for i in f.attrs.get("greedy_pending", []))
+        pending = np.nonzero(np.array(f["snapshots/pending"]))[0].tolist()
         f["snapshots/done"][last[1]] = 0
-    check(pending == sorted(last), "the snapshot file keeps the last round's picks %s (greedy_pending %s)" % (last, pending))
+    check(pending == sorted(last), "the snapshot file keeps the last round's picks %s (/snapshots/pending %s)" % (last, pending))
     r4 = off(1, "g4", 6)
     check(r4["resumed"] == 5 and r4["fom_solves"] == 1 and r4["greedy"]["training_indices"] == g1["training_indices"]
           and r4["greedy"]["rounds"][0].get("resumed_picks") == [last[1]],

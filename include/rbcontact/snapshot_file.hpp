@@ -62,7 +62,7 @@ public:
   // Rank 0 of comm writes s (others pass through): data, then H5Fflush, then the done flag, flush.
   PetscErrorCode Write(const Snapshot &s);
   PetscErrorCode Close();
-  // Greedy training: the picks of the round about to be solved, stored (attribute greedy_pending, flushed) before
+  // Greedy training: the picks of the round about to be solved, stored (dataset /snapshots/pending, flushed) before
   // they are solved, so that a run killed inside a round resumes by finishing the same picks before it builds the
   // next model (the model of a partial round would pick other parameters). Collective; rank 0 writes.
   PetscErrorCode SetPending(const std::vector<PetscInt> &picks);

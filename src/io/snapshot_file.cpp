@@ -68,6 +68,7 @@ constexpr int         kOldestReadableVersion = 1;
 const char *const     kDroppedExtras[]       = {"contact_K", "contact_dofs"};
 constexpr size_t      kMaxAttrString = 32768;
 const double          kNaN           = std::numeric_limits<double>::quiet_NaN();
+const char *const     kPendingSet    = "/snapshots/pending"; // greedy training: the round's picks (SnapshotFile::SetPending)
 
 using namespace rbc::h5;
 
@@ -126,6 +127,7 @@ bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
   if (!CreateDataset(c, f, "/snapshots/kkt", H5T_IEEE_F64LE, {ntrain, 4}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
   if (!CreateDataset(c, f, "/snapshots/seconds", H5T_IEEE_F64LE, {ntrain}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
   if (!CreateDataset(c, f, "/snapshots/done", H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr)) return false;
+  if (!CreateDataset(c, f, kPendingSet, H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr)) return false;
   H5Id g(H5Gcreate2(f, "/snapshots/extra", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (!g.ok()) return c.Fail("cannot create group /snapshots/extra");
   return true;
@@ -229,42 +231,36 @@ bool ReadDone(Ctx &c, hid_t f, hsize_t ntrain, std::vector<signed char> *done)
   return true;
 }
 
-// The greedy round's picks being solved (attribute greedy_pending, int64 indices into the training set; absent when
-// none). Read: every index checked against ntrain.
-constexpr const char *kPendingAttr = "greedy_pending";
-
+// The greedy round's picks being solved: /snapshots/pending, int8 per training point (1: picked by the round being
+// solved), allocated with the other datasets so that a write changes raw data only (files of before 2026-11-29 get it
+// at their first greedy round, before any pick is marked). Absent: no pick pending.
 bool ReadPending(Ctx &c, hid_t f, hsize_t ntrain, std::vector<PetscInt> *pending)
 {
-  bool exists = false;
   pending->clear();
-  if (!AttrExists(c, f, kPendingAttr, &exists)) return false;
-  if (!exists) return true;
-  H5Id a(H5Aopen(f, kPendingAttr, H5P_DEFAULT), H5Aclose);
-  if (!a.ok()) return c.Fail(std::string("cannot open attribute ") + kPendingAttr);
-  H5Id sp(H5Aget_space(a.get()), H5Sclose);
-  const hssize_t n = sp.ok() ? H5Sget_simple_extent_npoints(sp.get()) : -1;
-  if (n < 0 || n > (hssize_t)ntrain) return c.Fail(std::string("attribute ") + kPendingAttr + " has " + std::to_string((long long)n) + " entries for " + std::to_string((unsigned long long)ntrain) + " training points: a corrupt file", false);
-  std::vector<long long> v((size_t)n);
-  if (n > 0 && H5Aread(a.get(), H5T_NATIVE_LLONG, v.data()) < 0) return c.Fail(std::string("cannot read attribute ") + kPendingAttr);
-  for (long long i : v) {
-    if (i < 0 || i >= (long long)ntrain) return c.Fail(std::string("attribute ") + kPendingAttr + " names training point " + std::to_string(i) + " of " + std::to_string((unsigned long long)ntrain) + ": a corrupt file", false);
-    pending->push_back((PetscInt)i);
-  }
+  const htri_t e = H5Lexists(f, kPendingSet, H5P_DEFAULT);
+  if (e < 0) return c.Fail(std::string("cannot query dataset ") + kPendingSet);
+  if (!e) return true;
+  H5Id d(H5Dopen2(f, kPendingSet, H5P_DEFAULT), H5Dclose);
+  std::vector<hsize_t> dims;
+  if (!d.ok() || !DatasetDims(c, d.get(), kPendingSet, &dims)) return c.Fail(std::string("cannot open dataset ") + kPendingSet);
+  if (dims != std::vector<hsize_t>{ntrain}) return c.Fail(std::string("dataset ") + kPendingSet + " has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)ntrain), false);
+  std::vector<signed char> flag(ntrain, 0);
+  if (ntrain > 0 && H5Dread(d.get(), H5T_NATIVE_SCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, flag.data()) < 0) return c.Fail(std::string("cannot read dataset ") + kPendingSet);
+  for (hsize_t i = 0; i < ntrain; ++i)
+    if (flag[i]) pending->push_back((PetscInt)i);
   return true;
 }
 
-bool WritePending(Ctx &c, hid_t f, const std::vector<PetscInt> &pending)
+bool WritePending(Ctx &c, hid_t f, hsize_t ntrain, const std::vector<PetscInt> &pending)
 {
-  bool exists = false;
-  if (!AttrExists(c, f, kPendingAttr, &exists)) return false;
-  if (exists && H5Adelete(f, kPendingAttr) < 0) return c.Fail(std::string("cannot delete attribute ") + kPendingAttr);
-  if (!pending.empty()) {
-    const hsize_t          n = pending.size();
-    std::vector<long long> v(pending.begin(), pending.end());
-    H5Id                   sp(H5Screate_simple(1, &n, nullptr), H5Sclose);
-    H5Id                   a(sp.ok() ? H5Acreate2(f, kPendingAttr, H5T_STD_I64LE, sp.get(), H5P_DEFAULT, H5P_DEFAULT) : -1, H5Aclose);
-    if (!a.ok() || H5Awrite(a.get(), H5T_NATIVE_LLONG, v.data()) < 0) return c.Fail(std::string("cannot write attribute ") + kPendingAttr);
+  std::vector<signed char> flag(ntrain, 0);
+  for (PetscInt i : pending) flag[(size_t)i] = 1;
+  if (H5Lexists(f, kPendingSet, H5P_DEFAULT) <= 0) { // an older file: created (metadata) and flushed before any pick is marked
+    const signed char zero = 0;
+    if (!CreateDataset(c, f, kPendingSet, H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr) || !FlushSync(c, f)) return false;
   }
+  H5Id d(H5Dopen2(f, kPendingSet, H5P_DEFAULT), H5Dclose);
+  if (!d.ok() || (ntrain > 0 && H5Dwrite(d.get(), H5T_NATIVE_SCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, flag.data()) < 0)) return c.Fail(std::string("cannot write dataset ") + kPendingSet);
   return FlushSync(c, f);
 }
 
@@ -596,7 +592,7 @@ PetscErrorCode SnapshotFile::SetPending(const std::vector<PetscInt> &picks)
   if (rank == 0) {
     H5Quiet q;
     Ctx     c = FileCtx(path_);
-    if (!WritePending(c, (hid_t)file_, picks)) err = c.err;
+    if (!WritePending(c, (hid_t)file_, done_.size(), picks)) err = c.err;
   }
   PetscCall(BcastString(comm_, &err));
   PetscCheck(err.empty(), comm_, PETSC_ERR_FILE_WRITE, "%s", err.c_str());

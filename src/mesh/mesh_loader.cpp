@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <sys/stat.h>
@@ -428,24 +429,42 @@ static std::string UndefinedNodeRefs(const std::string &msh)
   };
   auto known = [&](long long t) { return t >= 0 && (size_t)t < defined.size() && defined[(size_t)t]; };
   auto bad   = [&](long long e, long long t) { return "element " + std::to_string(e) + " uses node " + std::to_string(t) + ", which the file does not define (a corrupt or hand-edited mesh)"; };
+  // msh 4.1: a section's header (blocks, count, smallest and largest tag), then each block's four numbers (the last
+  // one its count) and its body, read by body(count)
+  auto blocks41 = [&](const std::function<bool(long long)> &body) {
+    long long nb, cnt, lo, hi, h[4];
+    if (!(f >> nb >> cnt >> lo >> hi)) return false;
+    for (long long b = 0; b < nb; ++b)
+      if (!(f >> h[0] >> h[1] >> h[2] >> h[3]) || !body(h[3])) return false;
+    return true;
+  };
+  std::string err;
+  // an element line: its tag (2.2: then its type and tags), then its nodes, every one defined
+  auto elementLine = [&](const std::string &l, bool v22) {
+    std::istringstream in(l);
+    long long          id = 0, type, ntags = 0, t;
+    in >> id;
+    if (v22) in >> type >> ntags;
+    for (long long j = 0; j < ntags; ++j) in >> t;
+    while (err.empty() && in >> t)
+      if (!known(t)) err = bad(id, t);
+  };
   while (std::getline(f, line)) {
     if (line.rfind("$MeshFormat", 0) == 0) {
       int binary = 0;
       if (!(f >> version >> binary) || binary != 0) return "";
     } else if (line.rfind("$Nodes", 0) == 0) {
       if (version >= 4) {
-        long long nb, nn, lo, hi;
-        if (!(f >> nb >> nn >> lo >> hi)) return "";
-        for (long long b = 0; b < nb; ++b) {
-          long long d, e, par, n;
-          if (!(f >> d >> e >> par >> n)) return "";
+        const bool ok = blocks41([&](long long n) {
           for (long long k = 0; k < n; ++k) {
             long long t;
-            if (!(f >> t) || !define(t)) return "";
+            if (!(f >> t) || !define(t)) return false;
           }
           std::getline(f, line);
           for (long long k = 0; k < n; ++k) std::getline(f, line); // coordinates
-        }
+          return true;
+        });
+        if (!ok) return "";
       } else {
         long long n;
         if (!(f >> n)) return "";
@@ -457,35 +476,18 @@ static std::string UndefinedNodeRefs(const std::string &msh)
         }
       }
     } else if (line.rfind("$Elements", 0) == 0) {
+      long long n = 0;
       if (version >= 4) {
-        long long nb, ne, lo, hi;
-        if (!(f >> nb >> ne >> lo >> hi)) return "";
-        for (long long b = 0; b < nb; ++b) {
-          long long d, e, type, n;
-          if (!(f >> d >> e >> type >> n)) return "";
+        blocks41([&](long long cnt) {
           std::getline(f, line);
-          for (long long k = 0; k < n && std::getline(f, line); ++k) {
-            std::istringstream in(line);
-            long long          id, t;
-            in >> id;
-            while (in >> t)
-              if (!known(t)) return bad(id, t);
-          }
-        }
-      } else {
-        long long n;
-        if (!(f >> n)) return "";
+          for (long long k = 0; k < cnt && err.empty() && std::getline(f, line); ++k) elementLine(line, false);
+          return err.empty();
+        });
+      } else if (f >> n) {
         std::getline(f, line);
-        for (long long k = 0; k < n && std::getline(f, line); ++k) {
-          std::istringstream in(line);
-          long long          id, type, ntags, t;
-          if (!(in >> id >> type >> ntags)) return "";
-          for (long long j = 0; j < ntags; ++j) in >> t;
-          while (in >> t)
-            if (!known(t)) return bad(id, t);
-        }
+        for (long long k = 0; k < n && err.empty() && std::getline(f, line); ++k) elementLine(line, true);
       }
-      return "";
+      return err;
     }
   }
   return "";
