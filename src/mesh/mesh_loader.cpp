@@ -97,7 +97,7 @@ static bool EndsWith(const std::string &s, const std::string &suf) { return s.si
 
 // The text of a .geo and of every file it pulls in (Include "f", Merge "f", relative to the including file's directory,
 // recursively): the mesh cache key (an edited included file reused the stale mesh), and where -mesh_geo_set's names
-// are looked for. A file that cannot be read adds its name only (gmsh then says what is wrong).
+// are looked for. A file that cannot be read adds a mark only (gmsh then says what is wrong).
 static void GeoSources(const std::string &path, int depth, std::string *text)
 {
   std::ifstream f(path);
