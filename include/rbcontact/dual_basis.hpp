@@ -117,6 +117,8 @@ struct DualBasisResult {
   std::string           norm = "linf";      // norm of the errors: linf or l2
   PetscReal             initialMaxErr = 0;  // largest snapshot norm (the error of the empty basis)
   PetscReal             tolAbs = 0;         // the absolute tolerance the greedy used (after -dual_tol_relative)
+  // Whether the basis meets it (nmf does not read -dual_tol; a greedy may stop at -dual_max_r or at the cone's limit).
+  bool TolReached() const { return trainMaxErr <= tolAbs * (1 + 1e-12); }
   std::vector<PetscReal> trainErr;          // final projection error of every snapshot (NNLS onto the cone of W)
   PetscReal             mcpgMinRemainder = 0;    // mcpg: min over steps of min(theta - Upsilon) / ||theta|| before clipping (>= -1e-12)
   PetscReal             mcpgMaxLDPViolation = 0; // mcpg: max over steps of the LDP solution's violation of Upsilon <= theta (before restoration), / ||theta||

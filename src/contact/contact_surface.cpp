@@ -47,20 +47,18 @@ PetscErrorCode ContactSurface::Build(const Elasticity &elas, const std::string &
     // Facets inside a body (two cells): the body's name given for its surface (-contact_master block), or a curve
     // embedded in a body. Counted on every rank first: checked on the ranks that hold such facets alone, the others
     // waited for them in the next collective (a hang on 2 ranks).
-    PetscInt    bad[2] = {0, -1}, all[2];
-    PetscMPIInt rank;
-    MPI_Comm    comm;
+    PetscInt bad = 0;
+    MPI_Comm comm;
     PetscCall(PetscObjectGetComm((PetscObject)dm, &comm));
-    PetscCallMPI(MPI_Comm_rank(comm, &rank));
     for (PetscInt p = fStart; p < fEnd && dmlabel; ++p) {
       PetscInt val, nsupp;
       PetscCall(DMLabelGetValue(dmlabel, p, &val));
       if (val < 0) continue;
       PetscCall(DMPlexGetSupportSize(dm, p, &nsupp));
-      if (nsupp != 1) ++bad[0];
+      if (nsupp != 1) ++bad;
     }
-    PetscCallMPI(MPI_Allreduce(bad, all, 1, MPIU_INT, MPI_SUM, comm));
-    PetscCheck(all[0] == 0, comm, PETSC_ERR_USER_INPUT, "Contact surface '%s': %" PetscInt_FMT " of its facets lie inside a body (two cells each), not on its boundary: name a boundary curve of the body (surface in 3D) as the contact surface, not the body itself or a curve embedded in it", label.c_str(), all[0]);
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(bad == 0, comm, PETSC_ERR_USER_INPUT, "Contact surface '%s': %" PetscInt_FMT " of its facets lie inside a body (two cells each), not on its boundary: name a boundary curve of the body (surface in 3D) as the contact surface, not the body itself or a curve embedded in it", label.c_str(), bad);
   }
   for (PetscInt p = fStart; p < fEnd && dmlabel; ++p) {
     PetscInt val;

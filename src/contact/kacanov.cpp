@@ -649,12 +649,11 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   history.du      = loop.history.du;
   history.dl      = loop.history.dl;
   history.nactive = loop.history.nactive;
-  if (!converged && initialPenetrating > 0) { // (a gross initial overlap failed with the relaxation hint alone)
-    std::ostringstream o;
-    o << "; the bodies overlapped before any load: " << initialPenetrating << " slave points inside the master, by up to " << initialPenetration << " (the mesh or -mesh_geo_set / the maps put them through each other?)";
-    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", (loop.NotConverged(false) + o.str() + loop.NotConverged(true).substr(loop.NotConverged(false).size())).c_str());
+  if (!converged) {
+    std::ostringstream o; // (a gross initial overlap failed with the relaxation hint alone)
+    if (initialPenetrating > 0) o << "; the bodies overlapped before any load: " << initialPenetrating << " slave points inside the master, by up to " << initialPenetration << " (the mesh or -mesh_geo_set / the maps put them through each other?)";
+    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, o.str()).c_str());
   }
-  PetscCheck(converged, comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true).c_str());
 
   PetscCall(ComputeKKT(fom));
   PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol);

@@ -93,7 +93,7 @@ PetscInt KacanovLoop::Cycle(PetscInt *from) const
   return 0;
 }
 
-std::string KacanovLoop::NotConverged(bool withHistory) const
+std::string KacanovLoop::NotConverged(bool withHistory, const std::string &cause) const
 {
   const std::string  p = "-" + prefix_ + "kacanov_";
   std::ostringstream o;
@@ -102,6 +102,7 @@ std::string KacanovLoop::NotConverged(bool withHistory) const
   PetscInt from = 0;
   if (const PetscInt per = Cycle(&from))
     o << "; the changes repeat with period " << per << " from iterate " << from << ": a cycle, not a slow approach, so more iterations do not help (a smaller " << p << "relaxation may; for a reduced model, a cycle that damping does not remove says the training set does not resolve this parameter)";
+  o << cause;
   if (withHistory) {
     o << ". History:";
     for (size_t i = 0; i < history.du.size(); ++i) o << "\n  it " << i + 1 << ": du " << history.du[i] << ", dlambda " << history.dl[i] << ", active " << history.nactive[i];

@@ -33,6 +33,15 @@ static const char kMan[] = "README.md: Options";
 
 // A gmsh variable name, as -mesh_geo_set and -mu_geo_set give it to gmsh -setnumber (it went to a shell command line
 // unquoted: a name could run any command).
+// The first name of a list that appears twice ("" when none).
+static std::string Repeated(const std::vector<std::string> &names)
+{
+  for (size_t i = 0; i < names.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (names[i] == names[j]) return names[i];
+  return "";
+}
+
 static bool GeoIdentifier(const std::string &n)
 {
   if (n.empty() || std::isdigit((unsigned char)n[0])) return false;
@@ -181,8 +190,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   s.clear();
   PetscCall(GetString(PetscOptionsObject, "-mu_names", "Parameter names, comma separated", &s, NULL));
   const std::vector<std::string> pnames = SplitList(s);
-  for (size_t i = 0; i < pnames.size(); ++i) // (a repeated name: one of the -mu values was dropped without a word)
-    for (size_t j = 0; j < i; ++j) PetscCheck(pnames[i] != pnames[j], comm, PETSC_ERR_USER_INPUT, "-mu_names: the parameter name '%s' appears twice", pnames[i].c_str());
+  // (a repeated name: one of the -mu values was dropped without a word)
+  PetscCheck(Repeated(pnames).empty(), comm, PETSC_ERR_USER_INPUT, "-mu_names: the parameter name '%s' appears twice", Repeated(pnames).c_str());
   if (!pnames.empty()) {
     std::vector<PetscReal> lo, hi, def, val;
     PetscCall(GetRealArray(PetscOptionsObject, "-mu_min", "Parameter box: lower bounds, one per parameter", &lo, NULL));
@@ -223,8 +232,8 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscCall(GetString(PetscOptionsObject, "-bodies", "Body names = physical surface (volume) groups of the mesh, comma separated", &s, NULL));
   std::vector<std::string> names = SplitList(s);
   if (names.empty()) names.push_back("all");
-  for (size_t i = 0; i < names.size(); ++i) // (a repeated body: its cells went to the last entry, and the first was said to float)
-    for (size_t j = 0; j < i; ++j) PetscCheck(names[i] != names[j], comm, PETSC_ERR_USER_INPUT, "-bodies: the body '%s' appears twice", names[i].c_str());
+  // (a repeated body: its cells went to the last entry, and the first was said to float)
+  PetscCheck(Repeated(names).empty(), comm, PETSC_ERR_USER_INPUT, "-bodies: the body '%s' appears twice", Repeated(names).c_str());
   std::vector<PetscReal> E, nu;
   PetscCall(GetRealArray(PetscOptionsObject, "-body_E", "Young's modulus: one value, or one per body", &E, NULL));
   PetscCall(GetRealArray(PetscOptionsObject, "-body_nu", "Poisson ratio: one value, or one per body", &nu, NULL));

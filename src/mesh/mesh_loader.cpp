@@ -337,14 +337,11 @@ PetscErrorCode MeshCheckLabel(DM dm, const std::string &name, const char *option
 // element of entity 13 in physical group 12 lands in group 13 as well when one exists: a wrong mesh
 // (measured: pin_in_hole's master arc, Circle(13), became part of "pin_core", tag 13: an imposed
 // displacement on the master, contact enforced on half the arc). Refuse such files, naming the clash.
-static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, const std::string &option)
+// The message, or "" (rank 0, before the reader). generated: the .msh was meshed from a .geo (the advice differs).
+static std::string Gmsh22TagClash(const std::string &msh, const std::string &option, bool generated)
 {
-  PetscMPIInt rank;
   std::string why;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (rank == 0) {
+  {
     std::ifstream f(msh);
     std::string   line;
     bool          v2 = false;
@@ -360,7 +357,7 @@ static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, con
         fmt >> version >> binary;
         if (binary == 1) { // its $Elements cannot be read as text: the check below would find nothing (an audit's pin_in_hole: exit 0, force 0.503 for 0.358)
           why = "mesh '" + msh + "' (" + option + ") is in binary gmsh format 2.2, whose element tags cannot be checked against PETSc 3.18's reader (which mislabels the elements of an entity whose tag equals another physical group's): write it in format 4.1 (gmsh -format msh41" +
-                (option.find(".geo") != std::string::npos ? "; remove Mesh.MshFileVersion and Mesh.Binary from the .geo" : "") + ") or as ASCII 2.2";
+                (generated ? "; remove Mesh.MshFileVersion and Mesh.Binary from the .geo" : "") + ") or as ASCII 2.2";
           break;
         }
       } else if (line.rfind("$PhysicalNames", 0) == 0) {
@@ -398,7 +395,7 @@ static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, con
             std::ostringstream m;
             m << "mesh '" << msh << "' (" << option << ") is in gmsh format 2.2 and its entity " << ent << " (of physical group '" << (own != groups.end() ? own->second : std::to_string(phys))
               << "') has the tag of physical group '" << g->second << "': PETSc 3.18's reader would put those elements into '" << g->second
-              << "' too (a wrong mesh). " << (option.find(".geo") != std::string::npos ? "Remove Mesh.MshFileVersion from the .geo (rbcontact meshes it in format 4.1)" : "Write it with gmsh -format msh41")
+              << "' too (a wrong mesh). " << (generated ? "Remove Mesh.MshFileVersion from the .geo (rbcontact meshes it in format 4.1)" : "Write it with gmsh -format msh41")
               << " (or give the physical groups tags no entity uses)";
             why = m.str();
           }
@@ -407,9 +404,7 @@ static PetscErrorCode CheckGmsh22Tags(MPI_Comm comm, const std::string &msh, con
       }
     }
   }
-  PetscCall(BcastString(comm, &why));
-  PetscCheck(why.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "%s", why.c_str());
-  PetscFunctionReturn(0);
+  return why;
 }
 
 // Before the reader, for a user's ASCII .msh (4.1 or 2.2): an element pointing at a node tag the file does not define.
@@ -537,18 +532,25 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
   PetscCall(PetscLogEventBegin(MESH_Load, 0, 0, 0, 0));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-dm_plex_gmsh_use_regions", &set));
   if (!set) PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_gmsh_use_regions", "true"));
-  if (EndsWith(msh, ".msh")) PetscCall(CheckGmsh22Tags(comm, msh, "-mesh_file " + scene.mesh.file));
+  // A mesh our generator wrote (a .geo source meshed by gmsh into the cache, by a temporary file and a rename) is
+  // complete; a user's .msh may not be.
+  const bool generated = EndsWith(scene.mesh.file, ".geo");
   if (EndsWith(msh, ".msh")) {
-    // a body of -bodies whose cells are in no physical group: gmsh then saves only the lower-dimensional groups (the
-    // body's boundary curves without its cells), which PETSc's reader refuses on rank 0 while the other ranks wait in
-    // its collectives (a hang on 2 ranks for a generated mesh, which is not parsed on rank 0 first): checked before
-    std::string missing;
+    // Rank 0 reads the text before PETSc's reader: the format 2.2 tag clash; a body of -bodies whose cells are in no
+    // physical group (gmsh then saves only its boundary curves, which PETSc's reader refuses on rank 0 while the other
+    // ranks wait in its collectives: a hang on 2 ranks for a generated mesh, which is not parsed on rank 0 first); in
+    // a user's file, an element pointing at an undefined node.
+    std::string why;
     PetscMPIInt r0;
     PetscCallMPI(MPI_Comm_rank(comm, &r0));
-    if (r0 == 0) missing = BodiesWithoutGroup(msh, scene);
-    if (r0 == 0 && missing.empty() && !EndsWith(scene.mesh.file, ".geo")) missing = UndefinedNodeRefs(msh); // (a user's file)
-    PetscCall(BcastString(comm, &missing));
-    PetscCheck(missing.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "Mesh '%s' (from -mesh_file %s): %s", msh.c_str(), scene.mesh.file.c_str(), missing.c_str());
+    if (r0 == 0) {
+      why                 = Gmsh22TagClash(msh, "-mesh_file " + scene.mesh.file, generated);
+      std::string missing = why.empty() ? BodiesWithoutGroup(msh, scene) : "";
+      if (why.empty() && missing.empty() && !generated) missing = UndefinedNodeRefs(msh);
+      if (!missing.empty()) why = "Mesh '" + msh + "' (from -mesh_file " + scene.mesh.file + "): " + missing;
+    }
+    PetscCall(BcastString(comm, &why));
+    PetscCheck(why.empty(), comm, PETSC_ERR_FILE_UNEXPECTED, "%s", why.c_str());
   }
   {
     PetscErrorCode ierr = 0;
@@ -556,9 +558,6 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     PetscCallMPI(MPI_Comm_size(comm, &size));
     PetscCallMPI(MPI_Comm_rank(comm, &rank));
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    // A mesh our generator wrote (a .geo source meshed by gmsh into the cache, by a temporary file and a
-    // rename) is complete; a user's .msh may not be.
-    const bool generated = EndsWith(scene.mesh.file, ".geo");
     if (size > 1 && !generated) {
       // PETSc's gmsh reader parses the file on rank 0 while the other ranks wait in collectives:
       // a malformed file made rank 0 return an error and the others hang. So on several ranks,

@@ -34,7 +34,7 @@ PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Repor
   d["train_max_rel_err"] = (double)dual.trainMaxRelErr;
   d["history"]           = dual.history;
   d["tol_abs"]           = (double)dual.tolAbs;
-  d["tol_reached"]       = dual.trainMaxErr <= dual.tolAbs * (1 + 1e-12); // (nmf ignores -dual_tol; a greedy may stop at -dual_max_r or the cone's limit)
+  d["tol_reached"]       = dual.TolReached();
   d["norm"]              = dual.norm;
   d["gram_cond"]         = Finite(dual.gramCond);
   d["selected"]          = std::vector<double>(dual.selected.begin(), dual.selected.end());
