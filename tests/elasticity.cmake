@@ -44,6 +44,12 @@ add_test(NAME bad_input_garbage_msh_np2
   COMMAND ${RBC_EXPECT_ERROR} "Cannot read mesh '[^']*garbage_mesh[.]msh'" ${RBC_MPIEXEC} -n 2 ${RBC_FOM_RING} -mesh_file @GARBAGE_MSH@
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(bad_input_garbage_msh_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 60 PROCESSORS 2 LABELS elasticity)
+# An unknown name on 2 ranks: every rank's message lists the mesh's names (their union over the ranks: a rank lacking a
+# label listed none before 2026-12-01)
+add_test(NAME bad_input_unknown_physical_name_np2
+  COMMAND ${RBC_EXPECT_ERROR} "[[]1[]] rbcontact error: Physical name 'nosuch' [(]option -dirichlet[)] does not exist in mesh 'meshes/ring_on_block[.]geo'; it has: ring, block, slave, ring_top, block_bottom, master" ${RBC_MPIEXEC} -n 2 ${RBC_FOM_RING} -dirichlet ring_top,nosuch
+  WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(bad_input_unknown_physical_name_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 60 PROCESSORS 2 LABELS elasticity)
 
 # The element-by-element assembly (default) against PetscFE's residual and Jacobian: A, f, H1 matrix and
 # energy to 1e-12 on P1/P2, 2D/3D, mapped bodies at several mu, loads (body force, traction) and liftings.

@@ -246,7 +246,10 @@ def mismatch(args):
         shutil.copy(d + "/s.h5", bad)
         with h5py.File(bad, "r+") as f:
             x = np.array(f["snapshots/" + ds][row])
-            x[len(x) // 2] = val
+            if x.ndim == 0:  # a 1D dataset (/snapshots/seconds): the row's one value
+                x = val
+            else:
+                x[len(x) // 2] = val
             f["snapshots/" + ds][row] = x
         return subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
                                "-offline_stop", "bases", "-snapshots", bad, "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -266,6 +269,15 @@ def mismatch(args):
         p = bases_from_tampered("odd_" + ds, ds, row, val)
         check(p.returncode != 0 and ("odd_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and words in p.stdout and not os.path.exists(d + "/never.h5"),
               "a done row of /snapshots/%s with %s: refused naming the file and the row, no ROM" % (ds, words))
+    # the provenance of a done row: a NaN solve time (validate's FOM time and speedup from -test_snapshots turned NaN)
+    # and a negative or infinite KKT residual were accepted before 2026-12-01; a NaN residual means "not given"
+    for ds, row, val, words in (("seconds", 1, np.nan, "a solve time is a finite number"), ("kkt", 2, -1.0, "a KKT residual is a norm"),
+                                ("kkt", 0, np.inf, "a KKT residual is a norm")):
+        p = bases_from_tampered("prov_" + ds, ds, row, val)
+        check(p.returncode != 0 and ("prov_%s.h5" % ds) in p.stdout and ("row %d " % row) in p.stdout and ("/snapshots/" + ds) in p.stdout and words in p.stdout
+              and not os.path.exists(d + "/never.h5"), "%s in a done row of /snapshots/%s: refused naming the file, the row and the dataset, no ROM" % (val, ds))
+    p = bases_from_tampered("prov_kkt_nan", "kkt", 1, np.nan)
+    check(p.returncode == 0, "a NaN KKT residual (not given) is accepted")
 
 
 def early_options(args):
@@ -286,8 +298,18 @@ def early_options(args):
     with h5py.File(d + "/s3.h5", "r+") as f:  # one snapshot left to solve
         f["snapshots/done"][2] = 0
     p = run(args, 1, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/s3.h5", "-snapshots_restart", "-snapshots_sensitivities", "-snapshots_monitor"], expect_ok=False)
-    check(p.returncode != 0 and "the 2 finished snapshots of" in p.stdout and "solved without sensitivities" in p.stdout and "  snapshot " not in p.stdout,
+    check(p.returncode != 0 and "2 of the 2 finished snapshots of" in p.stdout and "solved without sensitivities" in p.stdout and "  snapshot " not in p.stdout,
           "-snapshots_sensitivities on a file solved without them: refused before any snapshot")
+    # a file whose sensitivity dataset exists but one done row was solved without them (a run resumed without the
+    # option writes no sensitivity row: zeros): refused before the remaining snapshots, naming the training point
+    # (was refused by the bases step only, after them)
+    run(args, 1, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/p3.h5", "-snapshots_sensitivities", "-offline_stop", "snapshots"])
+    with h5py.File(d + "/p3.h5", "r+") as f:
+        f["snapshots/extra/sensitivity_u"][1] = 0.0  # training point 2: as if solved without the option
+        f["snapshots/done"][2] = 0  # one snapshot left to solve
+    p = run(args, 2, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/p3.h5", "-snapshots_restart", "-snapshots_sensitivities", "-snapshots_monitor"], expect_ok=False)
+    check(p.returncode != 0 and "1 of the 2 finished snapshots of" in p.stdout and "(training points 2)" in p.stdout and "  snapshot " not in p.stdout,
+          "-snapshots_sensitivities on a file where one done row lacks them: refused before any snapshot, naming the point (2 ranks)")
 
 
 def bases(args):

@@ -213,12 +213,15 @@ int main(int argc, char **argv)
     PetscCallMPI(MPI_Bcast(&pid, 1, MPI_LONG, 0, PETSC_COMM_WORLD));
     const std::string base = "/tmp/rbc_test_training_set_" + std::to_string(pid);
     const std::string good = base + "_good.txt", out = base + "_out.txt", bad = base + "_bad.txt", cols = base + "_cols.txt", empty = base + "_empty.txt";
+    const std::string trail = base + "_trail.txt", twice = base + "_twice.txt";
     if (rank == 0) {
       std::ofstream(good) << "# E nu\n1.0, 0.1\n\n  1.5 0.2   # a comment\n2.0,0.3\n1.25\t0.15\n";
       std::ofstream(out) << "# header\n1.0 0.1\n2.5 0.2\n";
       std::ofstream(bad) << "1.0 0.1\n1.5 0.2\n\n1.2 zero.2x\n";
       std::ofstream(cols) << "1.0 0.1 7\n";
       std::ofstream(empty) << "# nothing\n\n";
+      std::ofstream(trail) << "1.0\n1.05,  # a trailing comma\n";
+      std::ofstream(twice) << "1.0,0.1\n1.5,,0.2\n";
     }
     PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
     ParameterSet   set;
@@ -238,13 +241,18 @@ int main(int argc, char **argv)
     PetscCall(ExpectError(two, "f_", "file with 3 columns for 2 parameters", {cols, "line 1", "3 values", "2 parameters"}));
     PetscCall(PetscOptionsSetValue(NULL, "-f_file", empty.c_str()));
     PetscCall(ExpectError(two, "f_", "file without samples", {empty, "no samples"}));
+    // an empty value beside a comma: a one-parameter file's "1.05," was read as 1.05 until 2026-12-01
+    PetscCall(PetscOptionsSetValue(NULL, "-f_file", trail.c_str()));
+    PetscCall(ExpectError(one, "f_", "one-parameter file with a trailing comma (line 2)", {trail, "line 2", "empty value after the last separator"}));
+    PetscCall(PetscOptionsSetValue(NULL, "-f_file", twice.c_str()));
+    PetscCall(ExpectError(two, "f_", "file with two commas in a row (line 2)", {twice, "line 2", "empty value before a separator"}));
     PetscCall(PetscOptionsSetValue(NULL, "-f_file", (base + "_missing.txt").c_str()));
     PetscCall(ExpectError(two, "f_", "missing file", {base + "_missing.txt", "-f_file"}));
     PetscCall(PetscOptionsClearValue(NULL, "-f_type"));
     PetscCall(PetscOptionsClearValue(NULL, "-f_file"));
     PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
     if (rank == 0)
-      for (const auto &f : {good, out, bad, cols, empty}) std::remove(f.c_str());
+      for (const auto &f : {good, out, bad, cols, empty, trail, twice}) std::remove(f.c_str());
   }
 
   int total = 0;

@@ -16,7 +16,8 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
 // exists, completes boundary labels, distributes it (-mesh_partitioner) and applies -dm_view.
 PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm);
 
-// Names of the DMLabels that come from gmsh physical groups (all labels but the standard ones).
+// Names of the DMLabels that come from gmsh physical groups (all labels but the standard ones): their union over the
+// ranks of the DM, the same on every rank. Collective.
 PetscErrorCode MeshPhysicalNames(DM dm, std::vector<std::string> *names);
 
 // Checks that a label of that name exists and is non-empty somewhere; the error names the option.

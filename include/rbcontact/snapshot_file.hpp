@@ -66,8 +66,10 @@ public:
   // they are solved, so that a run killed inside a round resumes by finishing the same picks before it builds the
   // next model (the model of a partial round would pick other parameters). Collective; rank 0 writes.
   PetscErrorCode SetPending(const std::vector<PetscInt> &picks);
-  // Whether the open file has the extra array name (/snapshots/extra/<name>), on every rank. Collective.
-  PetscErrorCode HasExtra(const std::string &name, bool *has) const;
+  // The done rows of the open file that lack the extra array name: all of them when /snapshots/extra/<name> does not
+  // exist, else those whose row is zero everywhere (never written: the dataset's fill value; a snapshot solved without
+  // it in a file another run gave it). Ascending, on every rank. Collective; rank 0 reads one row at a time.
+  PetscErrorCode RowsWithoutExtra(const std::string &name, std::vector<PetscInt> *rows) const;
   // The picks stored by the last SetPending (read by Open on a restart; empty when none), on every rank.
   const std::vector<PetscInt> &Pending() const { return pending_; }
   // Copies into this open file the done snapshots of another snapshot file of the same problem (every header

@@ -563,20 +563,44 @@ PetscErrorCode SnapshotFile::Write(const Snapshot &s)
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode SnapshotFile::HasExtra(const std::string &name, bool *has) const
+PetscErrorCode SnapshotFile::RowsWithoutExtra(const std::string &name, std::vector<PetscInt> *rows) const
 {
-  PetscMPIInt rank;
-  int         h = 0;
+  PetscMPIInt        rank;
+  std::string        err;
+  std::vector<long long> missing; // rank 0's answer, broadcast
 
   PetscFunctionBeginUser;
-  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::HasExtra: no snapshot file is open");
+  PetscCheck(open_, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "SnapshotFile::RowsWithoutExtra: no snapshot file is open");
   PetscCallMPI(MPI_Comm_rank(comm_, &rank));
   if (rank == 0) {
-    H5Quiet q;
-    h = H5Lexists((hid_t)file_, "/snapshots/extra", H5P_DEFAULT) > 0 && H5Lexists((hid_t)file_, ("/snapshots/extra/" + name).c_str(), H5P_DEFAULT) > 0;
+    H5Quiet           q;
+    Ctx               c    = FileCtx(path_);
+    const std::string dn   = "/snapshots/extra/" + name;
+    const bool        has  = H5Lexists((hid_t)file_, "/snapshots/extra", H5P_DEFAULT) > 0 && H5Lexists((hid_t)file_, dn.c_str(), H5P_DEFAULT) > 0;
+    std::vector<hsize_t> dims;
+    if (has) {
+      H5Id d(H5Dopen2((hid_t)file_, dn.c_str(), H5P_DEFAULT), H5Dclose);
+      if (!(d.ok() || c.Fail("cannot open dataset " + dn)) || !DatasetDims(c, d.get(), dn, &dims) || (dims.size() != 2 && !c.Fail("dataset " + dn + " is not ntrain x len", false))) err = c.err;
+    }
+    std::vector<double> row;
+    for (size_t i = 0; err.empty() && i < done_.size(); ++i) {
+      if (!done_[i]) continue;
+      bool written = false; // a row never written holds the dataset's fill value, 0, everywhere
+      if (has) {
+        row.assign((size_t)dims[1], 0.0);
+        if (!RowIO(c, (hid_t)file_, dn, H5T_NATIVE_DOUBLE, i, dims[1], row.data(), false)) err = c.err;
+        for (double x : row) written = written || x != 0;
+      }
+      if (!written) missing.push_back((long long)i);
+    }
   }
-  PetscCallMPI(MPI_Bcast(&h, 1, MPI_INT, 0, comm_));
-  *has = h != 0;
+  PetscCall(BcastString(comm_, &err));
+  PetscCheck(err.empty(), comm_, PETSC_ERR_FILE_READ, "%s", err.c_str());
+  long long n = (long long)missing.size();
+  PetscCallMPI(MPI_Bcast(&n, 1, MPI_LONG_LONG, 0, comm_));
+  missing.resize((size_t)n);
+  if (n) PetscCallMPI(MPI_Bcast(missing.data(), (PetscMPIInt)n, MPI_LONG_LONG, 0, comm_));
+  rows->assign(missing.begin(), missing.end());
   PetscFunctionReturn(0);
 }
 
@@ -761,6 +785,19 @@ bool ReadAllH5(Ctx &c, const std::string &path, SnapshotHeader *hOut, std::vecto
         return true;
       };
       ok = ok && finite("/snapshots/mu", s.mu) && finite("/snapshots/u", s.u) && finite("/snapshots/lambda", s.lambda);
+      // the provenance of a finished row: its solve time (validate's FOM time and speedup with -test_snapshots: a NaN
+      // there made them NaN) and its KKT residuals (NaN: not given), norms >= 0
+      auto provenance = [&](const std::string &name, const std::vector<PetscReal> &x, bool nanAllowed) {
+        for (size_t k = 0; k < x.size(); ++k)
+          if (!(std::isnan(x[k]) && nanAllowed) && !(x[k] >= 0 && x[k] < 1e150)) {
+            std::ostringstream m;
+            m << "row " << i << " (training point " << i + 1 << " of " << done.size() << ") of " << name << " holds " << x[k] << " (entry " << k << ") although the row is marked done; "
+              << (nanAllowed ? "a KKT residual is a norm (NaN: not given)" : "a solve time is a finite number of seconds >= 0") << ": the file is corrupt; recompute that snapshot (-snapshots_restart 0 recomputes all, or clear /snapshots/done[" << i << "])";
+            return c.Fail(m.str(), false);
+          }
+        return true;
+      };
+      ok = ok && provenance("/snapshots/seconds", {s.seconds}, false) && provenance("/snapshots/kkt", s.kkt, true);
       for (const auto &e : s.extra) ok = ok && finite("/snapshots/extra/" + e.first, e.second);
       // the row's parameter is its training point (resumed and imported rows are matched to 1e-14), and its
       // multipliers are those of a contact solution (>= 0): a row that says otherwise would build the bases wrong

@@ -282,7 +282,10 @@ PetscErrorCode GlobalPointCount(DM dm, bool cells, PetscInt *n)
 
 PetscErrorCode MeshPhysicalNames(DM dm, std::vector<std::string> *names)
 {
-  PetscInt n;
+  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
+  PetscInt    n;
+  PetscMPIInt size;
+  std::string mine; // this rank's names, one per line
 
   PetscFunctionBeginUser;
   names->clear();
@@ -292,7 +295,21 @@ PetscErrorCode MeshPhysicalNames(DM dm, std::vector<std::string> *names)
     PetscCall(DMGetLabelName(dm, l, &name));
     const std::string s(name);
     if (s == "depth" || s == "celltype" || s == "Cell Sets" || s == "Face Sets" || s == "Vertex Sets" || s == "Edge Sets" || s == "marker") continue;
-    names->push_back(s);
+    mine += s + "\n";
+  }
+  // the union over the ranks, in order of first appearance (a rank may lack a label: on 2 ranks the "does not exist"
+  // message of rank 1 listed no names until 2026-12-01)
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  std::vector<int> len((size_t)size), off((size_t)size + 1, 0);
+  const int        m = (int)mine.size();
+  PetscCallMPI(MPI_Allgather(&m, 1, MPI_INT, len.data(), 1, MPI_INT, comm));
+  for (PetscMPIInt r = 0; r < size; ++r) off[r + 1] = off[r] + len[r];
+  std::string all((size_t)off[size], '\0');
+  PetscCallMPI(MPI_Allgatherv(mine.data(), m, MPI_CHAR, &all[0], len.data(), off.data(), MPI_CHAR, comm));
+  for (size_t a = 0, b; a < all.size(); a = b + 1) {
+    b = all.find('\n', a);
+    const std::string s = all.substr(a, b - a);
+    if (std::find(names->begin(), names->end(), s) == names->end()) names->push_back(s);
   }
   PetscFunctionReturn(0);
 }

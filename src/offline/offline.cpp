@@ -305,11 +305,17 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     for (PetscInt i = 0; i < ntrain; ++i)
       if (std::find(done.begin(), done.end(), i) == done.end()) todo.push_back(i);
     if (!restart) PetscCheck((PetscInt)done.size() == imported, world, PETSC_ERR_PLIB, "new snapshot file with done entries");
-    if (s.sensitivities && (PetscInt)done.size() > imported) {
-      // (a file solved without them was refused only by the bases step, after every remaining snapshot was solved)
-      bool has;
-      PetscCall(file.HasExtra("sensitivity_u", &has));
-      PetscCheck(has, world, PETSC_ERR_FILE_UNEXPECTED, "-snapshots_sensitivities: the %zu finished snapshots of %s were solved without sensitivities: drop the option, or solve them again in a new file (-snapshots_restart 0)", done.size() - (size_t)imported, snapPath);
+    if (s.sensitivities && !done.empty()) {
+      // a file solved without them, or in part without them (a run resumed without the option: its rows read zeros),
+      // was refused only by the bases step, after every remaining snapshot was solved
+      std::vector<PetscInt> without;
+      PetscCall(file.RowsWithoutExtra("sensitivity_u", &without));
+      if (!without.empty()) {
+        std::string rows;
+        for (size_t k = 0; k < without.size() && k < 8; ++k) rows += (k ? ", " : "") + std::to_string(without[k] + 1);
+        if (without.size() > 8) rows += ", ...";
+        SETERRQ(world, PETSC_ERR_FILE_UNEXPECTED, "-snapshots_sensitivities: %zu of the %zu finished snapshots of %s were solved without sensitivities (training points %s): drop the option, or solve them again in a new file (-snapshots_restart 0)", without.size(), done.size(), snapPath, rows.c_str());
+      }
     }
 
     // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], and with

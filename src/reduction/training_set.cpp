@@ -83,6 +83,20 @@ std::string ReadSampleFile(const std::string &path, const std::string &option, c
   for (long lineno = 1; std::getline(f, line); ++lineno) {
     const auto hash = line.find('#');
     if (hash != std::string::npos) line.erase(hash);
+    // a comma or semicolon separates values: an empty field beside one ("1.0," in a one-parameter file read as 1.0, or a
+    // value lost in "0.9,,0.1") is refused, as an empty entry of a list option is
+    if (line.find_first_of(",;") != std::string::npos) {
+      size_t start = 0;
+      for (size_t k = 0; k <= line.size(); ++k) {
+        if (k < line.size() && line[k] != ',' && line[k] != ';') continue;
+        if (line.find_first_not_of(" \t\r", start) >= k) {
+          std::ostringstream m;
+          m << "Parameter sample file '" << path << "' line " << lineno << ": an empty value " << (k == line.size() ? "after the last" : "before a") << " separator (a comma too many?)";
+          return m.str();
+        }
+        start = k + 1;
+      }
+    }
     for (char &c : line)
       if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
     std::istringstream     ss(line);
