@@ -365,6 +365,16 @@ def warnings(args):
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-dirichlet_ring_top_u", "0,-0.3"] + args.extra, "deep")
     w = [s for s in r["warnings"] if "reaches the end of the slave surface" in s]
     check(len(w) == 2 and r["nactive"] == r["ncontact"], "push 0.3: the whole slave surface in contact (%d/%d), 2 end warnings (%d)" % (r["nactive"], r["ncontact"], len(w)))
+    # 3D (until 2026-12-01 2D only): a sphere's slave cap of radius 0.15 inside its contact zone (~0.2): every slave
+    # node active, the pressure 3x the cap of 0.3's, no word; the flat punch's face ends at the body's edges: no warning
+    r, _ = run(args, args.np, "runs/sphere_block3d.opts", ["-mesh_geo_set", "h_fine=0.08,h_far=1.2,rc=0.15"] + args.extra, "cap015")
+    w = [s for s in r["warnings"] if "reaches the edge of the slave surface" in s]
+    check(len(w) == 1 and r["nactive"] == r["ncontact"], "3D, slave cap 0.15 inside the contact zone (%d/%d active): one edge warning (%s)" % (r["nactive"], r["ncontact"], r["warnings"]))
+    r, _ = run(args, args.np, "runs/sphere_block3d.opts", ["-mesh_geo_set", "h_fine=0.08,h_far=1.2,rc=0.3"] + args.extra, "cap03")
+    check(r["warnings"] == [] and r["nactive"] < r["ncontact"], "3D, slave cap 0.3 (contact inside it): no warning (%s)" % r["warnings"])
+    r, _ = run(args, args.np, "runs/flat_punch3d.opts", args.extra, "punch3d")
+    check(r["nactive"] == r["ncontact"] and r["warnings"] == [] and r["contact_halfwidth"] is None,
+          "3D flat punch, whole face in contact, ending at the body's edges: no warning (%s); the 2D half-width null" % r["warnings"])
     r, _ = run(args, args.np, "runs/ring_on_block.opts", ["-body_nu", "0.4999"] + args.extra, "nu")
     w = [s for s in r["warnings"] if "-fem_degree 2" in s and "lock" in s]
     check(len(w) == 2, "P1, nu = 0.4999: a locking warning per body (%d)" % len(w))

@@ -370,6 +370,10 @@ def bad_input(args):
     lin = report(d + "/lin.json")
     check(lin["converged"] and lin["kacanov_iterations"] == 1, "-rom_kacanov_max_it 1: the linearized reduced model (1 iterate, converged)")
     expect_error(args, ["-rom", rom, "-rom_kacanov_relaxation", "1.5"], ["-rom_kacanov_relaxation", "1.5"], "-rom_kacanov_relaxation out of range")
+    # a tiny relaxation: the residual is tested, not the relaxed step (which met the tolerance at the first iterate:
+    # the warm start returned as converged, exit 0, until 2026-12-01; audit of that day)
+    expect_error(args, ["-rom", rom, "-mu", "1.12", "-rom_kacanov_relaxation", "1e-4"], ["did not converge", "-rom_kacanov_max_it"], "-rom_kacanov_relaxation 1e-4 from the warm start")
+    expect_error(args, ["-rom", rom, "-mu", "1.12", "-rom_warm_start", "0", "-rom_kacanov_relaxation", "1e-300"], ["did not converge"], "-rom_kacanov_relaxation 1e-300 without a warm start")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
     expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")
     # scene options that contradict the ROM were ignored without a word (the ROM's own answer, exit 0; audit 2026-11-29)

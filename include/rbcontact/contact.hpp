@@ -147,13 +147,14 @@ public:
   // the same on every rank.
   PetscErrorCode SurfaceDofs(MPI_Comm comm, std::vector<PetscInt> *D) const;
   // Multiplier rows of the slave vertices that end the slave surface (2D: the vertices of a single
-  // slave facet; 3D: none yet) and, per such row, the unit outward normal (reference mesh) of the body's
-  // boundary facet that continues the surface there (zero if none), the same on every rank (from Setup).
+  // slave facet; 3D: the vertices of an edge of a single slave facet) and, per such row, the unit outward normal
+  // (reference mesh; 3D: of the sum of them) of the body's boundary facets that continue the surface there (zero if
+  // none), the same on every rank (from Setup).
   const std::vector<PetscInt> &SlaveEndRows() const { return endRows_; }
   // 2D: multiplier rows (global, gathered on every rank) with an integration point that the last Assemble
   // projected past an end of the master surface (clamped to its end vertex, beyond it along the surface).
   PetscErrorCode PastMasterEndRows(MPI_Comm comm, std::vector<PetscInt> *rows) const;
-  const std::vector<std::array<PetscReal, 2>> &SlaveEndNextNormals() const { return endNext_; }
+  const std::vector<std::array<PetscReal, 3>> &SlaveEndNextNormals() const { return endNext_; }
   const ContactSurface &Slave() const { return slave_; }
   const ContactSurface &Master() const { return master_; }
   // Reference facet rule: barycentric points (dim per point) and weights summing to 1.
@@ -203,7 +204,7 @@ private:
     PetscReal b[3] = {0, 0, 0}, w = 0, bm[3] = {0, 0, 0};
   };
   std::vector<IntegrationPoint> points_; // the integration points of the last Assemble (AssembleTangent)
-  std::vector<std::array<PetscReal, 2>> endNext_;
+  std::vector<std::array<PetscReal, 3>> endNext_;
 };
 
 } // namespace rbc

@@ -29,7 +29,9 @@ public:
   // keeps a distributed state and calls Record with its own changes).
   void Begin(PetscInt n);
   // g (n values, the image of the input x) <- x + relaxation (g - x); returns the primal change
-  // |g - x| / |x| (l2; infinite when x = 0 and g != 0, 0 when both vanish).
+  // |g - x| / |x| of the image before the relaxation (l2; infinite when x = 0 and g != 0, 0 when both vanish): the
+  // fixed-point residual, whatever the relaxation (the relaxed step, relaxation |g - x|, met the tolerance at the first
+  // iterate with a relaxation of 1e-4 and returned the warm start as converged until 2026-12-01).
   PetscReal Relax(const PetscReal *x, PetscReal *g) const;
   // Records iterate k (du, dl, nactive of R), prints the monitor line (detail: backend's text or null) and
   // sets *converged: du <= rtolPrimal and dl <= rtolDual, or maxIt == 1 (the linearized model).

@@ -25,6 +25,8 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscCall(PetscOptionsReal("-hertz_radius", "Compare with Hertz's contact of a cylinder (2D) or a sphere (3D) of this radius", "docs/contact.md", hertzRadius, &hertzRadius, &hertz));
   PetscCall(PetscOptionsBool("-fom_affine", "Assemble A(mu), f(mu) from the affine terms (default with parameters)", "docs/reference_configuration.md", affine, &affine, &affineSet));
   PetscOptionsEnd();
+  // a radius <= 0 or not finite gave a negative or NaN Hertz contact radius in the report, exit 0
+  PetscCheck(!hertz || (std::isfinite(hertzRadius) && hertzRadius > 0), comm, PETSC_ERR_ARG_OUTOFRANGE, "-hertz_radius %g must be a finite number > 0 (the radius of Hertz's cylinder in 2D, sphere in 3D)", (double)hertzRadius);
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, outPath, "-fom_output"));
   PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-fom_output", outPath}, {"-fom_output's XDMF", outPath[0] ? XdmfPath(outPath) : ""}}, {}));
@@ -98,7 +100,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
     rep.root["nactive"]            = (long long)cs.nactive;
     rep.root["contact_force"]      = (double)cs.force;
     rep.root["max_pressure"]       = (double)cs.maxPressure;
-    rep.root["contact_halfwidth"]  = (double)cs.halfwidth;
+    rep.root["contact_halfwidth"]  = fom.elas.dim == 2 ? (double)cs.halfwidth : std::nan(""); // 2D only (null in 3D: it read 0)
     rep.root["contact_halfwidth_moment"] = (double)cs.halfwidthMoment; // 2 sqrt(int p s^2 / int p - ...): Hertz's a; the ROM's online half-width
     if (fom.elas.dim == 2) { // along the surface: 2D only (in 3D they would read 0: absent instead)
       rep.root["pressure_spread"]    = (double)cs.pressureSpread;
@@ -129,7 +131,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
       else HertzLineContact(scene, hertzRadius, cs.force, &a, &p0);                      // a cylinder
       JsonValue &hz  = rep.root["hertz"];
       hz["a"]        = (double)cs.halfwidthMoment; // from the pressure's second moment (docs/contact.md)
-      hz["a_nodes"]  = (double)cs.halfwidth;       // half the extent of the active nodes
+      hz["a_nodes"]  = fom.elas.dim == 2 ? (double)cs.halfwidth : std::nan(""); // half the extent of the active nodes (2D)
       hz["a_exact"]  = (double)a;
       hz["p0"]       = (double)cs.maxPressure;
       hz["p0_exact"] = (double)p0;

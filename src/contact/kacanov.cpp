@@ -574,7 +574,9 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(VecNorm(rhs, NORM_2, &nrhs));
     PetscCall(MatNorm(sys.K, NORM_FROBENIUS, &nK));
     const PetscReal lamScale = nK > 0 ? 1e-6 * nrhs / nK : 0.0;
-    const PetscReal dl = lamPrev ? KacanovLoop::RelChange(ndl, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
+    // (the multipliers of two relaxed inputs: their change scales with the relaxation, so it is taken back out, as
+    // KacanovLoop::Relax measures the primal residual before the relaxation)
+    const PetscReal dl = lamPrev ? KacanovLoop::RelChange(ndl / loop.relaxation, std::max(nlp, lamScale), nl) : (nl == 0 && lamScale == 0 ? 0.0 : kInf);
     iterations = k;
     char detail[320] = "";
     if (loop.monitor && saddle)
@@ -720,17 +722,27 @@ static PetscErrorCode MeshRatioWarning(MPI_Comm comm, const ContactMap &map, con
   PetscFunctionReturn(0);
 }
 
+// "(x, y)" or "(x, y, z)" for a message, as the stream writes each number.
+static std::string Point(PetscReal x, PetscReal y, PetscReal z, PetscInt dim)
+{
+  std::ostringstream o;
+  o << "(" << x << ", " << y;
+  if (dim == 3) o << ", " << z;
+  o << ")";
+  return o.str();
+}
+
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
-  std::vector<PetscReal> lam, x[3], n[2];
+  std::vector<PetscReal> lam, x[3], n[3];
   const ContactSystem   &sys = kac.sys;
   const PetscInt         dim = map.Slave().dim;
 
   PetscFunctionBeginUser;
   if (kac.initialPenetrating > 0) {
     std::ostringstream o;
-    o << "initial overlap: " << kac.initialPenetrating << " slave node(s) lie inside the master body before any deformation (deepest " << kac.initialPenetration << " at (" << kac.initialPenetrationAt[0] << ", " << kac.initialPenetrationAt[1]
-      << ")); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
+    o << "initial overlap: " << kac.initialPenetrating << " slave node(s) lie inside the master body before any deformation (deepest " << kac.initialPenetration << " at " << Point(kac.initialPenetrationAt[0], kac.initialPenetrationAt[1], kac.initialPenetrationAt[2], dim)
+      << "); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
     warnings->push_back(o.str());
   }
   // gathered once for the three checks below: multipliers, their largest value, slave vertex coordinates
@@ -752,7 +764,7 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
       }
     if (nact > 0) {
       std::ostringstream o;
-      o << "the contact zone runs past an end of the master surface: " << nact << " active slave node(s) lie beyond it (e.g. the node at (" << x[0][worst] << ", " << x[1][worst] << ") of the undeformed configuration, pressure " << lam[worst]
+      o << "the contact zone runs past an end of the master surface: " << nact << " active slave node(s) lie beyond it (e.g. the node at " << Point(x[0][worst], x[1][worst], dim == 3 ? x[2][worst] : 0, dim) << " of the undeformed configuration, pressure " << lam[worst]
         << "); their contact is measured to the master's end vertex, not to the body beyond it: declare a larger master surface";
       warnings->push_back(o.str());
     }
@@ -760,19 +772,31 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
   const auto &ends = map.SlaveEndRows();
   const auto &next = map.SlaveEndNextNormals();
   if (ends.empty()) PetscFunctionReturn(0);
-  for (int d = 0; d < 2; ++d) PetscCall(GatherVec(sys.normal[d], &n[d]));
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.normal[d], &n[d]));
+  PetscInt nfacing = 0, worst = -1;
   for (size_t e = 0; e < ends.size(); ++e) {
     const PetscInt r = ends[e];
     // the body's boundary continuing past the end faces the master (its outward normal against the
     // master's, which points to the slave): contact there is possible but not enforced. A surface that
     // ends at a corner of its body (a flat punch's edge: the next side is parallel to the master normal) is not.
-    const bool facing = next[e][0] * n[0][r] + next[e][1] * n[1][r] < -0.5;
-    if (facing && active(r)) {
-      std::ostringstream o;
-      o << "the contact zone reaches the end of the slave surface at (" << x[0][r] << ", " << x[1][r] << ") (pressure " << lam[r] << " there, max " << lmax
-        << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
-      warnings->push_back(o.str());
+    PetscReal dot = 0;
+    for (PetscInt d = 0; d < dim; ++d) dot += next[e][d] * n[d][r];
+    if (dot < -0.5 && active(r)) {
+      ++nfacing;
+      if (worst < 0 || lam[r] > lam[worst]) worst = r;
+      if (dim == 2) { // (2D: two ends at most, each named)
+        std::ostringstream o;
+        o << "the contact zone reaches the end of the slave surface at (" << x[0][r] << ", " << x[1][r] << ") (pressure " << lam[r] << " there, max " << lmax
+          << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
+        warnings->push_back(o.str());
+      }
     }
+  }
+  if (dim == 3 && nfacing > 0) { // one warning for the edge's nodes
+    std::ostringstream o;
+    o << "the contact zone reaches the edge of the slave surface: " << nfacing << " active node(s) on it (e.g. at " << Point(x[0][worst], x[1][worst], x[2][worst], 3) << ", pressure " << lam[worst] << " there, max " << lmax
+      << "): contact beyond the declared surface is not enforced and the bodies may interpenetrate there; declare a larger slave (and master) surface";
+    warnings->push_back(o.str());
   }
   PetscFunctionReturn(0);
 }

@@ -48,10 +48,11 @@ PetscReal KacanovLoop::Relax(const PetscReal *x, PetscReal *g) const
 {
   PetscReal nx = 0, ng = 0, nd = 0;
   for (PetscInt i = 0; i < n_; ++i) {
-    g[i] = x[i] + relaxation * (g[i] - x[i]);
+    const PetscReal d = g[i] - x[i]; // the residual, before the relaxation (its square does not underflow with it)
+    g[i]              = x[i] + relaxation * d;
     nx += x[i] * x[i];
     ng += g[i] * g[i];
-    nd += (g[i] - x[i]) * (g[i] - x[i]);
+    nd += d * d;
   }
   return RelChange(std::sqrt(nd), std::sqrt(nx), std::sqrt(ng));
 }

@@ -228,7 +228,8 @@ PetscErrorCode GeometryMap::CheckDimension(MPI_Comm comm, PetscInt dim) const
 {
   PetscFunctionBeginUser;
   for (const auto &n : needs_) {
-    if (n.coordinates) PetscCheck(n.value >= dim, comm, PETSC_ERR_USER_INPUT, "%s has %" PetscInt_FMT " coordinate(s); the mesh is %" PetscInt_FMT "D: give %" PetscInt_FMT, n.option.c_str(), n.value, dim, dim);
+    // fewer were padded with 0 (another map); more in 2D dropped the third (a translation along z did nothing), exit 0
+    if (n.coordinates) PetscCheck(n.value == dim, comm, PETSC_ERR_USER_INPUT, "%s has %" PetscInt_FMT " coordinate(s); the mesh is %" PetscInt_FMT "D: give %" PetscInt_FMT, n.option.c_str(), n.value, dim, dim);
     else PetscCheck(n.value < dim, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": the mesh is %" PetscInt_FMT "D (axes 0 to %" PetscInt_FMT ")", n.option.c_str(), n.value, dim, dim - 1);
   }
   PetscFunctionReturn(0);

@@ -1141,17 +1141,16 @@ PetscErrorCode ReducedModel::SolveLoop(const std::vector<PetscReal> &mu, Reduced
     const PetscReal du = loop.Relax(vprev.data(), sol->v.data());
     PetscInt        nact = 0;
     PetscReal       nl = 0, dln = 0;
+    // changes of the multiplier field W lambda^ (the FOM's rule), in the Gram matrix W'W: the QP's multipliers
+    // against the input's, before the relaxation (as the primal change, KacanovLoop::Relax)
+    for (PetscInt i = 0; i < r; ++i)
+      for (PetscInt j = 0; j < r; ++j) dln += (sol->lambda[i] - lprev[i]) * dualGram[(size_t)i * Rfull + j] * (sol->lambda[j] - lprev[j]);
     for (PetscInt i = 0; i < r; ++i) {
       sol->lambda[i] = lprev[i] + loop.relaxation * (sol->lambda[i] - lprev[i]);
       nact += sol->lambda[i] > 0;
     }
-    // changes of the multiplier field W lambda^ (the FOM's rule), in the Gram matrix W'W
     for (PetscInt i = 0; i < r; ++i)
-      for (PetscInt j = 0; j < r; ++j) {
-        const PetscReal g = dualGram[(size_t)i * Rfull + j];
-        nl += sol->lambda[i] * g * sol->lambda[j];
-        dln += (sol->lambda[i] - lprev[i]) * g * (sol->lambda[j] - lprev[j]);
-      }
+      for (PetscInt j = 0; j < r; ++j) nl += sol->lambda[i] * dualGram[(size_t)i * Rfull + j] * sol->lambda[j];
     nl  = std::max<PetscReal>(nl, 0);
     dln = std::max<PetscReal>(dln, 0);
     const PetscReal dl = nl > 0 ? std::sqrt(dln / nl) : std::sqrt(dln);
