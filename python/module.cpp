@@ -6,6 +6,7 @@
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
 #include "rbcontact/options_files.hpp"
 #include "rbcontact/rom_probe.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/offline.hpp"
 #include "rbcontact/reduced_model.hpp"
 #include "rbcontact/validation.hpp"
@@ -250,6 +251,7 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
       Check(PetscOptionsGetString(NULL, NULL, "-rom", romPath, sizeof romPath, NULL));
       if (!romPath[0]) throw std::runtime_error("rbcontact.probe: give the ROM file (rom=...)");
       Check(rbc::CheckDistinctFiles(PETSC_COMM_WORLD, {{"-report", reportPath}}, {{"-rom", romPath}}));
+      Check(rbc::CheckSceneOptions(PETSC_COMM_WORLD, "probe", romPath)); // as the command line's probe
       rbc::ProbeSummary ps;
       rep.root["stage"] = "probe";
       Check(rbc::ProbeRomFile(PETSC_COMM_WORLD, romPath, 1000, &rep.root["probe"], &ps));
@@ -262,7 +264,7 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
   }
   // options of this call nobody read (a misspelled keyword: trian_size=5 ran the file's 21 points without a word)
   std::vector<std::string> unused;
-  Check(rbc::UnusedOptions(stage, &unused));
+  Check(rbc::UnusedOptions(stage, &unused, options));
   if (!unused.empty()) {
     rbc::JsonValue &w = rep.root["warnings"];
     for (const auto &u : unused) {

@@ -381,6 +381,18 @@ def bad_input(args):
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-body_E", "200,100"], ["was built for another configuration of scene 'ring_on_block'"],
                  "online with the scene's options and another -body_E")
     run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts"])  # the scene it was built with: accepted
+    # another scene's options file with a -mu right for that scene: the scene named, not -mu (audit of 2026-12-01)
+    expect_error(args, ["-rom", rom, "-mu", "1.0,0.09", "-options_file", "runs/half_disks.opts"], ["the scene of the options is 'half_disks'", "was built for 'ring_on_block'"],
+                 "online with another scene's options file and its -mu")
+    # probe took scene options and another scene's file without a word (audit of 2026-12-01): checked as online's
+    expect_error(args, ["-rom", rom, "-probe_size", "5", "-body_E", "200,100"], ["probe: option -body_E is a scene option"], "probe -body_E without the scene", stage="probe")
+    expect_error(args, ["-rom", rom, "-probe_size", "5", "-options_file", "runs/half_disks.opts"], ["the scene of the options is 'half_disks'"], "probe with another scene's options file", stage="probe")
+    # misspelled options on the command line of online and probe (-mmu 1.1 solved at the default radius, exit 0, no word)
+    for stage, words, name in (("online", ["-rom", rom, "-mmu", "1.1"], "-mmu 1.1"), ("probe", ["-rom", rom, "-probe_size", "5", "-prob_size", "7"], "-prob_size 7")):
+        p = run(args, 1, stage, words)
+        check("option %s was not used by the %s stage" % (name, stage) in p.stdout, "%s %s (misspelled): warned by name" % (stage, name))
+    p = run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts"])
+    check("was not used" not in p.stdout, "online with its scene's options file: the file's other options (-fom_*, -train_*, ...) not reported")
     expect_error(args, ["-rom", rom, "-rom_kacanov_anderson", "11"], ["-rom_kacanov_anderson", "11"], "-rom_kacanov_anderson out of range")
     expect_error(args, ["-rom", rom, "-rom_warm_start_degree", "3"], ["-rom_warm_start_degree", "3"], "-rom_warm_start_degree out of range")
     # Anderson mixing (default depth 3) and the plain fixed point reach the same reduced solution
@@ -1271,6 +1283,18 @@ def files(args):
     offline(args, d2, np_=1, extra=small)
     p = run(args, 1, "validate", val + ["-rom_basis", d2 + "/rom.basis.h5"], expect_ok=False)
     check(p.returncode != 0 and "was not written by the offline run of the ROM" in p.stdout, "basis file of another offline run: refused (rom_id), exit %d" % p.returncode)
+    # ... also without its rom_id attribute (the check was skipped when either file lacked one: audit of 2026-12-01)
+    shutil.copy(d2 + "/rom.basis.h5", d2 + "/noid.basis.h5")
+    with h5py.File(d2 + "/noid.basis.h5", "r+") as f:
+        del f.attrs["rom_id"]
+    p = run(args, 1, "validate", val + ["-rom_basis", d2 + "/noid.basis.h5"], expect_ok=False)
+    check(p.returncode != 0 and "noid.basis.h5 has no rom_id, the ROM" in p.stdout, "basis file of another run without its rom_id: refused, exit %d" % p.returncode)
+    # a ROM moved without its basis file: named as the basis file, where it was looked for, and -rom_basis
+    os.makedirs(d2 + "/alone")
+    shutil.copy(rom, d2 + "/alone/rom.h5")
+    p = run(args, 1, "validate", [v if v != rom else d2 + "/alone/rom.h5" for v in val], expect_ok=False)
+    check(p.returncode != 0 and "the basis file of the ROM" in p.stdout and "is neither beside it" in p.stdout and "-rom_basis" in p.stdout,
+          "a ROM without its basis file: the message names the basis file and -rom_basis, exit %d" % p.returncode)
     # an offline run that fails in its last step leaves the previous pair as it was
     for np_ in (1, 2):
         p = run(args, np_, "offline", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-ecsw_max_points", "1"] + small, expect_ok=False)

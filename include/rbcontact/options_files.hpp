@@ -22,7 +22,9 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse();
 
 // After a stage ran: the options of the database in use (PETSc's default one, or a pushed one) that nobody read, as
 // messages ("option -trian_size 5 was not used by the offline stage (misspelled? ...)"), leaving out the families of
-// the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...).
-PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused);
+// the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...). given: the words given
+// directly (the command line, the Python keywords): online, probe and dualbasis leave out every option of a scene file but
+// their own families, not those given directly.
+PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused, const std::vector<std::string> &given = {});
 
 } // namespace rbc

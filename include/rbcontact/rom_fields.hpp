@@ -32,6 +32,10 @@ std::string SceneFingerprint(const SceneSpec &s, const GeometryMap &map);
 std::string SceneHashHex(const SceneSpec &s, const GeometryMap &map);
 // The ROM at romPath belongs to this scene as configured now (name and scene_hash); else a clear error.
 PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const SceneSpec &scene, const GeometryMap &map);
+// Scene options given to a stage that solves a ROM as it was built (online without -rom_reconstruct, probe): an options
+// file of a scene, -body_E 200,100 were ignored without a word (the ROM's own answer). With -scene they are checked
+// against the ROM (its scene name first, then CheckRomScene); without it, a scene option is refused by name.
+PetscErrorCode CheckSceneOptions(MPI_Comm comm, const std::string &stage, const std::string &romPath);
 
 // The contact system at the default parameter and u = 0 (Dirichlet values lifted); numbers order's
 // multipliers if needed. Its weight is the slave mass int psi_i of the reference configuration.

@@ -31,12 +31,12 @@ static const char help[] = "rbcontact: reduced-basis model reduction of friction
                            "Options of each stage: README.md and docs/ (contact.md, reference_configuration.md, offline.md, bases.md, eim.md, online.md).\n";
 
 // After a successful stage: a warning per option nobody read (misspelled, or for another solver).
-static PetscErrorCode WarnUnusedOptions(const std::string &stage)
+static PetscErrorCode WarnUnusedOptions(const std::string &stage, const std::vector<std::string> &given)
 {
   std::vector<std::string> unused;
 
   PetscFunctionBeginUser;
-  PetscCall(rbc::UnusedOptions(stage, &unused));
+  PetscCall(rbc::UnusedOptions(stage, &unused, given));
   for (const auto &u : unused) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: warning: %s\n", u.c_str()));
   PetscFunctionReturn(0);
 }
@@ -207,6 +207,7 @@ int main(int argc, char **argv)
       return (int)PETSC_ERR_FILE_OPEN;
     }
   }
+  const std::vector<std::string> given(argv + 1, argv + argc); // the options given on the command line (WarnUnusedOptions)
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(OneBlasThreadPerRank());
   {
@@ -251,7 +252,7 @@ int main(int argc, char **argv)
     (void)SlepcFinalize();
     return (int)ierr;
   }
-  PetscCall(WarnUnusedOptions(stage));
+  PetscCall(WarnUnusedOptions(stage, given));
   PetscCallMPI(MPI_Comm_free(&exitComm));
   PetscCall(SlepcFinalize());
   return 0;

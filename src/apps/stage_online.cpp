@@ -17,31 +17,6 @@
 
 namespace rbc {
 
-// Scene options given to online (an options file of a scene, -body_E 200,100) were ignored without a word: the ROM
-// answers for the configuration it was built with. With -scene they are checked against the ROM's scene hash, as
-// validate does; without it, a scene option is refused by name.
-static PetscErrorCode CheckSceneOptions(MPI_Comm comm, const char *romPath)
-{
-  static const char *const sceneFamilies[] = {"-scene", "-bodies", "-body_", "-mesh_file", "-mesh_refine", "-mesh_clscale", "-mesh_geo_set", "-dirichlet", "-traction", "-contact_slave",
-                                              "-contact_master", "-mu_names", "-mu_min", "-mu_max", "-mu_default", "-mu_geo_set", "-map_", "-fem_degree", "-param_"};
-  std::string first;
-  PetscBool   hasScene = PETSC_FALSE;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-scene", &hasScene));
-  for (const auto &o : OptionsInUse())
-    for (const char *f : sceneFamilies)
-      if (first.empty() && o.first.compare(0, std::strlen(f), f) == 0) first = o.first;
-  if (first.empty()) PetscFunctionReturn(0);
-  PetscCheck(hasScene, comm, PETSC_ERR_USER_INPUT, "online: option %s is a scene option, but online solves the ROM %s as it was built (its scene's options are stored in it); give the whole scene (-options_file runs/<scene>.opts) to have them checked against the ROM, or leave them out", first.c_str(), romPath);
-  SceneSpec   scene;
-  GeometryMap map;
-  PetscCall(SceneSpecFromOptions(comm, &scene));
-  PetscCall(map.SetFromOptions(comm, scene));
-  PetscCall(CheckRomScene(comm, romPath, scene, map));
-  PetscFunctionReturn(0);
-}
-
 PetscErrorCode StageOnline(MPI_Comm comm)
 {
   char           romPath[PETSC_MAX_PATH_LEN] = "", reportPath[PETSC_MAX_PATH_LEN] = "", recPath[PETSC_MAX_PATH_LEN] = "";
@@ -84,7 +59,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   PetscCall(PetscTime(&t0));
   PetscCall(model.Open(romPath));
   PetscCall(model.SetFromOptions());
-  if (!recPath[0]) PetscCall(CheckSceneOptions(comm, romPath)); // (-rom_reconstruct checks the scene itself)
+  if (!recPath[0]) PetscCall(CheckSceneOptions(comm, "online", romPath)); // (-rom_reconstruct checks the scene itself)
   PetscCall(PetscTime(&t1));
   const double tOpen = t1 - t0;
   // mu: -mu values, default the parameters' defaults

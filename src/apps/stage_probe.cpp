@@ -4,6 +4,7 @@
 // code) when the reduced loop fails at a probe parameter, naming the first with its `online -mu`.
 #include "stages.hpp"
 #include "rbcontact/report.hpp"
+#include "rbcontact/rom_fields.hpp"
 #include "rbcontact/rom_probe.hpp"
 
 namespace rbc {
@@ -23,6 +24,7 @@ PetscErrorCode StageProbe(MPI_Comm comm)
   PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "probe: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}}, {{"-rom", romPath}}));
+  PetscCall(CheckSceneOptions(comm, "probe", romPath)); // (another scene's options file, -body_E: ignored without a word before)
   rep.root["stage"] = "probe";
   PetscCall(ProbeRomFile(comm, romPath, 1000, &rep.root["probe"], &ps));
   const JsonValue &p = rep.root["probe"];

@@ -2,6 +2,8 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_file.hpp"
+#include "rbcontact/options_files.hpp"
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -65,6 +67,33 @@ PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const Sc
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode CheckSceneOptions(MPI_Comm comm, const std::string &stage, const std::string &romPath)
+{
+  static const char *const sceneFamilies[] = {"-scene", "-bodies", "-body_", "-mesh_file", "-mesh_refine", "-mesh_clscale", "-mesh_geo_set", "-dirichlet", "-traction", "-contact_slave",
+                                              "-contact_master", "-mu_names", "-mu_min", "-mu_max", "-mu_default", "-mu_geo_set", "-map_", "-fem_degree", "-param_"};
+  std::string first;
+  char        sceneName[256] = "";
+  PetscBool   hasScene       = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-scene", sceneName, sizeof sceneName, &hasScene));
+  for (const auto &o : OptionsInUse())
+    for (const char *f : sceneFamilies)
+      if (first.empty() && o.first.compare(0, std::strlen(f), f) == 0) first = o.first;
+  if (first.empty()) PetscFunctionReturn(0);
+  PetscCheck(hasScene, comm, PETSC_ERR_USER_INPUT, "%s: option %s is a scene option, but %s solves the ROM %s as it was built (its scene's options are stored in it); give the whole scene (-options_file runs/<scene>.opts) to have them checked against the ROM, or leave them out", stage.c_str(), first.c_str(), stage.c_str(), romPath.c_str());
+  // the scene's name first: another scene's options file was blamed on -mu ("the scene has 1 parameters") before
+  std::string romScene;
+  PetscCall(RomReadAttr(romPath, "scene", &romScene));
+  PetscCheck(romScene == sceneName, comm, PETSC_ERR_USER_INPUT, "the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", sceneName, romPath.c_str(), romScene.c_str(), romScene.c_str());
+  SceneSpec   scene;
+  GeometryMap map;
+  PetscCall(SceneSpecFromOptions(comm, &scene));
+  PetscCall(map.SetFromOptions(comm, scene));
+  PetscCall(CheckRomScene(comm, romPath, scene, map));
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const std::string &romPath, PetscInt nd, PetscInt nmult)
 {
   std::vector<unsigned long long> dims;
@@ -73,23 +102,32 @@ PetscErrorCode RomBases::Read(MPI_Comm comm, const ReducedModel &model, const st
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", buf, sizeof buf, &set));
-  if (set) path = buf;
-  else {
+  if (set) {
+    path = buf;
+    std::error_code ec;
+    PetscCheck(std::filesystem::exists(path, ec), comm, PETSC_ERR_FILE_OPEN, "basis file %s (-rom_basis): does not exist", path.c_str());
+  } else {
     // stored relative to the ROM file's directory (files of before 2026-11-22: relative to the
     // offline run's working directory, the fallback)
-    PetscCall(RomReadAttr(romPath, "basis_file", &path));
-    const std::filesystem::path p(path), beside = std::filesystem::path(romPath).parent_path() / p;
+    std::string stored;
+    PetscCall(RomReadAttr(romPath, "basis_file", &stored));
+    const std::filesystem::path p(stored), beside = std::filesystem::path(romPath).parent_path() / p;
     std::error_code             ec;
-    if (p.is_relative() && std::filesystem::exists(beside, ec)) path = beside.string();
+    path = p.is_relative() && std::filesystem::exists(beside, ec) ? beside.string() : stored;
+    // a ROM moved without its basis file was "ROM file 'rom.basis.h5': does not exist"
+    PetscCheck(std::filesystem::exists(path, ec), comm, PETSC_ERR_FILE_OPEN, "the basis file of the ROM %s (its attribute basis_file '%s') is neither beside it (%s) nor %s: give it with -rom_basis <file>", romPath.c_str(), stored.c_str(), beside.string().c_str(),
+               p.is_relative() ? "relative to the working directory" : "at that path");
   }
-  { // the pair written by one offline run (files of before 2026-11-23 have no rom_id: not checked)
+  { // the pair written by one offline run (files of before 2026-11-23 have no rom_id on either: not checked)
     std::string idRom, idBasis;
     PetscErrorCode e1, e2;
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
     e1 = RomReadAttr(romPath, "rom_id", &idRom);
     e2 = RomReadAttr(path, "rom_id", &idBasis);
     PetscCall(PetscPopErrorHandler());
-    PetscCheck(e1 || e2 || idRom == idBasis, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s (rom_id %s) was not written by the offline run of the ROM %s (rom_id %s): a mismatched or half-replaced pair; rerun offline (or give the right file with -rom_basis)", path.c_str(), idBasis.c_str(), romPath.c_str(), idRom.c_str());
+    // (a basis file without one was accepted beside a ROM with one: another run's basis, lambda error 0.19 for 0.007)
+    PetscCheck(e1 || !e2, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s has no rom_id, the ROM %s has one (%s): both are written by one offline run, so this basis file is not the ROM's (or it is damaged); rerun offline (or give the right file with -rom_basis)", path.c_str(), romPath.c_str(), idRom.c_str());
+    PetscCheck(e1 || idRom == idBasis, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s (rom_id %s) was not written by the offline run of the ROM %s (rom_id %s): a mismatched or half-replaced pair; rerun offline (or give the right file with -rom_basis)", path.c_str(), idBasis.c_str(), romPath.c_str(), idRom.c_str());
   }
   PetscCall(RomReadDataset(path, "/pod/modes", &dims, &modes));
   PetscCheck(dims.size() == 2 && (PetscInt)dims[0] == model.Nfull && (PetscInt)dims[1] == nd, comm, PETSC_ERR_FILE_UNEXPECTED, "basis file %s: /pod/modes is %llu x %llu, the ROM %s has N = %" PetscInt_FMT " and the scene %" PetscInt_FMT " dofs (another scene or mesh?)", path.c_str(), dims.size() > 0 ? dims[0] : 0ULL, dims.size() > 1 ? dims[1] : 0ULL, romPath.c_str(), model.Nfull, nd);
