@@ -126,9 +126,27 @@ public:
   Model(const Model &)            = delete;
   Model &operator=(const Model &) = delete;
 
-  Solution Solve(const std::vector<double> &mu)
+  // obj as a C-contiguous float64 array: a complex array was cast to its real part without a word (forcecast), a bool
+  // taken as 1.0, and a copy that could not be allocated (a broadcast view of 1e12 rows) a segmentation fault
+  static py::array_t<double, py::array::c_style | py::array::forcecast> RealArray(py::object obj, const std::string &who)
   {
-    const std::vector<PetscReal> m(mu.begin(), mu.end());
+    py::array in = py::array::ensure(obj);
+    if (!in) throw py::type_error(who + ": expected an array of parameter values");
+    const char kind = in.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') throw py::type_error(who + ": expected real parameter values, got dtype " + std::string(py::str(in.dtype())));
+    auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(in);
+    if (!a) {
+      PyErr_SetString(PyExc_MemoryError, (who + ": cannot make a contiguous float64 copy of the array of " + std::to_string((long long)in.size()) + " values").c_str());
+      throw py::error_already_set();
+    }
+    return a;
+  }
+
+  Solution Solve(py::object obj)
+  {
+    auto a = RealArray(obj, "solve");
+    if (a.ndim() > 1) throw py::type_error("solve: expected a sequence of parameter values (one point), got an array of " + std::to_string((long long)a.ndim()) + " dimensions");
+    const std::vector<PetscReal> m(a.data(), a.data() + a.size());
     Check(model_.par.CheckBox(PETSC_COMM_SELF, m)); // a clear error naming the parameter, its value and the box
     rbc::ReducedSolution sol;
     Check(model_.Solve(m, &sol));
@@ -160,12 +178,7 @@ public:
   // converge raises (its message names the parameter), unless nan_on_failure.
   py::array_t<double> ContactForces(py::object obj, bool nanOnFailure)
   {
-    // a complex array was cast to its real part without a word (forcecast); a non-numeric one is refused by name
-    py::array in_mus = py::array::ensure(obj);
-    if (!in_mus) throw py::type_error("contact_forces: expected an array of parameter points");
-    const char kind = in_mus.dtype().kind();
-    if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b') throw py::type_error(std::string("contact_forces: expected a real array of parameter points, got dtype ") + std::string(py::str(in_mus.dtype())));
-    auto           mus = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(in_mus);
+    auto           mus = RealArray(obj, "contact_forces");
     const PetscInt np  = (PetscInt)model_.par.params.size();
     if (mus.ndim() == 1 && np == 1) mus = mus.reshape({mus.shape(0), (py::ssize_t)1});
     if (mus.ndim() != 2 || mus.shape(1) != np) throw std::runtime_error("contact_forces: expected an array of shape (n, " + std::to_string(np) + ") (one row per parameter point)");

@@ -122,6 +122,21 @@ def main():
         except TypeError as e:
             check("dtype complex128" in str(e), "a complex array in contact_forces: TypeError naming its dtype (%s)" % str(e)[:120])
         check(np.array_equal(m.contact_forces([1.02, 1.05]), m.contact_forces(np.array([[1.02], [1.05]]))), "contact_forces on a list = on an (n, 1) array")
+        # solve() took a complex value's real part and a bool as 1.0; a copy that cannot be allocated crashed the
+        # interpreter (audit of 2026-12-01)
+        for bad, what in (([1.02 + 0.5j], "a complex value in solve"), (np.array([1.02 + 0.5j]), "a complex array in solve"), ([True], "a bool in solve"),
+                          (np.array([[True]]), "a bool array in contact_forces")):
+            try:
+                (m.contact_forces if "contact_forces" in what else m.solve)(bad)
+                check(False, "%s: no exception" % what)
+            except TypeError as e:
+                check("expected real parameter values, got dtype" in str(e), "%s: TypeError naming its dtype (%s)" % (what, str(e)[:100]))
+        check(m.solve(np.array([1.02])).contact_force == m.solve([1.02]).contact_force == m.solve((1.02,)).contact_force, "solve on an array, a list, a tuple: one answer")
+        try:
+            m.contact_forces(np.broadcast_to(np.array([1.02]), (10 ** 13, 1)))
+            check(False, "a broadcast view of 1e13 rows: no exception")
+        except MemoryError as e:
+            check("cannot make a contiguous float64 copy" in str(e), "a broadcast view of 1e13 rows in contact_forces: MemoryError, no crash (%s)" % str(e)[:100])
         # options before the first model, in a fresh interpreter: they reach the reduced model
         code = ("import rbcontact; rbcontact.initialize(['-rom_kacanov_monitor', '-rom_R', '2']); m = rbcontact.ReducedModel(%r); "
                 "s = m.solve([1.02]); print('R', m.R, 'lambda_hat', len(s.lambda_hat), 'converged', s.converged)" % rom)

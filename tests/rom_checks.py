@@ -375,6 +375,13 @@ def bad_input(args):
     expect_error(args, ["-rom", rom, "-mu", "1.12", "-rom_kacanov_relaxation", "1e-4"], ["did not converge", "-rom_kacanov_max_it"], "-rom_kacanov_relaxation 1e-4 from the warm start")
     expect_error(args, ["-rom", rom, "-mu", "1.12", "-rom_warm_start", "0", "-rom_kacanov_relaxation", "1e-300"], ["did not converge"], "-rom_kacanov_relaxation 1e-300 without a warm start")
     expect_error(args, ["-rom", rom, "-rom_qp_type", "bogus"], ["bogus"], "unknown -rom_qp_type")
+    # values that meant something else without a word (audits of 2026-12-01): a trailing -rom_N kept the default (and
+    # cancelled a file's -rom_N 3), a negative size meant the default, inf tolerances one iterate or no KKT check
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_N"], ["option -rom_N is given without a value"], "-rom_N without a value")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it"], ["option -rom_kacanov_max_it is given without a value"], "-rom_kacanov_max_it without a value")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_R", "-5"], ["-rom_R -5: a size >= 0, or -1 for the file's default"], "-rom_R -5")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_rtol_primal", "inf"], ["-rom_kacanov_rtol_primal (inf", "must be finite numbers > 0"], "-rom_kacanov_rtol_primal inf")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kkt_tol", "inf"], ["-rom_kkt_tol inf", "must be a finite number > 0"], "-rom_kkt_tol inf")
     expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")
     # scene options that contradict the ROM were ignored without a word (the ROM's own answer, exit 0; audit 2026-11-29)
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-body_E", "200,100"], ["option -body_E is a scene option", "-options_file runs/<scene>.opts"], "online -body_E without the scene")

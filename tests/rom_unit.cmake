@@ -51,3 +51,7 @@ rbc_add_mpi_test(NAME test_fork_join RANKS 1 TIMEOUT 60 COMMAND $<TARGET_FILE:te
 #   test_rom_contact_terms the public ContactTerms with A^ diagonalized once and the points' sum in float (its rows
 #                          theta V) against the same model without: run by rom_checks.py sphere_block3d on its ROM
 rbc_test_exe(test_rom_contact_terms)
+#   test_model_api         the C++ API's ReducedModel used out of order: no model (default-constructed, or after a
+#                          failed Open) refused by Solve, SetFromOptions and Truncate, naming the cause
+rbc_test_exe(test_model_api)
+rbc_add_mpi_test(NAME test_model_api RANKS 1 TIMEOUT 120 COMMAND $<TARGET_FILE:test_model_api> -options_file runs/ring_on_block.opts LABELS rom)

@@ -4,6 +4,7 @@
 // options nobody read after (misspelled).
 #pragma once
 #include <petscsys.h>
+#include <initializer_list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -25,6 +26,10 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse();
 // the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...). given: the words given
 // directly (the command line, the Python keywords): online, probe and dualbasis leave out every option of a scene file but
 // their own families, not those given directly.
+// Each of these options, where it is given, has a value: PETSc's readers keep the default for an option given without
+// one (-rom_N at the end of a command line), without a word. Collective on comm (the options are the same on every rank).
+PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names);
+
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused, const std::vector<std::string> &given = {});
 
 } // namespace rbc

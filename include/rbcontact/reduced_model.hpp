@@ -96,7 +96,8 @@ public:
   // at a few points with nonnegative weights (ECSW, empirical_cubature.hpp); Exact: every point.
   enum class ContactMode { EIM, Exact, Cubature };
 
-  // Reads a ROM file (any rank; no collective call). Errors name the file and the dataset.
+  // Reads a ROM file (any rank; no collective call). Errors name the file and the dataset; after a failed Open the
+  // object holds no model (Solve, SetFromOptions and Truncate refuse, naming that file).
   PetscErrorCode Open(const std::string &file);
   // -rom_kacanov_*, -rom_kkt_tol, -rom_warm_start <bool>, -rom_qp_* (ReducedQP), -rom_N, -rom_R, -rom_Mk, -rom_Mg (truncation),
   // -rom_hyper eim|ecsw (the hyper-reduction among those stored; default: the offline stage's first choice),
@@ -247,6 +248,9 @@ public:
 
 private:
   PetscErrorCode SolveLoop(const std::vector<PetscReal> &mu, ReducedSolution *sol);
+  PetscErrorCode Read(const std::string &file);          // Open's reading, into this object (Open keeps it on success only)
+  PetscErrorCode CheckHasModel(const char *method) const; // an error unless a model was read or built
+  std::string    failedOpen_;                             // the file of the last Open, when it failed (no model since)
   // The error estimate of a converged sol (ErrorEstimate), from the contact terms' last evaluation.
   PetscErrorCode EstimateError(const std::vector<PetscReal> &mu, ReducedSolution *sol);
   // ContactTerms; factored (AFactored() or ADiagonalized() only): K holds K^ L^{-T} (summed from cThetaTw_), or K^ V

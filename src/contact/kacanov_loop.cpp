@@ -29,7 +29,8 @@ PetscErrorCode KacanovLoop::SetFromOptions(MPI_Comm comm, const std::string &pre
   PetscCall(PetscOptionsBool("-monitor", "Print the changes and the active-set size per iteration", NULL, monitor, &monitor, NULL));
   PetscOptionsEnd();
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%smax_it %" PetscInt_FMT " must be >= 1", p.c_str(), maxIt);
-  PetscCheck(rtolPrimal > 0 && rtolDual > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "%srtol_primal (%g) and %srtol_dual (%g) must be > 0", p.c_str(), (double)rtolPrimal, p.c_str(), (double)rtolDual);
+  // (inf was accepted: one iterate, reported converged)
+  PetscCheck(rtolPrimal > 0 && rtolDual > 0 && std::isfinite(rtolPrimal) && std::isfinite(rtolDual), comm, PETSC_ERR_ARG_OUTOFRANGE, "%srtol_primal (%g) and %srtol_dual (%g) must be finite numbers > 0", p.c_str(), (double)rtolPrimal, p.c_str(), (double)rtolDual);
   PetscCheck(relaxation > 0 && relaxation <= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%srelaxation %g must lie in (0, 1]", p.c_str(), (double)relaxation);
   PetscCheck(anderson >= 0 && anderson <= 10, comm, PETSC_ERR_ARG_OUTOFRANGE, "%sanderson %" PetscInt_FMT " must lie in [0, 10] (0: plain Kacanov)", p.c_str(), anderson);
   PetscFunctionReturn(0);

@@ -69,6 +69,19 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse()
   return out;
 }
 
+PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names)
+{
+  PetscFunctionBeginUser;
+  for (const char *n : names) {
+    PetscBool has = PETSC_FALSE, set = PETSC_FALSE;
+    char      v[8] = "";
+    PetscCall(PetscOptionsHasName(NULL, NULL, n, &has));
+    if (has) PetscCall(PetscOptionsGetString(NULL, NULL, n, v, sizeof v, &set));
+    PetscCheck(!has || (set && v[0]), comm, PETSC_ERR_USER_INPUT, "option %s is given without a value", n);
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *out, const std::vector<std::string> &given)
 {
   PetscInt n;

@@ -1,6 +1,7 @@
 // src/rom/reduced_model.cpp: the online stage's model: reading/writing its data (ROM file, format 2,
 // docs/rom_file.md), truncation, the EIM (or exact) reduced contact terms and the reduced Kacanov loop.
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/warm_start.hpp"
 #include "dense_kernels.hpp"
 #include <petscblaslapack.h>
@@ -280,6 +281,17 @@ void WriteReducedModel(const ReducedModel &m, RomWriter *w)
 
 PetscErrorCode ReducedModel::Open(const std::string &path)
 {
+  PetscFunctionBeginUser;
+  // a failed Open left a half-replaced model that still solved (the old model's answer under the new file's name, or
+  // a mix of the two files; audit of 2026-12-01): it now leaves no model, and Solve says so (CheckHasModel)
+  const PetscErrorCode ierr = Read(path);
+  failedOpen_               = ierr ? path : std::string();
+  if (ierr) Nfull = 0;
+  PetscFunctionReturn(ierr);
+}
+
+PetscErrorCode ReducedModel::Read(const std::string &path)
+{
   std::string         fmt;
   int                 ver = 0;
   std::vector<double> d;
@@ -444,6 +456,10 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscInt    prec = ecswSingle ? 1 : 0;
 
   PetscFunctionBeginUser;
+  PetscCall(CheckHasModel("SetFromOptions"));
+  // an option without its value kept the default without a word (a trailing -rom_N cancelled a file's -rom_N 3)
+  PetscCall(CheckValuesGiven(PETSC_COMM_SELF, {"-rom_kkt_tol", "-rom_warm_start_degree", "-rom_threads", "-rom_N", "-rom_R", "-rom_Mk", "-rom_Mg", "-rom_hyper", "-rom_ecsw_sum", "-rom_gemm", "-rom_ecsw_precision",
+                                               "-rom_kacanov_max_it", "-rom_kacanov_rtol_primal", "-rom_kacanov_rtol_dual", "-rom_kacanov_relaxation", "-rom_kacanov_anderson"}));
   PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
   // one block, so that -help lists the reduced model's options with their values (prefix rom_)
   PetscOptionsBegin(PETSC_COMM_SELF, "rom_", "Reduced model (online solve)", "ReducedModel");
@@ -475,7 +491,10 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCall(PetscOptionsInt("-Mg", "EIM terms of the gap used (default: the offline selection)", "", mg, &mg, NULL));
   PetscOptionsEnd();
   PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
-  PetscCheck(kktTol > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCheck(kktTol > 0 && std::isfinite(kktTol), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be a finite number > 0", (double)kktTol);
+  // -1 is the default; another negative size meant it too without a word
+  for (const auto &o : {std::make_pair("-rom_N", n), std::make_pair("-rom_R", r), std::make_pair("-rom_Mk", mk), std::make_pair("-rom_Mg", mg)})
+    PetscCheck(o.second >= -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": a size >= 0, or -1 for the file's default", o.first, o.second);
   PetscCheck(threads >= 1 && threads <= 256, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_threads %" PetscInt_FMT " must be in [1, 256]", threads);
   // no EIM term at all is no contact term (Mk) or no gap (Mg): a converged answer without contact; the internal
   // callers (the EIM's size selection) may still truncate to 0
@@ -502,9 +521,19 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ReducedModel::CheckHasModel(const char *method) const
+{
+  PetscFunctionBeginUser;
+  // a default-constructed model "solved" (converged, empty solution) and blamed -rom_N ("out of range [1, 0]")
+  PetscCheck(Nfull > 0 || failedOpen_.empty(), PETSC_COMM_SELF, PETSC_ERR_ORDER, "ReducedModel::%s: no reduced model: the last Open (of %s) failed", method, failedOpen_.c_str());
+  PetscCheck(Nfull > 0, PETSC_COMM_SELF, PETSC_ERR_ORDER, "ReducedModel::%s: no reduced model (Open a ROM file first)", method);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, PetscInt mg)
 {
   PetscFunctionBeginUser;
+  PetscCall(CheckHasModel("Truncate"));
   sizesGiven_ = n >= 0 || r >= 0;
   if (n < 0) n = NDefault >= 1 ? std::min(NDefault, Npod) : Npod;
   if (r < 0) r = RDefault >= 1 ? std::min(RDefault, Rfull) : RSelected >= 1 ? std::min(RSelected, Rfull) : Rfull;
@@ -980,6 +1009,7 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
 PetscErrorCode ReducedModel::Solve(const std::vector<PetscReal> &mu, ReducedSolution *sol)
 {
   PetscFunctionBeginUser;
+  PetscCall(CheckHasModel("Solve"));
   PetscCall(par.CheckBox(PETSC_COMM_SELF, mu));
   PetscCall(RegisterEvents());
   PetscCall(PetscLogEventBegin(ROM_Solve, 0, 0, 0, 0));
