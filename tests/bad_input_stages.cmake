@@ -112,6 +112,10 @@ rbc_bad_stage(map_stretch_axis "-map_ring_stretch_axis 2: the mesh is 2D" fom -o
 rbc_bad_stage(map_dir_3d_in_2d "-map_ring_translation_dir has 3 coordinate[(]s[)]; the mesh is 2D: give 2" fom -options_file runs/ring_on_block.opts -map_ring dilation,translation -map_ring_translation_param radius -map_ring_translation_dir 0,0,1 -mu 1.1)
 rbc_bad_stage(hertz_radius_negative "-hertz_radius -1[.]? must be a finite number > 0" fom -options_file runs/ring_on_block.opts -hertz_radius -1)
 rbc_bad_stage(hertz_radius_inf "-hertz_radius inf[.]? must be a finite number > 0" fom -options_file runs/ring_on_block.opts -hertz_radius inf)
+# a mesh of tetrahedra and hexahedra: only the first cell's type was checked (errors of the contact surface or the
+# assembly followed, naming no mesh)
+rbc_bad_stage(mixed_cell_types "Mesh '[^']*mixed3d[.]geo': only simplex cells [(]triangles, tetrahedra[)] are supported; [0-9]+ of its cells are not [(]the first of type hexahedron[)]" fom -options_file runs/flat_punch3d.opts -mesh_file @MIXED3D_GEO@)
+rbc_bad_stage_np2(mixed_cell_types "only simplex cells [(]triangles, tetrahedra[)] are supported; [0-9]+ of its cells are not" fom -options_file runs/flat_punch3d.opts -mesh_file @MIXED3D_GEO@)
 rbc_bad_stage(map_center_inf "-map_ring_dilation_center: coordinate 1 is not a finite number" fom -options_file runs/ring_on_block.opts -map_ring_dilation_center inf,0.005)
 rbc_bad_stage(map_unknown_block "-map_ring: unknown map block 'bogus'" fom -options_file runs/ring_on_block.opts -map_ring bogus)
 # a user's mesh whose element points at an undefined node (PETSc's reader: a segmentation fault or "inverted cells"), or

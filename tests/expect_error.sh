@@ -13,7 +13,7 @@
 # by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
 # @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
 # @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf;
-# @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface.
+# @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface; @MIXED3D_GEO@ by a 3D mesh of tetrahedra and hexahedra.
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -89,6 +89,31 @@ else:
 open(sys.argv[2], "w").write("\n".join(L))
 PY
     args+=("$tmpdir/edited.msh")
+  elif [ "$a" = "@MIXED3D_GEO@" ]; then
+    # flat_punch3d's names with the punch in hexahedra (transfinite, recombined) and the base in tetrahedra
+    cat > "$tmpdir/mixed3d.geo" <<'GEO'
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 1, 1, 0.5};
+Box(2) = {0, 0, -0.5, 1, 1, 0.5};
+Mesh.MeshSizeMax = 0.25;
+c[] = Boundary{ Volume{1}; };
+cc[] = Unique(Abs(Boundary{ Surface{c[]}; }));
+Transfinite Curve{cc[]} = 4;
+Transfinite Surface{1:6};
+Recombine Surface{1:6};
+Transfinite Volume{1};
+Physical Volume("punch", 1) = {1};
+Physical Volume("base", 2)  = {2};
+Physical Surface("slave", 11)     = {5};
+Physical Surface("punch_top", 12) = {6};
+Physical Surface("punch_x0", 13)  = {1};
+Physical Surface("punch_y0", 14)  = {3};
+Physical Surface("master", 21)      = {12};
+Physical Surface("base_bottom", 22) = {11};
+Physical Surface("base_x0", 23)     = {7};
+Physical Surface("base_y0", 24)     = {9};
+GEO
+    args+=("$tmpdir/mixed3d.geo")
   elif [ "$a" = "@FREECURVE_GEO@" ]; then
     # meshes/ring_on_block.geo with a physical curve that lies in no surface (PETSc's reader refuses the mesh on rank 0)
     { cat "$(dirname "$0")/../meshes/ring_on_block.geo"

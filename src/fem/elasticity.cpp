@@ -278,12 +278,19 @@ PetscErrorCode Elasticity::Setup(DM dmIn, const SceneSpec &sceneIn)
   }
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
   {
-    DMPolytopeType ct;
-    PetscInt       cEnd;
+    // every cell, on every rank (the first one's type alone let a mesh of tetrahedra and hexahedra through, to errors
+    // of the contact surface or the assembly that named no mesh; and the check was rank-local)
+    const DMPolytopeType simplex = dim == 3 ? DM_POLYTOPE_TETRAHEDRON : DM_POLYTOPE_TRIANGLE;
+    PetscInt             cEnd, bad[2] = {0, -1}; // count, the first such cell's type
     PetscCall(DMPlexGetHeightStratum(dm, 0, NULL, &cEnd));
-    ct = DM_POLYTOPE_TRIANGLE;
-    if (cEnd > cStart) PetscCall(DMPlexGetCellType(dm, cStart, &ct));
-    PetscCheck(ct == DM_POLYTOPE_TRIANGLE || ct == DM_POLYTOPE_TETRAHEDRON, comm, PETSC_ERR_SUP, "Mesh '%s': only simplex cells (triangles, tetrahedra) are supported", scene.mesh.file.c_str());
+    for (PetscInt c = cStart; c < cEnd; ++c) {
+      DMPolytopeType ct;
+      PetscCall(DMPlexGetCellType(dm, c, &ct));
+      if (ct != simplex && bad[0]++ == 0) bad[1] = (PetscInt)ct;
+    }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad[0], 1, MPIU_INT, MPI_SUM, comm));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad[1], 1, MPIU_INT, MPI_MAX, comm));
+    PetscCheck(bad[0] == 0, comm, PETSC_ERR_SUP, "Mesh '%s': only simplex cells (triangles, tetrahedra) are supported; %" PetscInt_FMT " of its cells are not (the first of type %s)", scene.mesh.file.c_str(), bad[0], bad[1] >= 0 ? DMPolytopeTypes[bad[1]] : "other");
   }
   PetscCall(PetscFECreateLagrange(comm, dim, dim, PETSC_TRUE, degree, PETSC_DETERMINE, &fe));
   PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
