@@ -1249,6 +1249,49 @@ def guards(args):
             del f[ds]
             f[ds] = a
         expect_error(args, ["-rom", d + "/%s.h5" % name, "-mu", "1.02"], words + [name + ".h5"], "a ROM file with %s tampered" % ds)
+    # a third audit (2026-12-01): datasets that meant "no contact", a transposed array, map records that crashed or read
+    # out of bounds, an unreadable optional dataset taken as absent, an unchecked Gram matrix; each gave exit 0 or a
+    # message blaming an option or the solver
+    os.makedirs(d + "/ecsw_only")
+    rom_e, _ = offline(args, d + "/ecsw_only", np_=1, extra=["-train_size", "3", "-offline_probe", "0"])  # the cubature alone
+
+    def tamper(name, edit, src=rom):
+        shutil.copy(src, d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "a") as f:
+            edit(f)
+        return d + "/%s.h5" % name
+
+    def replace(ds, value):
+        def edit(f):
+            if ds in f:
+                del f[ds]
+            f[ds] = value
+        return edit
+
+    def setat(ds, idx, val):
+        def edit(f):
+            a = np.array(f[ds])
+            a[idx] = val
+            f[ds][...] = a
+        return edit
+
+    with h5py.File(rom, "r") as f:
+        pw, gram = np.array(f["online/ecsw/Pw"]), np.array(f["online/dual_gram"])
+    expect_error(args, ["-rom", tamper("nohyper", lambda f: f.__delitem__("online/hyper_default"), rom_e), "-mu", "1.02"], ["the hyper-reduction is the EIM, but the file holds no EIM term", "nohyper.h5"],
+                 "an ECSW-only ROM file without /online/hyper_default (solved with no contact at all, exit 0)")
+    cases = [
+             ("eimdef0", replace("online/eim_default", np.array([0.0, 5.0])), ["-rom_hyper", "eim"], ["/online/eim_default must hold 2 sizes"]),
+             ("kmeta", setat("online/kappa/meta", 1, -3), [], ["/online/kappa/meta must hold {0 or 1, a size >= 0}"]),
+             ("pwT", replace("online/ecsw/Pw", np.ascontiguousarray(pw.T)), [], ["/online/ecsw/Pw is %d x %d, %d x %d expected" % (pw.shape[1], pw.shape[0], pw.shape[0], pw.shape[1])]),
+             ("map_param", setat("online/map", 3, 1e6), [], ["/online/map block 0: parameter index"]),
+             ("map_ref", setat("online/map", 4, 0), [], ["/online/map block 0: reference value"]),
+             ("rtol_str", replace("online/kacanov_rtol", np.bytes_("1e-5,1e-4")), [], ["cannot read dataset /online/kacanov_rtol"]),
+             ("gram_neg", replace("online/dual_gram", -gram), [], ["/online/dual_gram has the diagonal entry"]),
+             ("sizes_dim", setat("online/sizes", 0, 4), [], ["/online/sizes gives the dimension 4"])]
+    for name, edit, extra, words in cases:
+        expect_error(args, ["-rom", tamper(name, edit), "-mu", "1.02"] + extra, words + [name + ".h5"], "a ROM file tampered (%s)" % name)
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-rom", tamper("quad", setat("online/eim_quadrature", 0, -3)), "-rom_basis", d + "/rom.basis.h5", "-test_size", "2",
+                        "-validate_repeat", "1"], ["/online/eim_quadrature must hold one number of subdivisions"], "validate with /online/eim_quadrature -3", stage="validate")
     # options files: one that includes itself, one missing; the previous report replaced by the failure's
     with open(d + "/self.opts", "w") as f:
         f.write("-options_file %s/self.opts\n" % d)

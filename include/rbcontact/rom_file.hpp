@@ -34,8 +34,9 @@ private:
 // Reads a dataset (any rank, independent); errors name the file and the dataset.
 PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, std::vector<unsigned long long> *dims, std::vector<double> *data);
 PetscErrorCode RomReadAttr(const std::string &path, const std::string &name, std::string *value);
-// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
-PetscErrorCode RomReadOptional(const std::string &path, const std::string &name, std::vector<double> *data, bool *found);
+// An optional dataset: *found false (and no error) when the file lacks it (the dataset or a group on its path); any
+// other failure to read it, and non-finite values, are an error. dims: its shape, when given.
+PetscErrorCode RomReadOptional(const std::string &path, const std::string &name, std::vector<double> *data, bool *found, std::vector<unsigned long long> *dims = nullptr);
 // Every value of a dataset read from a model file (what: "ROM file x.h5", "basis file b.h5") finite and below 1e150 in
 // magnitude: no value of a model comes near (moduli, coordinates, reduced operators), and a larger one is a corrupt
 // file whose products overflow to inf and NaN online. Errors name the file, the dataset and the entry.

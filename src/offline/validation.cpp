@@ -373,6 +373,8 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     std::vector<unsigned long long> dims;
     std::vector<double>             q;
     PetscCall(RomReadDataset(romPath, "/online/eim_quadrature", &dims, &q));
+    // (-3 was used: the exact-contact model had no contact, lambda error 1.0 reported, exit 0)
+    PetscCheck(q.size() == 1 && q[0] >= 1 && q[0] <= 64 && q[0] == std::floor(q[0]), comm, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_quadrature must hold one number of subdivisions in [1, 64]: a corrupt file", romPath);
     std::shared_ptr<ContactPatch> full;
     std::vector<PetscReal>        P;
     PetscCall(BuildFullContact(fom, cmap, order, bases.modes, bases.N, bases.W, bases.r, (PetscInt)q[0], &full, &P));

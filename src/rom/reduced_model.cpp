@@ -69,6 +69,41 @@ PetscErrorCode ReadChecked(const std::string &file, const std::string &name, siz
   PetscFunctionReturn(0);
 }
 
+// The same with the dataset's shape (docs/rom_file.md): the entry count alone let a transposed /online/ecsw/Pw through
+// (force +3.5 %, exit 0; audit of 2026-12-01).
+PetscErrorCode ReadShaped(const std::string &file, const std::string &name, const std::vector<U64> &shape, std::vector<double> *data)
+{
+  std::vector<U64> dims;
+  PetscFunctionBeginUser;
+  PetscCall(RomReadDataset(file, name, &dims, data));
+  if (dims != shape) {
+    auto str = [](const std::vector<U64> &v) {
+      std::string o;
+      for (U64 x : v) o += (o.empty() ? "" : " x ") + std::to_string(x);
+      return o.empty() ? std::string("a scalar") : o;
+    };
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: dataset %s is %s, %s expected (corrupt or mismatched file)", file.c_str(), name.c_str(), str(dims).c_str(), str(shape).c_str());
+  }
+  PetscCall(RomCheckValues("ROM file " + file, name, *data));
+  PetscFunctionReturn(0);
+}
+
+// A Gram matrix (R x R, row-major): symmetric to 1e-10 of its largest diagonal entry, with a positive diagonal (a negated
+// /online/estimate/mass_gram made the lambda estimate "available" at its floor, 50x below the error)
+PetscErrorCode CheckGram(const std::string &file, const char *name, const std::vector<double> &G, size_t R)
+{
+  double dmax = 0;
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < R; ++i) {
+    PetscCheck(G[i * R + i] > 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s has the diagonal entry %g at %zu (a Gram matrix: > 0): a corrupt file", file.c_str(), name, G[i * R + i], i);
+    dmax = std::max(dmax, G[i * R + i]);
+  }
+  for (size_t i = 0; i < R; ++i)
+    for (size_t j = 0; j < i; ++j)
+      PetscCheck(std::abs(G[i * R + j] - G[j * R + i]) <= 1e-10 * dmax, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s is not symmetric (entries (%zu, %zu) and (%zu, %zu)): a corrupt file", file.c_str(), name, i, j, j, i);
+  PetscFunctionReturn(0);
+}
+
 std::vector<PetscInt> ToInt(const std::vector<double> &d) { return std::vector<PetscInt>(d.begin(), d.end()); }
 } // namespace
 
@@ -148,9 +183,20 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
   PetscCall(ReadChecked(file, "/online/map", (size_t)-1, &rec));
   PetscCheck(!rec.empty() && rec.size() == 1 + 8 * (size_t)rec[0], PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/map is malformed", file.c_str());
   rec.erase(rec.begin());
+  // each block's {body, type, parameter, ref, v0, v1, v2, axis}: the parameter indexes mu and ref divides (a huge index
+  // was a segmentation fault, one past the end a read out of bounds blamed on Kacanov, ref 0 a non-finite QP naming
+  // no file; audit of 2026-12-01)
+  for (size_t i = 0; i < rec.size(); i += 8) {
+    const PetscReal pr = rec[i + 2], ref = rec[i + 3], axis = rec[i + 7];
+    PetscCheck(pr >= 0 && pr < (PetscReal)params.size() && pr == std::floor(pr), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/map block %zu: parameter index %g out of range [0, %zu): a corrupt file", file.c_str(), i / 8, (double)pr, params.size());
+    PetscCheck(std::isfinite(ref) && ref != 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/map block %zu: reference value %g must be finite and nonzero: a corrupt file", file.c_str(), i / 8, (double)ref);
+    PetscCheck(rec[i + 1] != 1 || (axis >= 0 && axis < 3 && axis == std::floor(axis)), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/map block %zu: stretch axis %g out of range [0, 3): a corrupt file", file.c_str(), i / 8, (double)axis);
+  }
   PetscCall(map.FromRecords((PetscInt)bodies.size(), rec));
   PetscCall(ReadChecked(file, "/online/affine/thetaA", (size_t)-1, &d));
   thetaA = CoefFromRecords(d);
+  // (an empty one was blamed on /online/affine/A's size)
+  PetscCheck(!thetaA.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/affine/thetaA holds no coefficient function (the stiffness has at least one term): a corrupt file", file.c_str());
   PetscCall(ReadChecked(file, "/online/affine/thetaF", (size_t)-1, &d));
   thetaF = CoefFromRecords(d);
   for (const auto *cs : {&thetaA, &thetaF})
@@ -304,6 +350,9 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
   PetscCheck(ver == 2, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s has format_version %d; the online stage reads version 2 (a file of 'offline -offline_stop bases' holds bases only: run offline without -offline_stop)", path.c_str(), ver);
   PetscCall(par.Read(path));
   PetscCall(ReadChecked(path, "/online/sizes", 6, &d));
+  PetscCheck(d[0] == 2 || d[0] == 3, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/sizes gives the dimension %g (2 or 3): a corrupt file", path.c_str(), d[0]);
+  for (int k = 1; k < 5; ++k)
+    PetscCheck(d[k] >= 0 && d[k] == std::floor(d[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/sizes entry %d is %g, not a size: a corrupt file", path.c_str(), k, d[k]);
   dim   = (PetscInt)d[0];
   Nfull = (PetscInt)d[1];
   Npod  = (PetscInt)d[2];
@@ -311,20 +360,26 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
   Rfull = (PetscInt)d[4];
   PetscCheck(Nfull > 0 && Rfull > 0 && Npod + nsup == Nfull && nsup <= Rfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: inconsistent sizes N %" PetscInt_FMT " (POD %" PetscInt_FMT " + supremizers %" PetscInt_FMT "), R %" PetscInt_FMT, path.c_str(), Nfull, Npod, nsup, Rfull);
   const size_t N = Nfull, R = Rfull;
-  PetscCall(ReadChecked(path, "/online/affine/A", par.NumA() * N * N, &Aq));
-  PetscCall(ReadChecked(path, "/online/affine/f", par.NumF() * N, &fq));
-  PetscCall(ReadChecked(path, "/online/kappa/meta", 2, &d));
-  kappaConst = d[0] != 0;
-  MkFull     = kappaConst ? 0 : (PetscInt)d[1];
-  PetscCall(ReadChecked(path, "/online/gap/meta", 2, &d));
-  gapConst = d[0] != 0;
-  MgFull   = gapConst ? 0 : (PetscInt)d[1];
-  PetscCall(ReadChecked(path, "/online/dual_gram", R * R, &dualGram));
+  PetscCall(ReadShaped(path, "/online/affine/A", {(U64)par.NumA(), N, N}, &Aq));
+  PetscCall(ReadShaped(path, "/online/affine/f", {(U64)par.NumF(), N}, &fq));
+  // {constant 0/1, M >= 0} (a negative M was blamed on -rom_Mk, "out of range [0, -3]")
+  auto meta = [&](const char *name, bool *cst, PetscInt *M) -> PetscErrorCode {
+    PetscFunctionBeginUser;
+    PetscCall(ReadChecked(path, name, 2, &d));
+    PetscCheck((d[0] == 0 || d[0] == 1) && d[1] >= 0 && d[1] == std::floor(d[1]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s must hold {0 or 1, a size >= 0}, not {%g, %g}: a corrupt file", path.c_str(), name, d[0], d[1]);
+    *cst = d[0] != 0;
+    *M   = *cst ? 0 : (PetscInt)d[1];
+    PetscFunctionReturn(0);
+  };
+  PetscCall(meta("/online/kappa/meta", &kappaConst, &MkFull));
+  PetscCall(meta("/online/gap/meta", &gapConst, &MgFull));
+  PetscCall(ReadShaped(path, "/online/dual_gram", {R, R}, &dualGram));
+  PetscCall(CheckGram(path, "/online/dual_gram", dualGram, R));
   PetscCall(patch.Deserialize(path, "/online/contact"));
-  PetscCheck(patch.N == Nfull && patch.dim == dim, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: the contact data has %" PetscInt_FMT " basis functions, the model %" PetscInt_FMT, path.c_str(), patch.N, Nfull);
-  if (kappaConst) PetscCall(ReadChecked(path, "/online/kappa/constant", N * R, &kConstant));
+  PetscCheck(patch.N == Nfull && patch.dim == dim, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: the contact data has %" PetscInt_FMT " basis functions in %" PetscInt_FMT "D, the model %" PetscInt_FMT " in %" PetscInt_FMT "D (/online/contact against /online/sizes)", path.c_str(), patch.N, patch.dim, Nfull, dim);
+  if (kappaConst) PetscCall(ReadShaped(path, "/online/kappa/constant", {N, R}, &kConstant));
   else if (MkFull > 0) {
-    PetscCall(ReadChecked(path, "/online/kappa/points", 2 * MkFull, &d));
+    PetscCall(ReadShaped(path, "/online/kappa/points", {(U64)MkFull, 2}, &d));
     kPoint.resize(MkFull);
     kMode.resize(MkFull);
     for (PetscInt j = 0; j < MkFull; ++j) {
@@ -332,16 +387,16 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
       kMode[j]  = (PetscInt)d[2 * j + 1];
       PetscCheck(kPoint[j] >= 0 && kPoint[j] < patch.NumPoints() && kMode[j] >= 0 && kMode[j] < Nfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/kappa/points: entry %" PetscInt_FMT " out of range", path.c_str(), j);
     }
-    PetscCall(ReadChecked(path, "/online/kappa/B", MkFull * MkFull, &kB));
-    PetscCall(ReadChecked(path, "/online/kappa/C", MkFull * N * R, &kC));
+    PetscCall(ReadShaped(path, "/online/kappa/B", {(U64)MkFull, (U64)MkFull}, &kB));
+    PetscCall(ReadShaped(path, "/online/kappa/C", {(U64)MkFull, N, R}, &kC));
   }
   if (gapConst) PetscCall(ReadChecked(path, "/online/gap/constant", R, &gConstant));
   else if (MgFull > 0) {
     PetscCall(ReadChecked(path, "/online/gap/points", MgFull, &d));
     gPoint = ToInt(d);
     for (PetscInt p : gPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/gap/points out of range", path.c_str());
-    PetscCall(ReadChecked(path, "/online/gap/B", MgFull * MgFull, &gB));
-    PetscCall(ReadChecked(path, "/online/gap/C", MgFull * R, &gC));
+    PetscCall(ReadShaped(path, "/online/gap/B", {(U64)MgFull, (U64)MgFull}, &gB));
+    PetscCall(ReadShaped(path, "/online/gap/C", {(U64)MgFull, R}, &gC));
   }
   warmMu.clear();
   warmV.clear();
@@ -352,8 +407,8 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
     if (!found) warmMu.clear();
     else {
       const size_t nw = warmMu.size() / std::max<size_t>(1, par.params.size());
-      PetscCall(ReadChecked(path, "/online/warm/v", nw * N, &warmV));
-      PetscCall(ReadChecked(path, "/online/warm/lambda", nw * R, &warmL));
+      PetscCall(ReadShaped(path, "/online/warm/v", {nw, N}, &warmV));
+      PetscCall(ReadShaped(path, "/online/warm/lambda", {nw, R}, &warmL));
     }
   }
   // optional (files of before 2026-11-23 hold the EIM only): the empirical cubature and the default method
@@ -366,14 +421,17 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
     if (found) {
       cPoint = ToInt(d);
       for (PetscInt p : cPoint) PetscCheck(p >= 0 && p < patch.NumPoints(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/ecsw/points out of range", path.c_str());
-      PetscCall(ReadChecked(path, "/online/ecsw/Pw", R * cPoint.size(), &cPw));
+      PetscCall(ReadShaped(path, "/online/ecsw/Pw", {R, (U64)cPoint.size()}, &cPw));
       OrderCubaturePoints(); // files written before 2026-11-27 hold them in the fit's order
     }
     PetscCall(RomReadOptional(path, "/online/hyper_default", &d, &found));
     if (found) {
-      PetscCheck(d.size() == 1 && (d[0] == 0 || d[0] == 1) && (d[0] == 0 || !cPoint.empty()), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default is malformed", path.c_str());
+      PetscCheck(d.size() == 1 && (d[0] == 0 || d[0] == 1), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default is malformed (one value, 0 for the EIM or 1 for the cubature)", path.c_str());
+      PetscCheck(d[0] == 0 || !cPoint.empty(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/hyper_default says the empirical cubature, but /online/ecsw/points is missing: a corrupt file", path.c_str());
       hyperDefault = d[0] == 1 ? ContactMode::Cubature : ContactMode::EIM;
     }
+    // the EIM by default (no hyper_default: a file of before 2026-11-23) with no EIM term solved with no contact at all
+    PetscCheck(hyperDefault != ContactMode::EIM || HasEIM(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s the EIM, but the file holds no EIM term (/online/kappa/meta, /online/gap/meta): a corrupt file", path.c_str(), found ? "/online/hyper_default says" : "without /online/hyper_default (files of before 2026-11-23) the hyper-reduction is");
   }
   mode_ = hyperDefault;
   { // optional (files written before 2026-11-25's eleventh session have none: the library's defaults): the online Kacanov tolerances
@@ -399,7 +457,9 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
     bool found;
     PetscCall(RomReadOptional(path, "/online/eim_default", &d, &found));
     if (found) {
-      PetscCheck(d.size() == 2 && d[0] >= -1 && d[0] <= MkFull && d[1] >= -1 && d[1] <= MgFull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_default must hold 2 sizes within [-1, Mk = %" PetscInt_FMT "] and [-1, Mg = %" PetscInt_FMT "]", path.c_str(), MkFull, MgFull);
+      // -1 (all) or a size in [1, M] (0 only where there is no such EIM: {0, x} solved with no contact, as -rom_Mk 0 would)
+      auto ok = [](double v, PetscInt M) { return v == std::floor(v) && (v == -1 || (v >= 1 && v <= M) || (v == 0 && M == 0)); };
+      PetscCheck(d.size() == 2 && ok(d[0], MkFull) && ok(d[1], MgFull), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/eim_default must hold 2 sizes, -1 or within [1, Mk = %" PetscInt_FMT "] and [1, Mg = %" PetscInt_FMT "]: a corrupt file", path.c_str(), MkFull, MgFull);
       MkDefault = (PetscInt)d[0];
       MgDefault = (PetscInt)d[1];
     }
@@ -422,6 +482,11 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
   { // optional (files of before 2026-11-26 have none): the answer's sizes inside the stored ones and the estimate's data
     bool found;
     PetscCall(RomReadOptional(path, "/online/estimate/default_sizes", &d, &found));
+    if (!found) { // the estimate's data without its sizes: another model (all the stored modes) and no estimate, no word
+      bool cal = false;
+      PetscCall(RomReadOptional(path, "/online/estimate/calibration", &d, &cal));
+      PetscCheck(!cal, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate holds a calibration but no default_sizes (the answer's sizes inside the stored bases): a corrupt file", path.c_str());
+    }
     if (found) {
       PetscCheck(d.size() == 2 && d[0] >= 1 && d[0] <= Npod && d[1] >= 1 && d[1] <= Rfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/default_sizes must hold 2 sizes within [1, %" PetscInt_FMT "] (POD modes) and [1, %" PetscInt_FMT "] (dual vectors)", path.c_str(), Npod, Rfull);
       NDefault = (PetscInt)d[0];
@@ -435,6 +500,7 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
       PetscCall(RomReadOptional(path, "/online/estimate/mass_gram", &massGram, &found));
       if (!found) massGram.clear();
       PetscCheck(massGram.empty() || massGram.size() == R * R, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/mass_gram has %zu entries, expected %zu", path.c_str(), massGram.size(), R * R);
+      if (!massGram.empty()) PetscCall(CheckGram(path, "/online/estimate/mass_gram", massGram, R));
     }
   }
   { // optional (files of before 2026-11-25): the surface data of the max pressure and the contact half-width

@@ -71,10 +71,13 @@ PetscErrorCode SurfaceOutputs::Read(const std::string &file, bool *found)
   dim_  = (PetscInt)meta[0];
   Rfom_ = (PetscInt)meta[1];
   r_    = (PetscInt)meta[2];
-  bool f1, f2;
-  PetscCall(RomReadOptional(file, "/online/outputs/W", &W_, &f1));
+  bool                            f1, f2;
+  std::vector<unsigned long long> dims;
+  PetscCall(RomReadOptional(file, "/online/outputs/W", &W_, &f1, &dims));
   PetscCall(RomReadOptional(file, "/online/outputs/slave_facets", &facets_, &f2));
-  PetscCheck(f1 && f2 && W_.size() == (size_t)r_ * Rfom_ && facets_.size() % kRec == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs is incomplete or has the wrong sizes (corrupt file?)", file.c_str());
+  // (the shape too: a transposed W gave a max pressure of 0, exit 0)
+  const bool shaped = dims.size() == 2 && dims[0] == (unsigned long long)r_ && dims[1] == (unsigned long long)Rfom_;
+  PetscCheck(f1 && f2 && shaped && facets_.size() % kRec == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs is incomplete or has the wrong sizes (W must be %" PetscInt_FMT " x %" PetscInt_FMT "; corrupt file?)", file.c_str(), r_, Rfom_);
   for (size_t f = 0; f < facets_.size(); f += kRec) {
     const PetscInt nv = (PetscInt)facets_[f + 1];
     PetscCheck(nv == dim_, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/outputs/slave_facets: a facet with %" PetscInt_FMT " vertices in %" PetscInt_FMT "D", file.c_str(), nv, dim_);
