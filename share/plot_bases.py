@@ -40,7 +40,10 @@ def main():
             sys.exit("plot_bases.py: '%s' has no pod block (run offline -offline_stop bases)" % a.pod)
         s = r["pod"]["singular_values"]
         axes[0].semilogy(range(1, len(s) + 1), [max(x / s[0], 1e-17) for x in s], "o-", ms=3)
-        axes[0].axvline(r["pod"]["n"], color="gray", ls="--", lw=0.8, label="N = %d (%s)" % (r["pod"]["n"], r["pod"]["inner"]))
+        # pod.n counts the supremizers too (the whole primal size): the POD's own modes are n - supremizers (the line
+        # stood past the singular values before 2026-12-01)
+        npod = r["pod"]["n"] - r["pod"].get("supremizers", 0)
+        axes[0].axvline(npod, color="gray", ls="--", lw=0.8, label="N_pod = %d (%s)" % (npod, r["pod"]["inner"]))
         axes[0].legend()
     axes[0].set_xlabel("index")
     axes[0].set_ylabel("singular value / first")

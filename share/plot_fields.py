@@ -45,6 +45,11 @@ def read_fields(path):
     except OSError as e:
         fail("cannot open '%s' as HDF5: %s" % (path, e))
     with f:
+        names = []
+        f.visititems(lambda name, obj: names.append("/" + name) if isinstance(obj, h5py.Dataset) else None)
+        if any("/pod_mode_" in n or "/supremizer_" in n for n in names):  # (drawn as a deformed FOM solution before 2026-12-01)
+            fail("'%s' is a basis view (offline -offline_basis_output: pod_mode_* and supremizer_* fields), not a FOM solution: "
+                 "open it in ParaView (its .xmf), or plot the output of rbcontact fom -fom_output" % path)
         missing = [d for d in DATASETS.values() if d not in f]
         if missing:
             have = []

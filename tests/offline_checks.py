@@ -287,7 +287,12 @@ def early_options(args):
     d = workdir("rbc_off_")
     cases = [(["-pod_tol", "2"], "-pod_tol 2. must lie in [0, 1)"), (["-pod_n", "0"], "-pod_n 0 must be >= 1"),
              (["-pod_inner", "bogus"], "Unknown option bogus for -pod_inner"), (["-dual_type", "bogus"], "Unknown option bogus for -dual_type"),
-             (["-dual_tol", "1"], "-dual_tol 1. with -dual_tol_relative must be < 1"), (["-pod_method", "svd"], "-pod_method svd computes the l2 POD only")]
+             (["-dual_tol", "1"], "-dual_tol 1. with -dual_tol_relative must be < 1"), (["-pod_method", "svd"], "-pod_method svd computes the l2 POD only"),
+             # refused after the snapshots (and, for the estimate's, after the ROM was written) until 2026-12-01
+             (["-pod_n", "6"], "-pod_n 6 must lie in [1, 5] (the number of snapshots)"), (["-estimate", "-estimate_safety", "0.5"], "-estimate_safety 0.5 out of range [1, 100]"),
+             (["-estimate", "-estimate_calibration_size", "-1"], "-estimate_calibration_size -1 out of range"),
+             (["-eim_quadrature_subdivisions", "0"], "-eim_quadrature_subdivisions 0 out of range [1, 64]"), (["-eim_patch_rings", "-1"], "-eim_patch_rings -1 out of range [0, 20]"),
+             (["-dual_tol_relative", "0", "-dual_tol", "inf"], "-dual_tol inf. must be a finite number >= 0")]
     for extra, words in cases:
         c = ["mpirun", "-n", "2", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-snapshots_monitor", "-rom", d + "/r.h5"] + extra
         p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -310,6 +315,37 @@ def early_options(args):
     p = run(args, 2, "runs/ring_on_block.opts", ["-train_size", "3", "-snapshots", d + "/p3.h5", "-snapshots_restart", "-snapshots_sensitivities", "-snapshots_monitor"], expect_ok=False)
     check(p.returncode != 0 and "1 of the 2 finished snapshots of" in p.stdout and "(training points 2)" in p.stdout and "  snapshot " not in p.stdout,
           "-snapshots_sensitivities on a file where one done row lacks them: refused before any snapshot, naming the point (2 ranks)")
+
+
+def bases_warnings(args):
+    """What the bases step builds badly, said (audit of 2026-12-01; each exit 0 without a word before): a dual basis
+    missing its tolerance, a training set of 1 or 2 points, an absolute -dual_tol that keeps no vector (refused by
+    name, it blamed -rom_R), dualbasis on a snapshot file's dataset (read transposed), plot_fields.py on a basis view
+    (drawn as a deformed solution)."""
+    d = workdir("rbc_off_")
+
+    def run(args, np_, opts, extra, expect_ok=True):  # the whole offline stage (the module's run stops after the snapshots)
+        c = ["mpirun", "-n", str(np_), args.exe, "offline", "-options_file", opts] + extra
+        p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if expect_ok and p.returncode != 0:
+            print(p.stdout[-4000:])
+            sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
+        return p
+    p = run(args, 1, "runs/ring_on_block.opts", ["-train_size", "7", "-dual_max_r", "1", "-rom", d + "/maxr1.h5", "-report", d + "/maxr1.json"])
+    check("warning: the dual basis misses its tolerance" in p.stdout and "(-dual_max_r stopped the greedy)" in p.stdout and report(d + "/maxr1.json")["dual"]["tol_reached"] is False,
+          "offline -dual_max_r 1: the missed tolerance warned with its reason")
+    p = run(args, 1, "runs/ring_on_block.opts", ["-train_size", "7", "-rom", d + "/ok.h5", "-offline_basis_output", d + "/view.h5"])
+    check("misses its tolerance" not in p.stdout and "too coarse" not in p.stdout, "offline with the shipped options: neither warning")
+    for n in ("1", "2"):
+        p = run(args, 1, "runs/ring_on_block.opts", ["-train_size", n, "-rom", d + "/t%s.h5" % n])
+        check("the training set is too coarse" in p.stdout, "offline -train_size %s: the too-coarse warning" % n)
+    p = run(args, 2, "runs/ring_on_block.opts", ["-train_size", "5", "-rom", d + "/tol10.h5", "-snapshots_restart", "0", "-dual_tol_relative", "0", "-dual_tol", "10"], expect_ok=False)
+    check(p.returncode != 0 and "the dual basis is empty: the tolerance 10" in p.stdout and "-dual_tol" in p.stdout and "supremizers" not in p.stdout,
+          "an absolute -dual_tol above every snapshot: refused naming -dual_tol (2 ranks)")
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ok.snapshots.h5:/snapshots/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "is a dataset of the rbcontact snapshot file" in p.stdout, "dualbasis on s.h5:/snapshots/lambda: refused, naming the file form")
+    p = subprocess.run(["/usr/bin/python3", "share/plot_fields.py", d + "/view.h5", "-o", d + "/view.png"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "is a basis view" in p.stdout and not os.path.exists(d + "/view.png"), "plot_fields.py on a basis view: refused, no picture")
 
 
 def bases(args):
@@ -653,7 +689,7 @@ def initial_guess(args):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "early_options", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "early_options", "bases_warnings", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -1352,6 +1352,16 @@ def files(args):
         left = glob.glob(d + "/*.tmp*") + glob.glob(d + "/.*tmp*")
         check(p.returncode != 0 and "-ecsw_max_points" in p.stdout and after == before and not left,
               "offline failing on %d rank(s) (-ecsw_max_points 1): ROM and basis file unchanged, no temporary file (%s)" % (np_, left))
+    # ... also when it fails after writing them (the held-out choice, the estimate's calibration read the written files;
+    # audit of 2026-12-01): the previous pair put back, no .previous file left
+    run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-offline_stop", "snapshots", "-train_type", "random", "-train_size", "3", "-train_seed", "3",
+                             "-body_E", "50,100", "-snapshots", d + "/held_E50.h5"])
+    for np_ in (1, 2):
+        p = run(args, np_, "offline", ["-options_file", "runs/ring_on_block.opts", "-rom", rom, "-dual_select_snapshots", d + "/held_E50.h5"] + small, expect_ok=False)
+        after = {q: sha(q) for q in before}
+        left = glob.glob(d + "/*.previous.*") + glob.glob(d + "/*.tmp*")
+        check(p.returncode != 0 and "-dual_select_snapshots" in p.stdout and after == before and not left,
+              "offline failing after writing the ROM on %d rank(s) (held-out file of another configuration): the previous pair put back (%s)" % (np_, left))
     p = run(args, 1, "validate", val)
     check(p.returncode == 0, "the previous ROM and basis file still validate")
     # the optional surface data of the max pressure and half-width (/online/outputs, since 2026-11-25): a file

@@ -119,6 +119,17 @@ struct DualBasisResult {
   PetscReal             tolAbs = 0;         // the absolute tolerance the greedy used (after -dual_tol_relative)
   // Whether the basis meets it (nmf does not read -dual_tol; a greedy may stop at -dual_max_r or at the cone's limit).
   bool TolReached() const { return trainMaxErr <= tolAbs * (1 + 1e-12); }
+  // Why it does not, for a warning (snapshots: the number of candidate columns): nmf's fixed rank, every snapshot kept,
+  // the cone's limit, a greedy whose own error met the tolerance while the cone projection's did not (angle measures
+  // the distance to the span), or -dual_max_r (the last reason said before 2026-12-01 even where -dual_max_r was unset).
+  std::string MissedTolReason(PetscInt snapshots) const
+  {
+    if (type == "nmf") return "nmf has the fixed rank -dual_r and does not read -dual_tol";
+    if (W.cols >= snapshots) return "every snapshot is in the basis";
+    if (!skipped.empty()) return "the remaining snapshots lie in the span of the basis but outside its cone (-dual_max_cond)";
+    if (!history.empty() && history.back() <= tolAbs * (1 + 1e-12)) return "the greedy met the tolerance in its own measure (" + std::string(type == "angle" ? "angle: the distance to the span" : "its selection error") + "), the projection onto the cone of the basis does not";
+    return "-dual_max_r stopped the greedy";
+  }
   std::vector<PetscReal> trainErr;          // final projection error of every snapshot (NNLS onto the cone of W)
   PetscReal             mcpgMinRemainder = 0;    // mcpg: min over steps of min(theta - Upsilon) / ||theta|| before clipping (>= -1e-12)
   PetscReal             mcpgMaxLDPViolation = 0; // mcpg: max over steps of the LDP solution's violation of Upsilon <= theta (before restoration), / ||theta||

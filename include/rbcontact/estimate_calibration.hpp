@@ -16,5 +16,8 @@ namespace rbc {
 // estimate {enrichment, calibration_points, calibration_seed, safety, scale, floor, calibration_min_effectivity,
 // calibration_max_effectivity (u, lambda, force), calibration_fom_median_s}. Collective on world.
 PetscErrorCode CalibrateErrorEstimate(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep);
+// Its options (-estimate_calibration_size, _seed, -estimate_safety), checked; *n, *seed, *safety hold the defaults on
+// entry. The offline stage checks them before the snapshots too.
+PetscErrorCode EstimateCalibrationOptions(MPI_Comm world, PetscInt *n, PetscInt *seed, PetscReal *safety);
 
 } // namespace rbc

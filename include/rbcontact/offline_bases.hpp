@@ -65,6 +65,22 @@ PetscErrorCode TruncateBases(OfflineBasisSet *b, PetscInt r);
 // (its lambda); negative entries beyond round-off (-1e-12 max |.|) are refused, round-off ones clipped to 0.
 PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &spec, DenseMatrix *L);
 
+// The files at paths (their link targets), as they are before a step that replaces them and may fail after: rank 0
+// keeps each existing one aside as a hard link (<file>.previous.<pid>); Restore puts them back (atomic renames), Drop
+// forgets them. A killed run leaves the .previous files beside the new ones.
+class PreviousFiles {
+public:
+  PreviousFiles(MPI_Comm comm, const std::vector<std::string> &paths);
+  PreviousFiles(const PreviousFiles &)            = delete;
+  PreviousFiles &operator=(const PreviousFiles &) = delete;
+  ~PreviousFiles() { Drop(); }
+  void Restore();
+  void Drop();
+
+private:
+  std::vector<std::pair<std::string, std::string>> kept_; // target, its hard link
+};
+
 // Report keys dual {type, r, train_max_err, train_max_rel_err, history, tol_abs, norm, gram_cond,
 // selected, min_entry} and nnls {solves, max_kkt, retries}; a negative basis entry is an error.
 PetscErrorCode ReportDualBasis(MPI_Comm comm, const DualBasisResult &dual, Report *rep);

@@ -61,8 +61,7 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   }
   PetscCall(PetscPrintf(comm, "rbcontact dualbasis: %s, %" PetscInt_FMT " multipliers x %" PetscInt_FMT " snapshots -> r = %" PetscInt_FMT ", max training error %.3e (rel. %.3e), %.2f s\n", dual.type.c_str(), L.rows, L.cols, dual.W.cols, (double)dual.trainMaxErr, (double)dual.trainMaxRelErr, (double)(t2 - t1)));
   if (!dual.TolReached()) { // (exit 0 without a word before; report key dual.tol_reached)
-    const std::string why = dual.type == "nmf" ? "nmf has the fixed rank -dual_r and does not read -dual_tol" : dual.W.cols >= L.cols ? "every snapshot is in the basis" : !dual.skipped.empty() ? "the remaining snapshots lie in the span of the basis but outside its cone (-dual_max_cond)" : "-dual_max_r stopped the greedy";
-    PetscCall(PetscPrintf(comm, "rbcontact dualbasis: warning: the basis misses its tolerance: max training error %.3e > %.3e (%s)\n", (double)dual.trainMaxErr, (double)dual.tolAbs, why.c_str()));
+    PetscCall(PetscPrintf(comm, "rbcontact dualbasis: warning: the basis misses its tolerance: max training error %.3e > %.3e (%s)\n", (double)dual.trainMaxErr, (double)dual.tolAbs, dual.MissedTolReason(L.cols).c_str()));
   }
   PetscCall(rep.Write(comm, reportPath));
   PetscFunctionReturn(0);

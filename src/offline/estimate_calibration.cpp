@@ -6,6 +6,19 @@
 
 namespace rbc {
 
+PetscErrorCode EstimateCalibrationOptions(MPI_Comm world, PetscInt *n, PetscInt *seed, PetscReal *safety)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(world, "estimate_", "Online error estimate: calibration (offline)", "CalibrateErrorEstimate");
+  PetscCall(PetscOptionsInt("-calibration_size", "random parameters where the FOM calibrates the estimate (0: none)", "", *n, n, NULL));
+  PetscCall(PetscOptionsInt("-calibration_seed", "seed of those parameters", "", *seed, seed, NULL));
+  PetscCall(PetscOptionsReal("-safety", "factor on the fitted calibration (a margin for parameters worse than every calibration point)", "", *safety, safety, NULL));
+  PetscOptionsEnd();
+  PetscCheck(*safety >= 1 && *safety <= 100, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_safety %g out of range [1, 100]", (double)*safety);
+  PetscCheck(*n >= 0 && *n <= 100000, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_calibration_size %" PetscInt_FMT " out of range [0, 1e5]", *n);
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode CalibrateErrorEstimate(MPI_Comm world, const SceneSpec &scene, const std::string &romPath, RomWriter *w, Report *rep)
 {
   PetscInt  n = 20, seed = 2026;
@@ -14,13 +27,7 @@ PetscErrorCode CalibrateErrorEstimate(MPI_Comm world, const SceneSpec &scene, co
   std::vector<double> sizes;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(world, "estimate_", "Online error estimate: calibration (offline)", "CalibrateErrorEstimate");
-  PetscCall(PetscOptionsInt("-calibration_size", "random parameters where the FOM calibrates the estimate (0: none)", "", n, &n, NULL));
-  PetscCall(PetscOptionsInt("-calibration_seed", "seed of those parameters", "", seed, &seed, NULL));
-  PetscCall(PetscOptionsReal("-safety", "factor on the fitted calibration (a margin for parameters worse than every calibration point)", "", safety, &safety, NULL));
-  PetscOptionsEnd();
-  PetscCheck(safety >= 1 && safety <= 100, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_safety %g out of range [1, 100]", (double)safety);
-  PetscCheck(n >= 0 && n <= 100000, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_calibration_size %" PetscInt_FMT " out of range [0, 1e5]", n);
+  PetscCall(EstimateCalibrationOptions(world, &n, &seed, &safety));
   PetscCall(RomReadOptional(romPath, "/online/estimate/default_sizes", &sizes, &has));
   JsonValue &e = rep->root["estimate"];
   e["enrichment"] = (bool)has;

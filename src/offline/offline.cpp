@@ -3,6 +3,7 @@
 // finished round written to the snapshot file before the next starts: a killed job resumes) and the
 // bases and ROM steps (offline_bases.cpp, offline_greedy.cpp, offline_rom.cpp).
 #include "rbcontact/offline.hpp"
+#include "rbcontact/estimate_calibration.hpp"
 #include "rbcontact/rom_probe.hpp"
 #include "rbcontact/dual_selection.hpp"
 #include "rbcontact/offline_bases.hpp"
@@ -196,6 +197,13 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(DualSensitivityStepFromOptions(world, &step));
     PetscCall(PODCheckOptions(world));
     PetscCall(DualBasisOptionsFromOptions(world, &dbo));
+    { // -pod_n beyond the snapshots (with their sensitivities) is known now (it was refused after them)
+      PetscInt  n = 0;
+      PetscBool set;
+      PetscCall(PetscOptionsGetInt(NULL, NULL, "-pod_n", &n, &set));
+      const PetscInt nsnap = ntrain * (s.sensitivities ? 1 + np : 1);
+      PetscCheck(!set || n <= nsnap, world, PETSC_ERR_ARG_OUTOFRANGE, "-pod_n %" PetscInt_FMT " must lie in [1, %" PetscInt_FMT "] (the number of snapshots%s)", n, nsnap, s.sensitivities ? " with their sensitivities" : "");
+    }
   }
   if (full) { // options of the last step, checked before the snapshots (hours on a real scene)
     EIMOptions  eo;
@@ -207,6 +215,19 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscBool estimate = PETSC_FALSE;
       PetscCall(PetscOptionsGetBool(NULL, NULL, "-estimate", &estimate, NULL));
       PetscCheck(!estimate || (hc.ecsw && hc.ecswFirst), world, PETSC_ERR_ARG_INCOMP, "-estimate needs the empirical cubature as the online default (-rom_hyper ecsw or ecsw,eim): the EIM gives no online error estimate");
+      if (estimate) { // (refused after the snapshots and the ROM's writing before 2026-12-01)
+        PetscInt  n = 20, seed = 2026;
+        PetscReal safety = 2;
+        PetscCall(EstimateCalibrationOptions(world, &n, &seed, &safety));
+      }
+    }
+    { // the contact patch's options of the last step (refused after the snapshots before 2026-12-01)
+      PetscInt  v = 4;
+      PetscBool set;
+      PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &v, &set));
+      PetscCheck(!set || (v >= 1 && v <= 64), world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", v);
+      PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_patch_rings", &v, &set));
+      PetscCheck(!set || (v >= 0 && v <= 20), world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", v);
     }
     PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
     PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));

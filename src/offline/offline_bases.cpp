@@ -12,6 +12,8 @@
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/mesh.hpp"
+#include "rbcontact/report.hpp"
+#include <cstdio>
 #include <cmath>
 #include <unistd.h>
 #include <filesystem>
@@ -241,6 +243,9 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
         }
       b->rDefault = r < dual.W.cols ? r : -1;
     } else PetscCall(BuildDualBasis(L, &dual));
+    // an absolute -dual_tol at or above every snapshot's distance to the empty cone keeps no vector: refused here, by
+    // name (it came later as "0 supremizers for 0 dual vectors" or "-rom_R 0 out of range", naming no given option)
+    PetscCheck(dual.W.cols > 0, world, PETSC_ERR_ARG_OUTOFRANGE, "the dual basis is empty: the tolerance %g (-dual_tol, absolute) is at or above the error of every multiplier snapshot without a basis (%.3e): lower -dual_tol", (double)dual.tolAbs, (double)dual.trainMaxErr);
     for (auto &j : dual.selected)
       if (j >= 0) j = srcOf[j]; // a predicted column counts as its snapshot's (the supremizers' K)
     if (massWeighted)
@@ -421,9 +426,13 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
     // too coarse for the dual tolerance (the greedy's error between training points is not controlled)
     // (-snapshots_sensitivities: the candidates are the snapshots' multipliers and their predicted neighbours)
     const PetscInt rAnswer   = bs.rDefault > 0 ? bs.rDefault : dual.W.cols, cand = bs.snapshotsUsed + bs.dualPredicted;
-    const bool     tooCoarse = rAnswer >= cand - 1 && cand > 2;
+    // (1 or 2 candidates were left out: exactly the coarsest sets, a lambda error 30x the 7-point set's without a word)
+    const bool     tooCoarse = rAnswer >= cand - 1 || cand <= 2;
     rep->root["dual_kept_all_snapshots"] = tooCoarse;
     if (tooCoarse) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis keeps %" PetscInt_FMT " of the %" PetscInt_FMT " training multipliers: the training set is too coarse for -dual_tol (use more training parameters or a larger -dual_tol)\n", rAnswer, cand));
+    // a basis that misses its tolerance (nmf's fixed rank, -dual_max_r, the cone's limit): the report said so, the
+    // terminal did not (the ROM 30-60x worse, exit 0), as dualbasis does since 2026-11-29
+    if (!dual.TolReached()) PetscCall(PetscPrintf(world, "rbcontact offline: warning: the dual basis misses its tolerance: max training error %.3e > %.3e (%s)\n", (double)dual.trainMaxErr, (double)dual.tolAbs, dual.MissedTolReason(cand).c_str()));
   }
 
   // --- bases file (-offline_stop bases: the ROM path; full pipeline: basisPath) and ROM file
@@ -531,12 +540,25 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   // that a failed run leaves the previous ROM and basis file together (and rom_id tells a torn pair)
   if (!onlineRom) PetscCall(w.Write(world, bpath));
   if (onlineRom) {
-    PetscCall(w.Write(world, bpath));
-    PetscCall(wr.Write(world, romPath));
-    if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
-    DualSizeRow chosen;
-    PetscCall(SelectDualSize(world, fom.scene, romPath, dso, &wr, rep, &chosen)); // -dual_select_*: the answer's R on held-out solutions
-    if (dso.refit && chosen.R < dual.W.cols) PetscCall(refitChosen(chosen));
+    // the calibration and the held-out choice read the written files: a failure there (an option out of range, a FOM
+    // solve) left the new pair in place of the previous one (audit of 2026-12-01), so the previous files are kept aside
+    // (hard links) until the last step and put back on a failure
+    PreviousFiles   previous(world, {bpath, romPath});
+    DualSizeRow     chosen;
+    PetscErrorCode  ierr = [&]() -> PetscErrorCode {
+      PetscFunctionBeginUser;
+      PetscCall(w.Write(world, bpath));
+      PetscCall(wr.Write(world, romPath));
+      if (bs.estimate) PetscCall(CalibrateErrorEstimate(world, fom.scene, romPath, &wr, rep));
+      PetscCall(SelectDualSize(world, fom.scene, romPath, dso, &wr, rep, &chosen)); // -dual_select_*: the answer's R on held-out solutions
+      if (dso.refit && chosen.R < dual.W.cols) PetscCall(refitChosen(chosen));
+      PetscFunctionReturn(0);
+    }();
+    if (ierr) {
+      previous.Restore();
+      PetscFunctionReturn(ierr);
+    }
+    previous.Drop();
     unsigned long long big[2] = {0, 0};
     std::string        bigName;
     if (wrank == 0) {
@@ -581,6 +603,29 @@ PetscErrorCode OfflineBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &ord
   PetscFunctionReturn(0);
 }
 
+PreviousFiles::PreviousFiles(MPI_Comm comm, const std::vector<std::string> &paths)
+{
+  PetscMPIInt rank = 0;
+  (void)MPI_Comm_rank(comm, &rank);
+  if (rank != 0) return;
+  for (const auto &p : paths) {
+    const std::string target = OutputTarget(p), keep = target + ".previous." + std::to_string((long)getpid());
+    if (::link(target.c_str(), keep.c_str()) == 0) kept_.emplace_back(target, keep);
+  }
+}
+
+void PreviousFiles::Restore()
+{
+  for (const auto &k : kept_) (void)std::rename(k.second.c_str(), k.first.c_str()); // atomic: the previous file is back
+  kept_.clear();
+}
+
+void PreviousFiles::Drop()
+{
+  for (const auto &k : kept_) (void)::unlink(k.second.c_str());
+  kept_.clear();
+}
+
 PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatrix *Lout)
 {
   PetscFunctionBeginUser;
@@ -592,7 +637,19 @@ PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatr
     SnapshotHeader h; // (an unfinished file was used without a word)
     PetscCall(SnapshotFile::ReadHeader(s, &h));
     if (snaps.size() < h.trainingPoints.size()) PetscCall(PetscPrintf(comm, "rbcontact dualbasis: warning: snapshot file %s holds %zu of its %zu snapshots (an unfinished run): the basis is built from those\n", s.c_str(), snaps.size(), h.trainingPoints.size()));
-  } else PetscCall(ImportSnapshotMatrix(comm, s, &cols));
+  } else {
+    // an rbcontact snapshot file's dataset (s.h5:/snapshots/lambda, ntrain x R) read as a matrix of another code (rows =
+    // multipliers) was taken transposed, unfinished rows included, exit 0
+    const size_t colon = s.rfind(':');
+    if (colon != std::string::npos) {
+      SnapshotHeader h;
+      PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+      const PetscErrorCode e = SnapshotFile::ReadHeader(s.substr(0, colon), &h);
+      PetscCall(PetscPopErrorHandler());
+      PetscCheck(e != 0, comm, PETSC_ERR_USER_INPUT, "dualbasis: %s is a dataset of the rbcontact snapshot file %s: give the file itself (-snapshots %s), whose finished rows are read as snapshots", s.c_str(), s.substr(0, colon).c_str(), s.substr(0, colon).c_str());
+    }
+    PetscCall(ImportSnapshotMatrix(comm, s, &cols));
+  }
   PetscCheck(!cols.empty() && !cols[0].empty(), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds no snapshots", s.c_str());
   DenseMatrix &L    = *Lout;
   PetscReal    vmax = 0, vmin = 0;

@@ -370,7 +370,7 @@ PetscErrorCode DualBasisOptionsFromOptions(MPI_Comm comm, DualBasisOptions *o)
   PetscOptionsEnd();
   // (-dual_tol 1 with -dual_tol_relative kept no vector, and the error came later from the supremizers: "0 supremizers
   // for 0 dual vectors", naming no option)
-  PetscCheck(o->tol >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be >= 0", (double)o->tol);
+  PetscCheck(o->tol >= 0 && std::isfinite(o->tol), comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g must be a finite number >= 0", (double)o->tol);
   PetscCheck(!o->tolRelative || o->tol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_tol %g with -dual_tol_relative must be < 1 (a fraction of the largest multiplier snapshot's norm: 1 keeps no dual vector)", (double)o->tol);
   PetscCheck(o->maxCond >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_cond %g must be >= 1", (double)o->maxCond);
   PetscCheck(o->maxR == -1 || o->maxR >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-dual_max_r %" PetscInt_FMT " must be >= 1", o->maxR);

@@ -488,7 +488,7 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
       PetscCheck(!cal, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate holds a calibration but no default_sizes (the answer's sizes inside the stored bases): a corrupt file", path.c_str());
     }
     if (found) {
-      PetscCheck(d.size() == 2 && d[0] >= 1 && d[0] <= Npod && d[1] >= 1 && d[1] <= Rfull, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/default_sizes must hold 2 sizes within [1, %" PetscInt_FMT "] (POD modes) and [1, %" PetscInt_FMT "] (dual vectors)", path.c_str(), Npod, Rfull);
+      PetscCheck(d.size() == 2 && d[0] >= 1 && d[0] <= Npod && d[1] >= 1 && d[1] <= Rfull && d[0] == std::floor(d[0]) && d[1] == std::floor(d[1]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/estimate/default_sizes must hold 2 sizes within [1, %" PetscInt_FMT "] (POD modes) and [1, %" PetscInt_FMT "] (dual vectors)", path.c_str(), Npod, Rfull);
       NDefault = (PetscInt)d[0];
       RDefault = (PetscInt)d[1];
       PetscCall(ReadChecked(path, "/online/estimate/calibration", 6, &d));
