@@ -655,9 +655,49 @@ def search(args):
         check(p.returncode != 0 and needle in p.stdout, "refused with a message naming %s" % needle)
 
 
+def solver_input(args):
+    """The fom stage's outputs, option values and solver settings found wrong by the audit of 2026-12-01 (each exit 0, a
+    half-written output or a message blaming the stiffness before): refused by name before any work, or right."""
+    out = workdir("rbc_contact_")
+    base = ["mpirun", "-n", str(args.np), args.exe, "fom"]
+    ring = base + ["-options_file", "runs/ring_on_block.opts"]
+
+    def fails(cmd, words, what):
+        p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        ok = p.returncode != 0 and all(w in p.stdout for w in words)
+        check(ok, "%s: refused naming %s" % (what, ", ".join(words)))
+        if not ok:
+            print(p.stdout[-1500:])
+        return p
+
+    os.mkdir(os.path.join(out, "x.xmf"))
+    fails(ring + ["-fom_output", os.path.join(out, "x.h5")], ["-fom_output's XDMF", "it is a directory", "checked before any work"], "-fom_output whose .xmf is a directory")
+    check(not os.path.exists(os.path.join(out, "x.h5")), "... and no .h5 written (it was, then the run failed)")
+    opts = os.path.join(out, "in.opts")
+    with open(opts, "w") as f:
+        f.write("-options_file runs/ring_on_block.opts\n-fem_degree 2\n")
+    before = open(opts).read()
+    fails(base + ["-options_file", opts, "-report", opts], ["the output -report", "is the input -options_file"], "-report onto the run's options file")
+    check(open(opts).read() == before, "... the options file unchanged (it held the report)")
+    fails(base + ["-options_file", opts, "-fem_degree"], ["option -fem_degree is given without a value"], "a trailing -fem_degree (cancelled the file's -fem_degree 2)")
+    fails(ring + ["-kacanov_max_it"], ["option -kacanov_max_it is given without a value"], "-kacanov_max_it without a value")
+    fails(ring + ["-fom_kkt_tol", "inf"], ["-fom_kkt_tol inf", "must be a finite number > 0"], "-fom_kkt_tol inf")
+    fails(ring + ["-fom_dual_matrix", "saddle", "-contact_compliance", "bogus"], ["-contact_compliance: unknown value 'bogus'"], "-contact_compliance bogus with the saddle path")
+    fails(base + ["-options_file", "runs/flat_punch.opts", "-fem_degree", "2", "-contact_quadrature", "nodal"], ["-contact_quadrature nodal collocates at the slave vertices", "-fem_degree 2"],
+          "P2 with nodal collocation (the patch test 3.7 % off)")
+    fails(ring + ["-fom_ksp_type", "cg", "-fom_pc_type", "jacobi", "-fom_ksp_rtol", "1e-3"], ["is inaccurate", "-fom_ksp_rtol"], "a loose iterative elastic solver (blamed on a singular stiffness)")
+    r0, _ = run(args, args.np, "runs/ring_on_block.opts", [], "ref")
+    r1, _ = run(args, args.np, "runs/ring_on_block.opts", ["-fom_qp_tao_type", "bqpip", "-fom_qp_polish", "0"], "nopolish")
+    check(r1["nactive"] == r0["nactive"] and abs(r1["contact_halfwidth"] - r0["contact_halfwidth"]) <= 1e-6 * r0["contact_halfwidth"],
+          "BQPIP without the polish: %d active nodes, half-width %.6f as the default's (%d, %.6f; its 1e-16 values counted)" % (r1["nactive"], r1["contact_halfwidth"], r0["nactive"], r0["contact_halfwidth"]))
+    if args.np == 2:  # a rank without cells: the per-rank Schur factorization failed, blamed on the Dirichlet conditions
+        r2, _ = run(args, 2, "runs/ring_on_block.opts", ["-mesh_partitioner", "gather"], "gather")
+        check(abs(r2["contact_force"] - r0["contact_force"]) <= 1e-10 * r0["contact_force"], "-mesh_partitioner gather on 2 ranks: force %.14f = the default's %.14f" % (r2["contact_force"], r0["contact_force"]))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

@@ -26,6 +26,10 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse();
 // the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...). given: the words given
 // directly (the command line, the Python keywords): online, probe and dualbasis leave out every option of a scene file but
 // their own families, not those given directly.
+// The options files the last CheckOptionsFiles visited (the whole -options_file chain, as named): inputs of the run,
+// which no output may replace (CheckDistinctFiles; `fom -report in.opts -options_file in.opts` overwrote it, exit 0).
+const std::vector<std::string> &OptionsFilesRead();
+
 // Each of these options, where it is given, has a value: PETSc's readers keep the default for an option given without
 // one (-rom_N at the end of a command line), without a word. Collective on comm (the options are the same on every rank).
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names);

@@ -29,7 +29,12 @@ PetscErrorCode StageFom(MPI_Comm comm)
   PetscCheck(!hertz || (std::isfinite(hertzRadius) && hertzRadius > 0), comm, PETSC_ERR_ARG_OUTOFRANGE, "-hertz_radius %g must be a finite number > 0 (the radius of Hertz's cylinder in 2D, sphere in 3D)", (double)hertzRadius);
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, outPath, "-fom_output"));
-  PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-fom_output", outPath}, {"-fom_output's XDMF", outPath[0] ? XdmfPath(outPath) : ""}}, {}));
+  // the XDMF beside it too (a directory there failed after the solve, the new .h5 in place; a FIFO was replaced)
+  PetscCall(CheckOutputPath(comm, outPath[0] ? XdmfPath(outPath) : "", "-fom_output's XDMF"));
+  char      meshPath[PETSC_MAX_PATH_LEN] = "";
+  PetscBool meshSet                      = PETSC_FALSE;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-mesh_file", meshPath, sizeof meshPath, &meshSet));
+  PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-fom_output", outPath}, {"-fom_output's XDMF", outPath[0] ? XdmfPath(outPath) : ""}}, {{"-mesh_file", meshPath}}));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   ElasticFOM    fom;
   ContactMap    map;

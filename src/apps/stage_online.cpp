@@ -50,6 +50,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   }
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, recPath, "-rom_reconstruct"));
+  PetscCall(CheckOutputPath(comm, recPath[0] ? XdmfPath(recPath) : "", "-rom_reconstruct's XDMF"));
   {
     char basisPath[PETSC_MAX_PATH_LEN] = "";
     PetscCall(PetscOptionsGetString(NULL, NULL, "-rom_basis", basisPath, sizeof basisPath, NULL));

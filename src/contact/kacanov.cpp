@@ -89,7 +89,12 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, saddle above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscCall(PetscOptionsInt("-dual_dense_max_dofs", "auto: dense S only while the compliance G (contact dofs squared) has at most this many rows (memory)", NULL, dualDenseMaxDofs, &dualDenseMaxDofs, NULL));
   PetscOptionsEnd();
-  PetscCheck(kktTol > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be > 0", (double)kktTol);
+  PetscCheck(kktTol > 0 && std::isfinite(kktTol), comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be a finite number > 0", (double)kktTol);
+  { // checked here for every QP path (the dense one alone read it: bogus passed with -fom_dual_matrix shell or saddle)
+    char m[32] = "auto";
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-contact_compliance", m, sizeof m, NULL));
+    PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "inverse") || !strcmp(m, "redundant") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur, inverse, redundant or solves)", m);
+  }
   PetscCall(RenameTaoOptions(comm));
   PetscCall(qp_.Setup("fom_"));
   PetscCall(shell_.SetFromOptions(comm, "fom_"));
@@ -816,10 +821,14 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
   s->R = (PetscInt)lam.size();
   PetscReal lmax = 0;
   for (PetscReal l : lam) lmax = std::max(lmax, l);
+  // active: above 1e-10 of the largest multiplier (as ContactSurfaceWarnings): an interior-point QP without its
+  // active-set polish (-fom_qp_polish 0) leaves values of 1e-16 to 1e-11 that counted as contact (45 active nodes for
+  // 15, the half-width 3.2x; audit of 2026-12-01)
+  const PetscReal athr = 1e-10 * lmax;
   for (size_t i = 0; i < lam.size(); ++i) {
     // lambda_i is the coefficient of the pressure field in the hat basis psi_i (docs/contact.md):
     // nodal pressure lambda_i, resultant int p n2 = sum_i lambda_i int psi_i n2.
-    if (lam[i] > 0) ++s->nactive;
+    if (lam[i] > athr) ++s->nactive;
     for (PetscInt d = 0; d < dim; ++d) s->forceVec[d] += lam[i] * w[i] * n[d][i];
     s->maxPressure = std::max(s->maxPressure, lam[i]);
   }
@@ -838,7 +847,7 @@ PetscErrorCode SummarizeContact(const ContactSystem &sys, Vec lambda, PetscInt d
     const PetscReal t[2] = {-s->forceVec[1] / s->force, s->forceVec[0] / s->force};
     std::vector<std::pair<PetscReal, PetscReal>> active; // (tangent coordinate, nodal pressure)
     for (size_t i = 0; i < lam.size(); ++i)
-      if (lam[i] > 0) active.emplace_back(x[0][i] * t[0] + x[1][i] * t[1], lam[i]);
+      if (lam[i] > athr) active.emplace_back(x[0][i] * t[0] + x[1][i] * t[1], lam[i]);
     std::sort(active.begin(), active.end());
     {
       // second moment of the pressure along the tangent (exact a for p0 sqrt(1 - x^2/a^2))

@@ -201,10 +201,14 @@ static PetscErrorCode BlockDiagonalAcrossRanks(Mat A, PetscBool *yes, Mat *Ad)
   *Ad = nullptr;
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIAIJ, &mpiaij));
   if (mpiaij) {
-    MatInfo info;
+    MatInfo  info;
+    PetscInt m;
     PetscCall(MatMPIAIJGetSeqAIJ(A, Ad, &Ao, NULL));
     PetscCall(MatGetInfo(Ao, MAT_LOCAL, &info));
-    coupled = info.nz_used > 0;
+    PetscCall(MatGetLocalSize(A, &m, NULL));
+    // (a rank without rows, -mesh_partitioner gather: its empty block's factorization failed, blamed on the Dirichlet
+    // conditions; the parallel factorization takes it)
+    coupled = info.nz_used > 0 || m == 0;
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &coupled, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)A)));
   *yes = coupled ? PETSC_FALSE : PETSC_TRUE;
@@ -525,7 +529,16 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
                infog1 == -38 ? ": a parallel ordering (-fom_mat_mumps_icntl_28 2) that this MUMPS build lacks (PT-Scotch/ParMETIS); drop -fom_mat_mumps_icntl_28" : infog1 == -9 || infog1 == -8 || infog1 == -14 || infog1 == -15 || infog1 == -17 || infog1 == -20 ? ": its workspace is too small: raise -fom_mat_mumps_icntl_14" : infog1 == -10 ? ": the stiffness is numerically singular: a body without enough Dirichlet conditions (-dirichlet)?" : "");
     SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: DIVERGED_PC_FAILED (%s). A zero pivot usually means a body without enough Dirichlet conditions (-dirichlet)", PCFailedReasons[pcr]);
   }
-  PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. A singular stiffness usually means a body without enough Dirichlet conditions (-dirichlet)", KSPConvergedReasons[reason]);
+  // an iterative solver: its own limits first (-fom_ksp_max_it 5 was blamed on the Dirichlet conditions alone)
+  PetscBool iterative;
+  {
+    KSPType kt;
+    PetscCall(KSPGetType(ksp, &kt));
+    PetscCall(PetscStrcmp(kt, KSPPREONLY, &iterative));
+    iterative = iterative ? PETSC_FALSE : PETSC_TRUE;
+  }
+  PetscCheck(reason > 0, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) did not converge: %s. %s", KSPConvergedReasons[reason],
+             iterative && reason == KSP_DIVERGED_ITS ? "The iterative solver reached -fom_ksp_max_it: raise it, or use a stronger -fom_pc_type (the default is a direct Cholesky factorization)" : "A singular stiffness usually means a body without enough Dirichlet conditions (-dirichlet)");
   if (!residualChecked_) { // the first solve with a new factorization: a direct solver on a singular A says nothing
     Vec       r;
     PetscReal nr, nb;
@@ -535,7 +548,11 @@ PetscErrorCode ElasticFOM::ApplyInverse(Vec rhs, Vec x)
     PetscCall(VecNorm(r, NORM_2, &nr));
     PetscCall(VecNorm(rhs, NORM_2, &nb));
     PetscCall(VecDestroy(&r));
-    PetscCheck(std::isfinite(nr) && nr <= 1e-6 * nb, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) is inaccurate: relative residual %s. The stiffness is singular or nearly so: a body may rotate or move freely (too few Dirichlet conditions, -dirichlet), or the materials are degenerate", std::isfinite(nr) && nb > 0 ? std::to_string(nr / nb).c_str() : "not finite");
+    PetscReal rtol;
+    PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
+    // (an iterative solver stopped by a loose -fom_ksp_rtol was blamed on a singular stiffness)
+    PetscCheck(std::isfinite(nr) && nr <= 1e-6 * nb, PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED, "The elastic solve (KSP prefix fom_) is inaccurate: relative residual %s (at most 1e-6 is accepted). %s", std::isfinite(nr) && nb > 0 ? std::to_string(nr / nb).c_str() : "not finite",
+               iterative && rtol > 1e-7 ? "The iterative solver stopped at its tolerance -fom_ksp_rtol; set it to 1e-8 or below" : "The stiffness is singular or nearly so: a body may rotate or move freely (too few Dirichlet conditions, -dirichlet), or the materials are degenerate");
     residualChecked_ = true;
   }
   PetscFunctionReturn(0);

@@ -99,9 +99,14 @@ PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> 
   PetscFunctionReturn(0);
 }
 
+static std::vector<std::string> optionsFilesRead; // of the last CheckOptionsFiles
+
+const std::vector<std::string> &OptionsFilesRead() { return optionsFilesRead; }
+
 std::string CheckOptionsFiles(const std::vector<std::string> &words)
 {
   std::vector<std::string>                             chain, shown;
+  optionsFilesRead.clear();
   std::function<std::string(const std::string &, int)> visit = [&](const std::string &file, int depth) -> std::string {
     char buf[PATH_MAX];
     if (!realpath(file.c_str(), buf)) return "options file " + file + " (-options_file): " + std::strerror(errno);
@@ -116,6 +121,7 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
     if (!in) return "options file " + file + " (-options_file): cannot be read";
     chain.push_back(canon);
     shown.push_back(file);
+    if (std::find(optionsFilesRead.begin(), optionsFilesRead.end(), file) == optionsFilesRead.end()) optionsFilesRead.push_back(file);
     for (std::string line; std::getline(in, line);) {
       const size_t hash = line.find('#');
       if (hash != std::string::npos) line.resize(hash);

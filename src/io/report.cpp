@@ -1,5 +1,6 @@
 // src/io/report.cpp: JSON tree for the -report summaries and atomic file writing.
 #include "rbcontact/report.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/provenance.hpp"
 #include <cmath>
 #include <cerrno>
@@ -226,7 +227,7 @@ static std::string FileKey(const std::string &path)
   return std::string("path ") + (realpath(dir.c_str(), buf) ? buf : dir.c_str()) + "/" + name;
 }
 
-PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputs)
+PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputsGiven)
 {
   PetscMPIInt rank;
   std::string why;
@@ -234,7 +235,9 @@ PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    std::vector<std::string> ko, ki;
+    std::vector<std::string>                         ko, ki;
+    std::vector<std::pair<std::string, std::string>> inputs = inputsGiven; // and every options file of the run
+    for (const auto &f : OptionsFilesRead()) inputs.emplace_back("-options_file", f);
     for (const auto &o : outputs) ko.push_back(o.second.empty() ? std::string() : FileKey(o.second));
     for (const auto &i : inputs) ki.push_back(i.second.empty() ? std::string() : FileKey(i.second));
     for (size_t a = 0; a < outputs.size() && why.empty(); ++a) {

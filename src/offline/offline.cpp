@@ -163,6 +163,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   if (full) PetscCall(CheckOutputPath(world, s.basis, "-rom_basis"));
   PetscCheck(s.basisView.empty() || full, world, PETSC_ERR_ARG_INCOMP, "-offline_basis_output needs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
   if (!s.basisView.empty()) PetscCall(CheckOutputPath(world, s.basisView, "-offline_basis_output"));
+  if (!s.basisView.empty()) PetscCall(CheckOutputPath(world, XdmfPath(s.basisView), "-offline_basis_output's XDMF"));
   {
     char reportPath[PETSC_MAX_PATH_LEN] = "";
     PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
