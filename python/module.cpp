@@ -190,7 +190,7 @@ public:
     rbc::ReducedSolution   sol;
     for (py::ssize_t k = 0; k < n; ++k) {
       for (PetscInt i = 0; i < np; ++i) m[i] = in(k, i);
-      Check(model_.par.CheckBox(PETSC_COMM_SELF, m));
+      Check(model_.par.CheckBox(PETSC_COMM_SELF, m, "contact_forces: row " + std::to_string((long long)k))); // (it blamed -mu, no row)
       Check(model_.Solve(m, &sol));
       if (sol.force.empty() && sol.converged) throw std::runtime_error("contact_forces: this ROM's hyper-reduction (" + std::string(model_.HyperName()) + ") computes no online force; use the ECSW cubature (-rom_hyper ecsw)");
       if (!sol.converged) {

@@ -17,6 +17,8 @@ NP="${RBC_NP:-2}"
 PYTHON=/usr/bin/python3 # Debian's interpreter: a pyenv python3 on PATH may lack h5py
 
 die() { echo "quickstart.sh: error: $*" >&2; exit 1; }
+# (RBC_NP=0 ran mpirun -n 0, one process per slot; RBC_NP=abc failed after the setup and the build, blamed on fom)
+case "$NP" in '' | *[!0-9]* | 0*) die "RBC_NP='$NP' must be a number of MPI ranks >= 1" ;; esac
 step() { echo; echo "==> $*"; }
 
 step "setup (share/setup.sh)"

@@ -292,7 +292,8 @@ def early_options(args):
              (["-pod_n", "6"], "-pod_n 6 must lie in [1, 5] (the number of snapshots)"), (["-estimate", "-estimate_safety", "0.5"], "-estimate_safety 0.5 out of range [1, 100]"),
              (["-estimate", "-estimate_calibration_size", "-1"], "-estimate_calibration_size -1 out of range"),
              (["-eim_quadrature_subdivisions", "0"], "-eim_quadrature_subdivisions 0 out of range [1, 64]"), (["-eim_patch_rings", "-1"], "-eim_patch_rings -1 out of range [0, 20]"),
-             (["-dual_tol_relative", "0", "-dual_tol", "inf"], "-dual_tol inf. must be a finite number >= 0")]
+             (["-dual_tol_relative", "0", "-dual_tol", "inf"], "-dual_tol inf. must be a finite number >= 0"),
+             (["-estimate", "-estimate_pod_tol", "0.5"], "-estimate_pod_tol 0.5 must lie in [0, -pod_tol")]
     for extra, words in cases:
         c = ["mpirun", "-n", "2", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-snapshots_monitor", "-rom", d + "/r.h5"] + extra
         p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

@@ -112,7 +112,7 @@ def main():
         missing = os.path.join(d, "nonexistent.h5")
         raises(lambda: rbcontact.ReducedModel(missing), [missing], "a missing ROM file")
         raises(lambda: m.solve([1.3]), ["radius", "1.3"], "a radius outside the box")
-        raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["radius"], "a radius outside the box in contact_forces")
+        raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["contact_forces: row 1", "radius"], "a radius outside the box in contact_forces (the row named, not -mu)")
         raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
         raises(lambda: rbcontact.initialize(["-rom_kacanov_monitor"]), ["already initialized"], "options after the first model")
         # a complex array was cast to its real part without a word (pybind11's forcecast)

@@ -1362,6 +1362,17 @@ def files(args):
         left = glob.glob(d + "/*.previous.*") + glob.glob(d + "/*.tmp*")
         check(p.returncode != 0 and "-dual_select_snapshots" in p.stdout and after == before and not left,
               "offline failing after writing the ROM on %d rank(s) (held-out file of another configuration): the previous pair put back (%s)" % (np_, left))
+    # validate's own inputs and outputs (audit of 2026-12-01): -report onto the basis file or the test snapshots replaced
+    # them (exit 0); the sweep's .csv was not checked before the FOM solves; an option without a value kept the default;
+    # test parameters outside the box blamed -mu
+    expect_error(args, val + ["-report", d + "/rom.basis.h5"], ["the output -report", "is the input (the ROM's basis file)"], "validate -report onto the ROM's basis file", stage="validate")
+    check(sha(d + "/rom.basis.h5") == before[d + "/rom.basis.h5"], "... the basis file unchanged")
+    os.mkdir(d + "/sw.csv")
+    expect_error(args, val + ["-validate_sweep", "-validate_sweep_output", d + "/sw"], ["-validate_sweep_output (.csv)", "it is a directory"], "validate with the sweep's .csv a directory", stage="validate")
+    expect_error(args, val + ["-test_seed"], ["option -test_seed is given without a value"], "validate -test_seed without a value", stage="validate")
+    expect_error(args, val + ["-mu_max", "1.3", "-test_type", "grid"], ["test parameter", "(-test_*)", "outside its box"], "validate with test points outside the ROM's box", stage="validate")
+    expect_error(args, ["-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", d + "/never.h5", "-estimate", "-estimate_calibration_size", "2"],
+                 ["-estimate_calibration_size 2: at least 3 calibration parameters"], "offline -estimate_calibration_size 2 (an estimate 4000x low)", stage="offline")
     p = run(args, 1, "validate", val)
     check(p.returncode == 0, "the previous ROM and basis file still validate")
     # the optional surface data of the max pressure and half-width (/online/outputs, since 2026-11-25): a file

@@ -65,6 +65,10 @@ PetscErrorCode TruncateBases(OfflineBasisSet *b, PetscInt r);
 // (its lambda); negative entries beyond round-off (-1e-12 max |.|) are refused, round-off ones clipped to 0.
 PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &spec, DenseMatrix *L);
 
+// -estimate and the enrichment's tolerances (-estimate_pod_tol, -estimate_dual_tol), checked against -pod_tol and
+// -dual_tol; the offline stage calls it before the snapshots too (they were refused after them).
+PetscErrorCode EstimateEnrichmentOptions(MPI_Comm world, PetscBool *estimate, PetscReal *estPodTol, PetscReal *estDualTol);
+
 // The files at paths (their link targets), as they are before a step that replaces them and may fail after: rank 0
 // keeps each existing one aside as a hard link (<file>.previous.<pid>); Restore puts them back (atomic renames), Drop
 // forgets them. A killed run leaves the .previous files beside the new ones.

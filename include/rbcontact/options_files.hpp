@@ -33,6 +33,8 @@ const std::vector<std::string> &OptionsFilesRead();
 // Each of these options, where it is given, has a value: PETSc's readers keep the default for an option given without
 // one (-rom_N at the end of a command line), without a word. Collective on comm (the options are the same on every rank).
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names);
+// The same for -<prefix><name> (names without the dash: {"seed", "type"} with prefix "test_").
+PetscErrorCode CheckValuesGiven(MPI_Comm comm, const std::string &prefix, std::initializer_list<const char *> names);
 
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused, const std::vector<std::string> &given = {});
 

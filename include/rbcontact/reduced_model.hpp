@@ -36,7 +36,8 @@ public:
   void           ThetaA(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
   void           ThetaF(const std::vector<PetscReal> &mu, std::vector<PetscReal> *th) const;
   // A clear error naming the parameter, the value and the box when mu is outside it (or has the wrong size).
-  PetscErrorCode CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const;
+  // what: who gave mu, in the messages ("-mu"; validate names the test parameter and its source)
+  PetscErrorCode CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu, const std::string &what = "-mu") const;
   PetscInt       NumA() const { return (PetscInt)thetaA.size(); }
   // Every coefficient of A a constant (no material parameter, map or parameter enters it): A^(mu) is A^ for every mu.
   bool           AConstant() const;

@@ -82,6 +82,16 @@ PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char 
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode CheckValuesGiven(MPI_Comm comm, const std::string &prefix, std::initializer_list<const char *> names)
+{
+  PetscFunctionBeginUser;
+  for (const char *n : names) {
+    const std::string full = "-" + prefix + n;
+    PetscCall(CheckValuesGiven(comm, {full.c_str()}));
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *out, const std::vector<std::string> &given)
 {
   PetscInt n;

@@ -1,5 +1,6 @@
 // src/offline/estimate_calibration.cpp: CalibrateErrorEstimate (rbcontact/estimate_calibration.hpp).
 #include "rbcontact/estimate_calibration.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/error_estimate.hpp"
 #include "rbcontact/training_set.hpp"
 #include "rbcontact/validation.hpp"
@@ -9,6 +10,7 @@ namespace rbc {
 PetscErrorCode EstimateCalibrationOptions(MPI_Comm world, PetscInt *n, PetscInt *seed, PetscReal *safety)
 {
   PetscFunctionBeginUser;
+  PetscCall(CheckValuesGiven(world, "estimate_", {"calibration_size", "calibration_seed", "safety", "pod_tol", "dual_tol", "cubature"})); // (the defaults, without a word)
   PetscOptionsBegin(world, "estimate_", "Online error estimate: calibration (offline)", "CalibrateErrorEstimate");
   PetscCall(PetscOptionsInt("-calibration_size", "random parameters where the FOM calibrates the estimate (0: none)", "", *n, n, NULL));
   PetscCall(PetscOptionsInt("-calibration_seed", "seed of those parameters", "", *seed, seed, NULL));
@@ -16,6 +18,9 @@ PetscErrorCode EstimateCalibrationOptions(MPI_Comm world, PetscInt *n, PetscInt 
   PetscOptionsEnd();
   PetscCheck(*safety >= 1 && *safety <= 100, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_safety %g out of range [1, 100]", (double)*safety);
   PetscCheck(*n >= 0 && *n <= 100000, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_calibration_size %" PetscInt_FMT " out of range [0, 1e5]", *n);
+  // (1 or 2 points fitted scales that put the estimate up to 4000x below the error, stored as available; audit of
+  // 2026-12-01)
+  PetscCheck(*n == 0 || *n >= 3, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_calibration_size %" PetscInt_FMT ": at least 3 calibration parameters (1 or 2 fit scales that underestimate the error by orders of magnitude), or 0 for none", *n);
   PetscFunctionReturn(0);
 }
 
@@ -31,6 +36,7 @@ PetscErrorCode CalibrateErrorEstimate(MPI_Comm world, const SceneSpec &scene, co
   PetscCall(RomReadOptional(romPath, "/online/estimate/default_sizes", &sizes, &has));
   JsonValue &e = rep->root["estimate"];
   e["enrichment"] = (bool)has;
+  if (has && n == 0) PetscCall(PetscPrintf(world, "rbcontact offline: warning: -estimate_calibration_size 0: the online error estimate is not calibrated (scale 1, floor 0): a raw residual-based indicator, not a bound (docs/error_estimate.md)\n"));
   if (!has || n == 0) PetscFunctionReturn(0); // nothing to calibrate (the bases need every basis function) or not asked
 
   ParameterSet cal;

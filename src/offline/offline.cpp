@@ -218,8 +218,10 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscCheck(!estimate || (hc.ecsw && hc.ecswFirst), world, PETSC_ERR_ARG_INCOMP, "-estimate needs the empirical cubature as the online default (-rom_hyper ecsw or ecsw,eim): the EIM gives no online error estimate");
       if (estimate) { // (refused after the snapshots and the ROM's writing before 2026-12-01)
         PetscInt  n = 20, seed = 2026;
-        PetscReal safety = 2;
+        PetscReal safety = 2, pt, dt;
+        PetscBool e;
         PetscCall(EstimateCalibrationOptions(world, &n, &seed, &safety));
+        PetscCall(EstimateEnrichmentOptions(world, &e, &pt, &dt));
       }
     }
     { // the contact patch's options of the last step (refused after the snapshots before 2026-12-01)

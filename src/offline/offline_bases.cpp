@@ -98,6 +98,28 @@ PetscErrorCode CheckSnapshotSensitivities(MPI_Comm world, const std::vector<Snap
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode EstimateEnrichmentOptions(MPI_Comm world, PetscBool *estimate, PetscReal *estPodTol, PetscReal *estDualTol)
+{
+  PetscReal podTol = kPODDefaultTol, dualTol = kDualDefaultTol;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetReal(NULL, "pod_", "-tol", &podTol, NULL));
+  PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, NULL));
+  *estimate = PETSC_FALSE;
+  PetscOptionsBegin(world, NULL, "Online error estimate (offline)", "OfflineBases");
+  PetscCall(PetscOptionsBool("-estimate", "store enriched bases and a calibration for the online error estimate (docs/error_estimate.md)", "", *estimate, estimate, NULL));
+  *estPodTol  = podTol * 1e-2;
+  *estDualTol = dualTol * 0.1;
+  PetscCall(PetscOptionsReal("-estimate_pod_tol", "POD tolerance of the enriched primal space (default -pod_tol / 100)", "", *estPodTol, estPodTol, NULL));
+  PetscCall(PetscOptionsReal("-estimate_dual_tol", "dual greedy tolerance of the enriched dual space (default -dual_tol / 10)", "", *estDualTol, estDualTol, NULL));
+  PetscOptionsEnd();
+  if (*estimate) {
+    PetscCheck(*estPodTol >= 0 && *estPodTol <= podTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_pod_tol %g must lie in [0, -pod_tol = %g]", (double)*estPodTol, (double)podTol);
+    PetscCheck(*estDualTol > 0 && *estDualTol <= dualTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_dual_tol %g must lie in (0, -dual_tol = %g]", (double)*estDualTol, (double)dualTol);
+  }
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order, const std::vector<Snapshot> &snaps, PetscInt R, ContactMap *cmap, OfflineBasisSet *b, bool sensitivities, const std::string &source)
 {
   PetscLogDouble t0, t1, t2;
@@ -114,19 +136,9 @@ PetscErrorCode BuildBases(MPI_Comm world, ElasticFOM &fom, CanonicalOrder &order
   PetscCall(PetscOptionsGetReal(NULL, "dual_", "-tol", &dualTol, NULL));
   PetscCall(PetscOptionsHasName(NULL, "pod_", "-n", &podNSet));
   PetscCall(PetscOptionsGetString(NULL, "dual_", "-type", dualType, sizeof dualType, NULL));
-  PetscOptionsBegin(world, NULL, "Online error estimate (offline)", "OfflineBases");
-  PetscCall(PetscOptionsBool("-estimate", "store enriched bases and a calibration for the online error estimate (docs/error_estimate.md)", "", estimate, &estimate, NULL));
-  estPodTol  = podTol * 1e-2;
-  estDualTol = dualTol * 0.1;
-  PetscCall(PetscOptionsReal("-estimate_pod_tol", "POD tolerance of the enriched primal space (default -pod_tol / 100)", "", estPodTol, &estPodTol, NULL));
-  PetscCall(PetscOptionsReal("-estimate_dual_tol", "dual greedy tolerance of the enriched dual space (default -dual_tol / 10)", "", estDualTol, &estDualTol, NULL));
-  PetscOptionsEnd();
+  PetscCall(EstimateEnrichmentOptions(world, &estimate, &estPodTol, &estDualTol));
   b->estimate = estimate;
   b->nDefault = b->rDefault = -1;
-  if (estimate) {
-    PetscCheck(estPodTol >= 0 && estPodTol <= podTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_pod_tol %g must lie in [0, -pod_tol = %g]", (double)estPodTol, (double)podTol);
-    PetscCheck(estDualTol > 0 && estDualTol <= dualTol, world, PETSC_ERR_ARG_OUTOFRANGE, "-estimate_dual_tol %g must lie in (0, -dual_tol = %g]", (double)estDualTol, (double)dualTol);
-  }
   // --- primal: POD in the chosen inner product of the reference configuration
   PetscCall(PetscTime(&t0));
   PetscOptionsBegin(world, "pod_", "Primal basis (offline)", "OfflineBases");

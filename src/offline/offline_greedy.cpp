@@ -1,6 +1,7 @@
 // src/offline/offline_greedy.cpp: the greedy training's options, candidate pool, error indicator and picks
 // (offline_greedy.hpp, docs/greedy_training.md).
 #include "rbcontact/offline_greedy.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/offline_bases.hpp"
 #include "rbcontact/offline_rom.hpp"
 #include "rbcontact/rom_fields.hpp"
@@ -17,6 +18,7 @@ static const char *const kCriterionNames[] = {"residual", "penetration", "max", 
 PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
 {
   PetscFunctionBeginUser;
+  PetscCall(CheckValuesGiven(comm, "greedy_", {"tol", "max_solves", "batch", "indicator", "separation"})); // (the defaults, without a word)
   PetscOptionsBegin(comm, "greedy_", "Greedy training (offline -train_type greedy)", "rbcontact");
   PetscCall(PetscOptionsReal("-tol", "Stop once the largest indicator over the candidates is at most this", "", o->tol, &o->tol, NULL));
   PetscCall(PetscOptionsInt("-max_solves", "FOM solves in all (initial set included)", "", o->maxSolves, &o->maxSolves, NULL));

@@ -9,6 +9,7 @@
 // ranks, the ROM runs redundantly on every rank (identical data, identical answers); its timed solves run on rank 0
 // while the other ranks wait (-validate_time_all_ranks: on every rank at once).
 #include "rbcontact/validation.hpp"
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/greedy_indicator.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/kacanov.hpp"
@@ -24,6 +25,7 @@
 #include <algorithm>
 #include <numeric>
 #include <cmath>
+#include <filesystem>
 #include <cstring>
 #include <iomanip>
 #include <sstream>
@@ -43,6 +45,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
     if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
     PetscCall(PetscStrncpy(sweepOut, s->sweepOutput.empty() ? (stem + "_sweep").c_str() : s->sweepOutput.c_str(), sizeof sweepOut));
   }
+  PetscCall(CheckValuesGiven(comm, {"-validate_repeat", "-validate_threads", "-validate_sweep_R", "-validate_sweep_output", "-validate_sweep_fractions", "-test_snapshots"})); // (the defaults, without a word)
   PetscOptionsBegin(comm, NULL, "rbcontact validate: the ROM against the FOM on a test set", "rbcontact");
   PetscCall(PetscOptionsInt("-validate_repeat", "online solves per test parameter (the median is reported)", "", s->repeat, &s->repeat, NULL));
   {
@@ -85,6 +88,7 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   s->sweep       = sweep;
   s->sweepOutput = sweepOut;
   if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".json", "-validate_sweep_output"));
+  if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".csv", "-validate_sweep_output (.csv)")); // (a FIFO was replaced, a directory failed after every FOM solve)
   PetscFunctionReturn(0);
 }
 
@@ -330,7 +334,22 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     char reportPath[PETSC_MAX_PATH_LEN] = "";
     PetscCall(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
     const std::string so = settings.sweep ? settings.sweepOutput : std::string();
-    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-validate_sweep_output (.json)", so.empty() ? so : so + ".json"}, {"-validate_sweep_output (.csv)", so.empty() ? so : so + ".csv"}}, {{"-rom", romPathIn}}));
+    // the inputs validate reads besides the ROM: the test snapshots, the sample file, the basis file (given, or the ROM's
+    // beside it); -report onto any of them replaced it with the report, exit 0 (audit of 2026-12-01)
+    std::vector<std::pair<std::string, std::string>> ins = {{"-rom", romPathIn}};
+    for (const char *opt : {"-test_snapshots", "-test_file", "-rom_basis"}) {
+      char v[PETSC_MAX_PATH_LEN] = "";
+      PetscCall(PetscOptionsGetString(NULL, NULL, opt, v, sizeof v, NULL));
+      if (v[0]) ins.emplace_back(opt, v);
+    }
+    {
+      std::string stored;
+      PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+      const PetscErrorCode e = RomReadAttr(romPathIn, "basis_file", &stored);
+      PetscCall(PetscPopErrorHandler());
+      if (!e && !stored.empty()) ins.emplace_back("(the ROM's basis file)", std::filesystem::path(stored).is_relative() ? (std::filesystem::path(romPathIn).parent_path() / stored).string() : stored);
+    }
+    PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}, {"-validate_sweep_output (.json)", so.empty() ? so : so + ".json"}, {"-validate_sweep_output (.csv)", so.empty() ? so : so + ".csv"}}, ins));
   }
   const PetscInt repeat = settings.repeat;
   const bool     sweep  = settings.sweep;
@@ -355,7 +374,9 @@ PetscErrorCode RunValidation(MPI_Comm comm, const SceneSpec &scene, const std::s
     PetscCheck(r >= 1 && r <= model.Rfull, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors, the ROM file %s stores %" PetscInt_FMT, r, romPath, model.Rfull);
   PetscCall(RomReadAttr(romPath, "scene", &romScene));
   PetscCheck(scene.name == romScene, comm, PETSC_ERR_USER_INPUT, "validate: the scene of the options is '%s', the ROM %s was built for '%s' (give -options_file runs/%s.opts)", scene.name.c_str(), romPath, romScene.c_str(), romScene.c_str());
-  for (const auto &mu : test.points) PetscCall(model.par.CheckBox(comm, mu));
+  // (a test set outside the ROM's box was blamed on -mu, which nobody gave: the test parameter and its source named)
+  for (size_t j = 0; j < test.points.size(); ++j)
+    PetscCall(model.par.CheckBox(comm, test.points[j], "test parameter " + std::to_string(j + 1) + " of " + std::to_string(test.points.size()) + (settings.testSnapshots.empty() ? std::string(" (-test_*)") : " (" + settings.testSnapshotsOption + " " + settings.testSnapshots + ")")));
 
   // the FOM of the scene (reference configuration, affine terms) and the bases
   PetscCall(fom.Create(comm, scene));

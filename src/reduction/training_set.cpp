@@ -4,6 +4,7 @@
 // and compiler) and the reader of sample files (one point per line, checked against the box).
 #include "rbcontact/report.hpp"
 #include "rbcontact/training_set.hpp"
+#include "rbcontact/options_files.hpp"
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -211,6 +212,8 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCall(PetscStrncpy(typeBuf, defType, sizeof typeBuf));
+  // (a trailing -test_seed kept the default and cancelled an options file's value, exit 0; audit of 2026-12-01)
+  PetscCall(CheckValuesGiven(comm, prefix, {"type", "seed", "file"}));
   PetscOptionsBegin(comm, prefix, "Parameter samples", "rbcontact");
   PetscCall(PetscOptionsString("-type", "Sample type: grid, random, lhs or file", "ParameterSetFromOptions", typeBuf, typeBuf, sizeof typeBuf, NULL));
   type = typeBuf;

@@ -228,18 +228,18 @@ void ReducedParametrization::ThetaF(const std::vector<PetscReal> &mu, std::vecto
   for (size_t q = 0; q < thetaF.size(); ++q) (*th)[q] = thetaF[q].Evaluate(*light_, &map, mu);
 }
 
-PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu) const
+PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector<PetscReal> &mu, const std::string &what) const
 {
   PetscFunctionBeginUser;
   if (mu.size() != params.size()) {
     std::string names;
     for (const auto &p : params) names += (names.empty() ? "" : ", ") + p.name;
-    SETERRQ(comm, PETSC_ERR_ARG_SIZ, "-mu: %zu values given, the model has %zu parameters (%s, in this order)", mu.size(), params.size(), names.c_str());
+    SETERRQ(comm, PETSC_ERR_ARG_SIZ, "%s: %zu values given, the model has %zu parameters (%s, in this order)", what.c_str(), mu.size(), params.size(), names.c_str());
   }
   for (size_t i = 0; i < mu.size(); ++i) {
-    PetscCheck(std::isfinite(mu[i]), comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: parameter '%s' is not a finite number", params[i].name.c_str());
+    PetscCheck(std::isfinite(mu[i]), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: parameter '%s' is not a finite number", what.c_str(), params[i].name.c_str());
     const PetscReal tol = 1e-12 * std::max<PetscReal>(1.0, std::abs(params[i].max - params[i].min));
-    PetscCheck(mu[i] >= params[i].min - tol && mu[i] <= params[i].max + tol, comm, PETSC_ERR_ARG_OUTOFRANGE, "-mu: %s (the reduced model is trained there only)", OutOfBoxMessage(params[i], mu[i]).c_str());
+    PetscCheck(mu[i] >= params[i].min - tol && mu[i] <= params[i].max + tol, comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: %s (the reduced model is trained there only)", what.c_str(), OutOfBoxMessage(params[i], mu[i]).c_str());
   }
   PetscFunctionReturn(0);
 }
