@@ -686,6 +686,15 @@ def solver_input(args):
     fails(base + ["-options_file", "runs/flat_punch.opts", "-fem_degree", "2", "-contact_quadrature", "nodal"], ["-contact_quadrature nodal collocates at the slave vertices", "-fem_degree 2"],
           "P2 with nodal collocation (the patch test 3.7 % off)")
     fails(ring + ["-fom_ksp_type", "cg", "-fom_pc_type", "jacobi", "-fom_ksp_rtol", "1e-3"], ["is inaccurate", "-fom_ksp_rtol"], "a loose iterative elastic solver (blamed on a singular stiffness)")
+    # a byte that is not UTF-8 in an option value (the report copies the options): the report stays valid JSON in UTF-8
+    # (json.loads failed on it, exit 0; audit of 2026-12-01), a valid non-ASCII character kept
+    rep = os.path.join(out, "utf8.json")
+    subprocess.run(ring + ["-mesh_file", b"m\xc3\xa9sh\xff.geo".decode("utf-8", "surrogateescape"), "-report", rep], stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    try:
+        r = json.loads(open(rep, "rb").read().decode("utf-8"))
+        check("m\u00e9sh\ufffd.geo" in r["error"], "a failure report with a non-UTF-8 byte in -mesh_file: valid UTF-8 JSON, the byte as U+FFFD, the accent kept")
+    except (ValueError, KeyError, OSError) as e:
+        check(False, "a failure report with a non-UTF-8 byte in -mesh_file: %s" % e)
     r0, _ = run(args, args.np, "runs/ring_on_block.opts", [], "ref")
     r1, _ = run(args, args.np, "runs/ring_on_block.opts", ["-fom_qp_tao_type", "bqpip", "-fom_qp_polish", "0"], "nopolish")
     check(r1["nactive"] == r0["nactive"] and abs(r1["contact_halfwidth"] - r0["contact_halfwidth"]) <= 1e-6 * r0["contact_halfwidth"],

@@ -74,19 +74,45 @@ const JsonValue *JsonValue::Get(const std::string &key) const
 }
 double JsonValue::AsNumber() const { return kind_ == Kind::Integer ? (double)int_ : num_; }
 
+// The length of the valid UTF-8 sequence at s[i] (1 to 4), or 0 (an invalid or truncated one).
+static size_t Utf8Length(const std::string &s, size_t i)
+{
+  const unsigned char c = (unsigned char)s[i];
+  const size_t        n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xe ? 3 : (c >> 3) == 0x1e ? 4 : 0;
+  if (n == 0 || i + n > s.size()) return 0;
+  for (size_t k = 1; k < n; ++k)
+    if (((unsigned char)s[i + k] >> 6) != 0x2) return 0;
+  const unsigned char c1 = n > 1 ? (unsigned char)s[i + 1] : 0; // overlong forms, surrogates, beyond U+10FFFF: invalid
+  if ((n == 2 && c < 0xc2) || (n == 3 && ((c == 0xe0 && c1 < 0xa0) || (c == 0xed && c1 >= 0xa0))) || (n == 4 && (c > 0xf4 || (c == 0xf0 && c1 < 0x90) || (c == 0xf4 && c1 >= 0x90)))) return 0;
+  return n;
+}
+
 static std::string Escape(const std::string &s)
 {
   std::string o;
-  for (char c : s) {
+  for (size_t i = 0; i < s.size();) {
+    const char c = s[i];
     switch (c) {
     case '"': o += "\\\""; break;
     case '\\': o += "\\\\"; break;
     case '\n': o += "\\n"; break;
     case '\t': o += "\\t"; break;
     default:
-      if ((unsigned char)c < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); o += b; }
-      else o += c;
+      if ((unsigned char)c < 0x20) {
+        char b[8];
+        std::snprintf(b, sizeof b, "\\u%04x", c);
+        o += b;
+      } else if ((unsigned char)c >= 0x80) {
+        // a byte that is not valid UTF-8 (an option value of another encoding) made the whole report unreadable to a
+        // JSON parser (audit of 2026-12-01): it is written as U+FFFD, a valid sequence as it is
+        const size_t n = Utf8Length(s, i);
+        if (n == 0) o += "\\ufffd";
+        else o.append(s, i, n);
+        i += n ? n : 1;
+        continue;
+      } else o += c;
     }
+    ++i;
   }
   return o;
 }

@@ -133,7 +133,7 @@ PetscErrorCode RomReadVersion(const std::string &path, int *version)
   PetscFunctionReturn(0);
 }
 
-// An optional dataset: *found false (and no error) when the file lacks it; non-finite values are an error.
+// An optional dataset: *found false (and no error) when the file lacks it; an unreadable one and non-finite values are an error.
 PetscErrorCode RomReadOptional(const std::string &file, const std::string &name, std::vector<double> *data, bool *found, std::vector<unsigned long long> *dimsOut)
 {
   std::vector<unsigned long long> dims;

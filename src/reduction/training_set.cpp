@@ -205,6 +205,7 @@ PetscErrorCode ParameterSetFromOptions(MPI_Comm comm, const std::vector<ParamSpe
   const std::string optType = "-" + pre + "type", optSize = "-" + pre + "size", optSeed = "-" + pre + "seed", optFile = "-" + pre + "file";
   char              typeBuf[64] = "", fileBuf[PETSC_MAX_PATH_LEN] = "";
   PetscInt          sizes[65], nsizes = 65, seed = defSeed; // (one more than taken: PETSc drops values beyond the buffer silently)
+  std::fill(sizes, sizes + 65, defSize); // (-help printed an uninitialised default, different every run)
   PetscBool         flgSize = PETSC_FALSE, flgFile = PETSC_FALSE;
   std::string       type, file;
   PetscMPIInt       rank;
