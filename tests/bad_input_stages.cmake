@@ -19,6 +19,9 @@ rbc_bad_stage(supremizers_infsup "-pod_supremizers_infsup 1.5 out of range [(]0,
 rbc_bad_stage(greedy_tol "-greedy_tol 0 must be > 0" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_tol 0 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_max_solves "-greedy_max_solves 0 must be >= 1" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 0 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_indicator "Unknown option bogus for -greedy_indicator" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_indicator bogus -rom /tmp/rbc_never.h5)
+# -greedy_indicator estimate without -estimate: refused before any FOM solve (after the initial set's before 2026-12-01;
+# this test checks the message only)
+rbc_bad_stage(greedy_indicator_estimate "-greedy_indicator estimate needs -estimate" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_indicator estimate -rom /tmp/rbc_never.h5)
 rbc_bad_stage(train_type "Unknown value 'greedyy' for option -train_type [(]grid, random, lhs or file; the offline stage also takes greedy[)]" offline -options_file runs/ring_on_block.opts -train_type greedyy -rom /tmp/rbc_never.h5)
 rbc_bad_stage(offline_no_snapshot_file "give the snapshot file with -snapshots" offline -options_file runs/ring_on_block.opts -offline_stop snapshots)
 rbc_bad_stage(snapshots_subcomm "-snapshots_subcomm 3 must lie in [[]1, 1[]]" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm 3)

@@ -184,6 +184,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCheck(scene.contact, world, PETSC_ERR_SUP, "-train_type greedy: the indicator is that of a contact scene (-contact_slave, -contact_master)");
     PetscCheck(full, world, PETSC_ERR_ARG_INCOMP, "-train_type greedy builds the reduced model while it trains: it runs the whole offline stage (not -offline_stop %s)", bases ? "bases" : "snapshots");
     PetscCall(GreedyOptionsFromOptions(world, &gopt));
+    { // (refused after the initial set's FOM solves before 2026-12-01)
+      PetscBool estimate = PETSC_FALSE;
+      PetscCall(PetscOptionsGetBool(NULL, NULL, "-estimate", &estimate, NULL));
+      PetscCheck(gopt.criterion != GreedyCriterion::Estimate || estimate, world, PETSC_ERR_ARG_INCOMP, "-greedy_indicator estimate needs -estimate (the enriched bases of the online error estimate)");
+    }
     gopt.sensitivities = s.sensitivities;
     PetscCall(GreedyPoolFromOptions(world, scene.params, &train, &ninitial));
     // (a budget below the initial set solved the initial set anyway, without a word)
