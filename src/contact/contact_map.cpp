@@ -5,6 +5,7 @@
 // rho(z) the closest point of the deformed master surface to the deformed slave point z + u_1(z),
 // n2 the master's outward unit normal there (facet normal or interpolated nodal normals).
 #include "rbcontact/contact.hpp"
+#include "rbcontact/options_files.hpp"
 #include "contact_point.hpp"
 #include <petscsf.h>
 #include <petscdt.h>
@@ -91,6 +92,8 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscBool flg;
 
   PetscFunctionBeginUser;
+  PetscCall(CheckValuesGiven(comm, {"-contact_quadrature", "-contact_quadrature_points", "-contact_quadrature_subdivisions", "-contact_multiplier", "-contact_normal", "-contact_segment_search",
+                                    "-contact_master_search", "-contact_master_search_margin", "-contact_compliance"})); // (the defaults, without a word)
   PetscOptionsBegin(comm, NULL, "Contact map: quadrature, normal, multipliers (docs/contact.md)", "ContactMap");
   PetscCall(PetscOptionsString("-contact_quadrature", "Slave quadrature: gauss (segment by segment), composite, nodal", "docs/contact.md", quad, quad, sizeof quad, NULL));
   if (!strcmp(quad, "gauss")) quadrature = ContactQuadrature::Gauss;

@@ -2,6 +2,7 @@
 // matrix-free S of dual_shell.cpp: -fom_dual_matrix), KKT checks and the contact summary (force,
 // pressure, active zone).
 #include "rbcontact/kacanov.hpp"
+#include "rbcontact/options_files.hpp"
 #include "contact_point.hpp"
 #include "pressure_moments.hpp"
 #include <petscblaslapack.h>
@@ -68,6 +69,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
     PetscCall(PetscLogEventRegister("RBCContactQP", MAT_CLASSID, &KAC_QP));
   }
   PetscCall(loop.SetFromOptions(comm, "")); // -kacanov_* (Anderson mixing on the contact-dof displacement: dense dual matrix only)
+  PetscCall(CheckValuesGiven(comm, {"-kacanov_type", "-kacanov_newton_max_ratio", "-fom_kkt_tol", "-fom_dual_matrix", "-fom_dual_dense_max", "-fom_dual_dense_max_dofs"})); // (the defaults, without a word)
   PetscOptionsBegin(comm, "kacanov_", "Kacanov iterations of the full-order model", "KacanovSolver");
   {
     const char *types[] = {"fixed_point", "newton"};

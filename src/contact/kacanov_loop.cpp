@@ -1,6 +1,7 @@
 // src/contact/kacanov_loop.cpp: KacanovLoop, the fixed-point loop shared by the full-order and the reduced
 // Kacanov iterations (options, relaxation, primal change, stopping rule, Anderson mixing, monitor, history).
 #include "rbcontact/kacanov_loop.hpp"
+#include "rbcontact/options_files.hpp"
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -20,6 +21,8 @@ PetscErrorCode KacanovLoop::SetFromOptions(MPI_Comm comm, const std::string &pre
 
   PetscFunctionBeginUser;
   prefix_ = prefix;
+  // given without a value, PETSc kept the default without a word (the FOM's and the ROM's loops alike)
+  PetscCall(CheckValuesGiven(comm, prefix + "kacanov_", {"max_it", "rtol_primal", "rtol_dual", "relaxation", "anderson"}));
   PetscOptionsBegin(comm, (prefix + "kacanov_").c_str(), "Kacanov iterations", "KacanovLoop");
   PetscCall(PetscOptionsInt("-max_it", "Maximum Kacanov iterations (1: the linearized model)", NULL, maxIt, &maxIt, NULL));
   PetscCall(PetscOptionsReal("-rtol_primal", "Relative change of the primal input to stop", NULL, rtolPrimal, &rtolPrimal, NULL));

@@ -160,13 +160,9 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   PetscInt    refine = 0;
 
   PetscFunctionBeginUser;
-  // the numeric and list options of the scene and the full-order solver: given without a value, PETSc kept the default
+  // the numeric and list options of the scene (the contact map's and the solver's: ContactMap::Setup, KacanovSolver): given without a value, PETSc kept the default
   // without a word (a trailing -fem_degree cancelled a file's -fem_degree 2: another discretization, exit 0)
-  PetscCall(CheckValuesGiven(comm, {"-fem_degree", "-mesh_refine", "-mesh_clscale", "-mesh_partitioner", "-mesh_metis_seed", "-mesh_file", "-scene", "-contact_slave", "-contact_master",
-                                    "-contact_quadrature", "-contact_quadrature_points", "-contact_quadrature_subdivisions", "-contact_multiplier", "-contact_normal", "-contact_segment_search",
-                                    "-contact_master_search", "-contact_master_search_margin", "-contact_compliance", "-fom_kkt_tol", "-fom_dual_matrix", "-fom_dual_dense_max",
-                                    "-fom_dual_dense_max_dofs", "-kacanov_max_it", "-kacanov_rtol_primal", "-kacanov_rtol_dual", "-kacanov_relaxation", "-kacanov_anderson",
-                                    "-kacanov_newton_max_ratio"}));
+  PetscCall(CheckValuesGiven(comm, {"-fem_degree", "-mesh_refine", "-mesh_clscale", "-mesh_partitioner", "-mesh_metis_seed", "-mesh_file", "-scene", "-contact_slave", "-contact_master"}));
   PetscOptionsBegin(comm, NULL, "Scene: mesh, parameters, bodies, boundary conditions, contact pair (README.md: Options)", "rbcontact");
   PetscCall(GetString(PetscOptionsObject, "-scene", "Scene name (reports, file headers)", &scene->name, NULL));
   PetscCall(GetString(PetscOptionsObject, "-mesh_file", "gmsh mesh: .geo (meshed and cached) or .msh; relative to the working directory, then the installed share/rbcontact", &scene->mesh.file, &flg));

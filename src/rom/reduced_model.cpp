@@ -524,8 +524,7 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscFunctionBeginUser;
   PetscCall(CheckHasModel("SetFromOptions"));
   // an option without its value kept the default without a word (a trailing -rom_N cancelled a file's -rom_N 3)
-  PetscCall(CheckValuesGiven(PETSC_COMM_SELF, {"-rom_kkt_tol", "-rom_warm_start_degree", "-rom_threads", "-rom_N", "-rom_R", "-rom_Mk", "-rom_Mg", "-rom_hyper", "-rom_ecsw_sum", "-rom_gemm", "-rom_ecsw_precision",
-                                               "-rom_kacanov_max_it", "-rom_kacanov_rtol_primal", "-rom_kacanov_rtol_dual", "-rom_kacanov_relaxation", "-rom_kacanov_anderson"}));
+  PetscCall(CheckValuesGiven(PETSC_COMM_SELF, {"-rom_kkt_tol", "-rom_warm_start_degree", "-rom_threads", "-rom_N", "-rom_R", "-rom_Mk", "-rom_Mg", "-rom_hyper", "-rom_ecsw_sum", "-rom_gemm", "-rom_ecsw_precision"})); // (the loop's: KacanovLoop)
   PetscCall(loop.SetFromOptions(PETSC_COMM_SELF, "rom_"));
   // one block, so that -help lists the reduced model's options with their values (prefix rom_)
   PetscOptionsBegin(PETSC_COMM_SELF, "rom_", "Reduced model (online solve)", "ReducedModel");
