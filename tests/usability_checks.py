@@ -158,6 +158,21 @@ def help_(args):
                 "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "fom -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "the shipped scene: no rbcontact warning (deprecated or unused option)")
+    m = re.search(r"^\s+-mu <([-0-9.e+]+)", p.stdout, re.M)
+    check(m is not None and 0.95 <= float(m.group(1)) <= 1.1, "fom -help shows the default of -mu inside the box [0.95, 1.1] (%s)" % (m.group(1) if m else None))
+    # a stage's -help without its input: the options read before it, a note naming the input, exit 0 and no error
+    # (it stopped at the first missing input with exit 95); the report is not written
+    for stage, needs, listed in (("fom", "-mesh_file", ("-mesh_file", "-bodies", "-mu_names", "-dirichlet")), ("offline", "-mesh_file", ("-train_type", "-snapshots", "-mesh_file")),
+                                 ("online", "-rom", ("-rom", "-online_repeat")), ("probe", "-rom", ("-rom",)), ("validate", "-rom", ("-rom", "-validate_repeat", "-validate_sweep")),
+                                 ("dualbasis", "-snapshots", ("-snapshots", "-dual_out"))):
+        p = run(args, 1, [stage, "-help"], expect_ok=False)
+        check(p.returncode == 0 and "rbcontact error" not in p.stdout, "%s -help without %s: exit %d (0), no error" % (stage, needs, p.returncode))
+        check(("the stage needs %s, where it stops" % needs) in p.stdout, "%s -help: the note names %s" % (stage, needs))
+        for opt in listed:
+            check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "%s -help without %s lists %s" % (stage, needs, opt))
+    # without -help the missing input is still an error
+    p = run(args, 1, ["online"], expect_ok=False)
+    check(p.returncode != 0 and "online: give the ROM file with -rom" in p.stdout, "online without -rom and without -help: an error (exit %d)" % p.returncode)
     # the offline, online and validate stages list their own options and the reduced model's (the offline
     # run writes the small ROM the others open)
     d = workdir()

@@ -5,6 +5,7 @@
 #pragma once
 #include <petscsys.h>
 #include <initializer_list>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -37,5 +38,17 @@ PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char 
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, const std::string &prefix, std::initializer_list<const char *> names);
 
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused, const std::vector<std::string> &given = {});
+
+// -help without an input the stage needs (rbcontact fom -help: no -mesh_file): the options read so far are listed, and
+// the stage ends there with exit 0 instead of an error (PETSc lists an option as it is read, so the rest of the listing
+// needs the inputs: docs/bad_input.md "-help"). Thrown by RequireInput, caught by the executable's main (the Python
+// module turns it into a RuntimeError).
+struct HelpStop : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The check of a stage's required input (given: the option holds a value). Missing: with -help, a note naming option
+// and HelpStop; otherwise the error PETSC_ERR_USER_INPUT with message. Collective on comm.
+PetscErrorCode RequireInput(MPI_Comm comm, bool given, const char *option, const char *message);
 
 } // namespace rbc

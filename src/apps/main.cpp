@@ -233,6 +233,10 @@ int main(int argc, char **argv)
       PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
       ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
     }
+  } catch (const rbc::HelpStop &) { // -help without the stage's input: the options read so far were listed (RequireInput)
+    PetscCallMPI(MPI_Comm_free(&exitComm));
+    PetscCall(SlepcFinalize());
+    return 0;
   } catch (const std::exception &e) { // a C++ exception through the stage (std::bad_alloc: a size beyond memory): said, reported, then
     // MPI_Abort, since the other ranks may wait in a collective
     const bool  mem = dynamic_cast<const std::bad_alloc *>(&e) != nullptr;

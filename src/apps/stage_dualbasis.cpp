@@ -1,6 +1,7 @@
 // src/apps/stage_dualbasis.cpp: `rbcontact dualbasis`: a nonnegative dual basis of a multiplier
 // snapshot matrix from any source: "file.h5:/dataset" or a PETSc binary matrix from another code
 // (rows = multipliers, columns = snapshots), or a snapshot file of the offline stage.
+#include "rbcontact/options_files.hpp"
 #include "stages.hpp"
 #include "rbcontact/offline_bases.hpp"
 #include "rbcontact/dual_basis.hpp"
@@ -23,7 +24,7 @@ PetscErrorCode StageDualBasis(MPI_Comm comm)
   PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
   PetscCall(PetscOptionsString("-dual_out", "write the basis (and its history) to this HDF5 file", "", out, out, sizeof out, NULL));
   PetscOptionsEnd();
-  PetscCheck(set && spec[0], comm, PETSC_ERR_USER_INPUT, "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)");
+  PetscCall(RequireInput(comm, set && spec[0], "-snapshots", "dualbasis: give the multiplier snapshots with -snapshots file.h5:/dataset (or a PETSc binary matrix, or an offline snapshot file)"));
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckOutputPath(comm, out, "-dual_out"));
   {

@@ -40,7 +40,7 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   PetscCall(PetscOptionsString("-rom_reconstruct", "write the full fields of the reduced solution to this HDF5 file (+ .xmf; needs the scene options and the basis file)", "", recPath, recPath, sizeof recPath, NULL));
   PetscCall(PetscOptionsInt("-online_repeat", "solve this many times and report the median time", "", repeat, &repeat, NULL));
   PetscOptionsEnd();
-  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "online: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+  PetscCall(RequireInput(comm, set && romPath[0], "-rom", "online: give the ROM file with -rom <file.h5> (written by rbcontact offline)"));
   {
     PetscBool hasMu = PETSC_FALSE;
     PetscCall(PetscOptionsHasName(NULL, NULL, "-mu", &hasMu));

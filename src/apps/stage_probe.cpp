@@ -2,6 +2,7 @@
 // solved at many parameters of its box without the FOM (rom_probe.hpp): failures of the reduced loop,
 // iterations and, where the file stores an error estimate, the largest estimated errors. Fails (exit
 // code) when the reduced loop fails at a probe parameter, naming the first with its `online -mu`.
+#include "rbcontact/options_files.hpp"
 #include "stages.hpp"
 #include "rbcontact/report.hpp"
 #include "rbcontact/rom_fields.hpp"
@@ -21,7 +22,7 @@ PetscErrorCode StageProbe(MPI_Comm comm)
   PetscCall(PetscOptionsString("-rom", "the ROM file (written by rbcontact offline)", "", romPath, romPath, sizeof romPath, &set));
   PetscCall(PetscOptionsString("-report", "JSON report of the run", "", reportPath, reportPath, sizeof reportPath, NULL));
   PetscOptionsEnd();
-  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "probe: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
+  PetscCall(RequireInput(comm, set && romPath[0], "-rom", "probe: give the ROM file with -rom <file.h5> (written by rbcontact offline)"));
   PetscCall(CheckOutputPath(comm, reportPath, "-report"));
   PetscCall(CheckDistinctFiles(comm, {{"-report", reportPath}}, {{"-rom", romPath}}));
   PetscCall(CheckSceneOptions(comm, "probe", romPath)); // (another scene's options file, -body_E: ignored without a word before)

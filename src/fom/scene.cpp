@@ -64,13 +64,15 @@ static PetscErrorCode GetString(PetscOptionItems *PetscOptionsObject, const char
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscReal> *v, PetscBool *set)
+// shown: the default -help prints (its first value; else 0)
+static PetscErrorCode GetRealArray(PetscOptionItems *PetscOptionsObject, const char *name, const char *text, std::vector<PetscReal> *v, PetscBool *set, const std::vector<PetscReal> &shown = {})
 {
   PetscReal buf[65] = {0}; // -help prints buf[0] of an unset option; one more than taken: PETSc drops values beyond the buffer silently
   PetscInt  n = 65;
   PetscBool flg;
 
   PetscFunctionBeginUser;
+  for (size_t i = 0; i < shown.size() && i < 64; ++i) buf[i] = shown[i];
   PetscCall(PetscOptionsRealArray(name, text, kMan, buf, &n, &flg));
   PetscCheck(!flg || n <= 64, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "option %s takes at most 64 values, more were given", name);
   // every rank reads the same options: a local error on each (no collective, no hang)
@@ -163,10 +165,11 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   // the numeric and list options of the scene (the contact map's and the solver's: ContactMap::Setup, KacanovSolver): given without a value, PETSc kept the default
   // without a word (a trailing -fem_degree cancelled a file's -fem_degree 2: another discretization, exit 0)
   PetscCall(CheckValuesGiven(comm, {"-fem_degree", "-mesh_refine", "-mesh_clscale", "-mesh_partitioner", "-mesh_metis_seed", "-mesh_file", "-scene", "-contact_slave", "-contact_master"}));
+  bool meshGiven = false;
   PetscOptionsBegin(comm, NULL, "Scene: mesh, parameters, bodies, boundary conditions, contact pair (README.md: Options)", "rbcontact");
   PetscCall(GetString(PetscOptionsObject, "-scene", "Scene name (reports, file headers)", &scene->name, NULL));
   PetscCall(GetString(PetscOptionsObject, "-mesh_file", "gmsh mesh: .geo (meshed and cached) or .msh; relative to the working directory, then the installed share/rbcontact", &scene->mesh.file, &flg));
-  PetscCheck(flg, comm, PETSC_ERR_USER_INPUT, "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)");
+  meshGiven = flg; // checked after the block (-help lists the whole block first)
   PetscCall(PetscOptionsReal("-mesh_clscale", "gmsh characteristic length factor (.geo)", kMan, scene->mesh.clscale, &scene->mesh.clscale, NULL));
   PetscCall(PetscOptionsInt("-mesh_refine", "Halve the mesh size this many times (.geo: -mesh_clscale x 0.5^n)", kMan, refine, &refine, NULL));
   PetscCheck(scene->mesh.clscale > 0 && std::isfinite(scene->mesh.clscale), comm, PETSC_ERR_ARG_OUTOFRANGE, "-mesh_clscale %g must be a finite number > 0", (double)scene->mesh.clscale); // (inf crashed gmsh)
@@ -201,7 +204,10 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
     PetscCall(GetRealArray(PetscOptionsObject, "-mu_min", "Parameter box: lower bounds, one per parameter", &lo, NULL));
     PetscCall(GetRealArray(PetscOptionsObject, "-mu_max", "Parameter box: upper bounds", &hi, NULL));
     PetscCall(GetRealArray(PetscOptionsObject, "-mu_default", "Default parameter values (the reference configuration)", &def, NULL));
-    PetscCall(GetRealArray(PetscOptionsObject, "-mu", "Parameter values of this run (fom, online), inside the box", &val, &flg));
+    std::vector<PetscReal> shown = def; // -help: the default values (-mu <0.> lay outside most boxes)
+    if (shown.empty() && lo.size() == hi.size())
+      for (size_t i = 0; i < lo.size(); ++i) shown.push_back(0.5 * (lo[i] + hi[i]));
+    PetscCall(GetRealArray(PetscOptionsObject, "-mu", "Parameter values of this run (fom, online), inside the box; default -mu_default", &val, &flg, shown));
     s.clear();
     PetscCall(GetString(PetscOptionsObject, "-mu_geo_set", "gmsh constant set by each parameter ('-' for none), comma separated", &s, NULL));
     const std::vector<std::string> geo = SplitList(s);
@@ -348,6 +354,7 @@ PetscErrorCode SceneSpecFromOptions(MPI_Comm comm, SceneSpec *scene)
   }
   if (scene->contact) PetscCheck(!scene->slave.empty() && !scene->master.empty(), comm, PETSC_ERR_USER_INPUT, "-contact 1 needs -contact_slave NAME and -contact_master NAME");
   PetscOptionsEnd();
+  PetscCall(RequireInput(comm, meshGiven, "-mesh_file", "No mesh: give -mesh_file <file.geo|file.msh> (usually in runs/<scene>.opts via -options_file)"));
   PetscFunctionReturn(0);
 }
 

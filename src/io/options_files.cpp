@@ -69,6 +69,23 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse()
   return out;
 }
 
+PetscErrorCode RequireInput(MPI_Comm comm, bool given, const char *option, const char *message)
+{
+  PetscBool help = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  if (given) PetscFunctionReturn(0);
+  PetscCall(PetscOptionsHasHelp(NULL, &help));
+  if (help) {
+    PetscCall(PetscPrintf(comm, "\nrbcontact -help: the options above are those read before the stage needs %s, where it stops (nothing was run).\n"
+                                "A stage lists each option as it reads it: give %s (and the scene, -options_file runs/<scene>.opts) to see the rest;\n"
+                                "with its inputs, -help runs the stage, as PETSc programs do. Every option is described in README.md (Options) and docs/.\n",
+                          option, option));
+    throw HelpStop(std::string("-help: stopped before ") + option);
+  }
+  SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", message);
+}
+
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names)
 {
   PetscFunctionBeginUser;

@@ -2,6 +2,7 @@
 // the checks of the later steps' options, the snapshot solves (groups of ranks over the parameters, every
 // finished round written to the snapshot file before the next starts: a killed job resumes) and the
 // bases and ROM steps (offline_bases.cpp, offline_greedy.cpp, offline_rom.cpp).
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/offline.hpp"
 #include "rbcontact/estimate_calibration.hpp"
 #include "rbcontact/rom_probe.hpp"
@@ -155,8 +156,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
   PetscCall(PetscTime(&t0));
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   PetscCallMPI(MPI_Comm_size(world, &wsize));
-  PetscCheck(!bases || !s.rom.empty(), world, PETSC_ERR_USER_INPUT, "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)");
-  PetscCheck(!s.snapshots.empty(), world, PETSC_ERR_USER_INPUT, "offline: give the snapshot file with -snapshots <file.h5>");
+  PetscCall(RequireInput(world, !bases || !s.rom.empty(), "-rom", "offline: give the ROM file to write with -rom <file.h5> (or stop after the snapshots: -offline_stop snapshots -snapshots <file.h5>)"));
+  PetscCall(RequireInput(world, !s.snapshots.empty(), "-snapshots", "offline: give the snapshot file with -snapshots <file.h5>"));
   if (bases) PetscCall(CheckOutputPath(world, s.rom, "-rom"));
   PetscCall(CheckOutputPath(world, s.snapshots, "-snapshots"));
   for (const auto &from : s.from) PetscCheck(from != s.snapshots, world, PETSC_ERR_ARG_WRONG, "-snapshots_from %s: that is the snapshot file being written (-snapshots)", from.c_str());

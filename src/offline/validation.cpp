@@ -851,8 +851,8 @@ PetscErrorCode RunValidationFromOptions(MPI_Comm comm, const std::string &report
   PetscOptionsBegin(comm, NULL, "rbcontact validate: the ROM file", "rbcontact");
   PetscCall(PetscOptionsString("-rom", "the ROM file (written by rbcontact offline)", "", romPath, romPath, sizeof romPath, &set));
   PetscOptionsEnd();
-  PetscCheck(set && romPath[0], comm, PETSC_ERR_USER_INPUT, "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)");
   PetscCall(ValidationSettingsFromOptions(comm, reportPath, &s));
+  PetscCall(RequireInput(comm, set && romPath[0], "-rom", "validate: give the ROM file with -rom <file.h5> (written by rbcontact offline)"));
   PetscCall(SceneSpecFromOptions(comm, &scene));
   if (s.testSnapshots.empty()) PetscCall(ParameterSetFromOptions(comm, scene.params, "test_", &test));
   else { // the test set is the file's; the -test_* options of a scene's options file are set aside without a warning
