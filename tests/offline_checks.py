@@ -508,6 +508,11 @@ def greedy(args):
         t = report(d + "/v.json")["test"]
         print("  validate, 6 FOM solves: max rel err u %.2e, lambda %.2e, force %.2e" % (t["max_rel_err_u"], t["max_rel_err_lambda"], t["max_rel_err_force"]))
         check(t["max_rel_err_u"] <= 1e-4 and t["max_rel_err_lambda"] <= 1e-2 and t["max_rel_err_force"] <= 1e-3, "the 6-solve greedy ROM meets u <= 1e-4, lambda <= 1e-2, force <= 1e-3 on 20 random radii")
+    # the greedy's snapshot file as a test set: refused as such (the advice to finish it was refused by its restart)
+    p = subprocess.run(["mpirun", "-n", "2", args.exe, "validate", "-options_file", "runs/ring_on_block.opts", "-rom", d + "/g2.h5", "-test_snapshots", d + "/g2.snapshots.h5"],
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "was written by a greedy training (-train_type greedy): it holds the 6 points the greedy solved among its" in p.stdout and "candidates, not a test set" in p.stdout,
+          "validate -test_snapshots <the greedy's snapshot file>: refused as a greedy training's file (exit %d)" % p.returncode)
     # -greedy_indicator estimate (docs/error_estimate.md): the rounds with an enrichment ranked by the online estimate's
     # raw u change, the others by the residual
     re_ = off(2, "ge", 8, ["-estimate", "-greedy_indicator", "estimate", "-estimate_calibration_size", "4"])

@@ -216,7 +216,7 @@ int main(int argc, char **argv)
     const std::string trail = base + "_trail.txt", twice = base + "_twice.txt";
     if (rank == 0) {
       std::ofstream(good) << "# E nu\n1.0, 0.1\n\n  1.5 0.2   # a comment\n2.0,0.3\n1.25\t0.15\n";
-      std::ofstream(out) << "# header\n1.0 0.1\n2.5 0.2\n";
+      std::ofstream(out) << "# header\n1.0 0.1\n1.5 0.35\n";
       std::ofstream(bad) << "1.0 0.1\n1.5 0.2\n\n1.2 zero.2x\n";
       std::ofstream(cols) << "1.0 0.1 7\n";
       std::ofstream(empty) << "# nothing\n\n";
@@ -234,7 +234,7 @@ int main(int argc, char **argv)
     Check(code == 0 && set.points == expect, "file: 4 samples (comments, blank lines, commas, tabs) read exactly" + (msg.empty() ? std::string() : ": " + msg));
     PetscCall(SameOnAllRanks(set.points, "file"));
     PetscCall(PetscOptionsSetValue(NULL, "-f_file", out.c_str()));
-    PetscCall(ExpectError(two, "f_", "file with a point outside the box (line 3)", {out, "line 3", "'E'", "outside its box"}));
+    PetscCall(ExpectError(two, "f_", "file with a point outside the box (line 3), the box in its shortest digits (17 before)", {out, "line 3", "'nu' = 0.35 is outside its box [0.1, 0.3]"}));
     PetscCall(PetscOptionsSetValue(NULL, "-f_file", bad.c_str()));
     PetscCall(ExpectError(two, "f_", "file with a malformed line (line 4)", {bad, "line 4", "zero.2x", "not a finite number"}));
     PetscCall(PetscOptionsSetValue(NULL, "-f_file", cols.c_str()));

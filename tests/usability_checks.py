@@ -194,6 +194,11 @@ def help_(args):
     for opt in ("-rom", "-report", "-validate_repeat", "-validate_sweep", "-validate_sweep_fractions", "-validate_sweep_output", "-test_type", "-test_size",
                 "-rom_hyper", "-test_snapshots", "-validate_sweep_R"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "validate -help lists %s" % opt)
+    # the sweep's options without -validate_sweep: said (nothing read them, without a word before)
+    p = run(args, 1, ["validate", "-options_file", "runs/ring_on_block.opts", "-rom", rom, "-test_size", "1", "-validate_repeat", "1", "-validate_sweep_R", "3", "-validate_sweep_fractions", "0.5"])
+    for o in ("-validate_sweep_R", "-validate_sweep_fractions"):
+        check(("warning: %s has no effect without -validate_sweep" % o) in p.stdout, "validate %s without -validate_sweep: a warning" % o)
+    check("-validate_sweep_output has no effect" not in p.stdout, "validate: no warning for a sweep option not given")
     p = run(args, 1, ["dualbasis", "-snapshots", d + "/rom.snapshots.h5", "-help"])
     for opt in ("-snapshots", "-report", "-dual_out", "-dual_type", "-dual_tol"):
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "dualbasis -help lists %s" % opt)

@@ -87,6 +87,13 @@ PetscErrorCode ValidationSettingsFromOptions(MPI_Comm comm, const std::string &r
   for (PetscInt r : s->rValues) PetscCheck(r >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-validate_sweep_R: %" PetscInt_FMT " dual vectors (at least 1)", r);
   s->sweep       = sweep;
   s->sweepOutput = sweepOut;
+  if (!s->sweep) { // the sweep's own options without the sweep: nothing read them (no warning before)
+    for (const char *o : {"-validate_sweep_fractions", "-validate_sweep_output", "-validate_sweep_R"}) {
+      PetscBool has = PETSC_FALSE;
+      PetscCall(PetscOptionsHasName(NULL, NULL, o, &has));
+      if (has) PetscCall(PetscPrintf(comm, "rbcontact validate: warning: %s has no effect without -validate_sweep (the speed-against-error sweep)\n", o));
+    }
+  }
   if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".json", "-validate_sweep_output"));
   if (s->sweep) PetscCall(CheckOutputPath(comm, s->sweepOutput + ".csv", "-validate_sweep_output (.csv)")); // (a FIFO was replaced, a directory failed after every FOM solve)
   PetscFunctionReturn(0);
@@ -115,6 +122,12 @@ PetscErrorCode ReadTestSnapshots(MPI_Comm comm, const std::string &path, const c
   }
   PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "%s %s: its parameters (%zu) are not the test set (%zu)", opt, file, h.trainingPoints.size(), test.points.size());
   PetscCall(SnapshotFile::ReadAll(path, snaps));
+  { // a greedy training's file solves only its picks among the candidates: "finish it" was advice its restart refuses
+    const std::string &o = h.optionsText, g = "-train_type greedy";
+    const size_t       k = o.find(g);
+    const bool greedy    = k != std::string::npos && (k + g.size() == o.size() || o[k + g.size()] == ' ');
+    PetscCheck(!greedy || snaps->size() == test.points.size(), comm, PETSC_ERR_USER_INPUT, "%s %s was written by a greedy training (-train_type greedy): it holds the %zu points the greedy solved among its %zu candidates, not a test set. Write a test set with offline -offline_stop snapshots -train_type random -train_size <n> -snapshots <test.h5> (the scene's options as for the ROM), or leave -test_snapshots out (validate solves the FOM on the -test_* set)", opt, file, snaps->size(), test.points.size());
+  }
   PetscCheck(snaps->size() == test.points.size(), comm, PETSC_ERR_USER_INPUT, "%s %s holds %zu of its %zu solutions: finish it with offline -offline_stop snapshots -snapshots_restart -snapshots %s (and the options that wrote it)", opt, file, snaps->size(), test.points.size(), file);
   PetscFunctionReturn(0);
 }

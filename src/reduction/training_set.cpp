@@ -122,10 +122,8 @@ std::string ReadSampleFile(const std::string &path, const std::string &option, c
     }
     for (size_t j = 0; j < x.size(); ++j)
       if (x[j] < params[j].min || x[j] > params[j].max) {
-        std::ostringstream m;
-        m.precision(17);
-        m << "Parameter sample file '" << path << "' line " << lineno << ": parameter '" << params[j].name << "' = " << x[j] << " is outside its box [" << params[j].min << ", " << params[j].max << "]";
-        return m.str();
+        // the shortest digits that tell the value from the box's ends (the box was printed with 17 digits)
+        return "Parameter sample file '" + path + "' line " + std::to_string(lineno) + ": " + OutOfBoxMessage(params[j], x[j]);
       }
     pts->push_back(x);
   }
