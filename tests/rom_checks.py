@@ -1279,6 +1279,17 @@ def guards(args):
         pw, gram = np.array(f["online/ecsw/Pw"]), np.array(f["online/dual_gram"])
     expect_error(args, ["-rom", tamper("nohyper", lambda f: f.__delitem__("online/hyper_default"), rom_e), "-mu", "1.02"], ["the hyper-reduction is the EIM, but the file holds no EIM term", "nohyper.h5"],
                  "an ECSW-only ROM file without /online/hyper_default (solved with no contact at all, exit 0)")
+    def setattr_(name, value):
+        def edit(f):
+            f.attrs[name] = value
+        return edit
+    # a float format_version (2.7 read as 2 by HDF5's conversion) and more parameter names than parameters (accepted)
+    expect_error(args, ["-rom", tamper("fver", setattr_("format_version", np.float64(2.7))), "-mu", "1.02"], ["attribute 'format_version' is not an integer", "fver.h5"],
+                 "a ROM file whose format_version is 2.7")
+    expect_error(args, ["-rom", tamper("pnames", setattr_("param_names", np.bytes_("radius,extra"))), "-mu", "1.02"], ["param_names 'radius,extra' holds 2 names for the 1 parameters", "pnames.h5"],
+                 "a ROM file with two parameter names for one parameter")
+    expect_error(args, ["-rom", rom_e, "-mu", "1.02", "-rom_Mk", "1"], ["-rom_Mk 1: the ROM file", "holds no EIM of kappa"],
+                 "-rom_Mk 1 on an ECSW-only ROM file (it said 'out of range [0, 0]')")
     cases = [
              ("eimdef0", replace("online/eim_default", np.array([0.0, 5.0])), ["-rom_hyper", "eim"], ["/online/eim_default must hold 2 sizes"]),
              ("kmeta", setat("online/kappa/meta", 1, -3), [], ["/online/kappa/meta must hold {0 or 1, a size >= 0}"]),

@@ -79,7 +79,8 @@ PetscErrorCode StageOnline(MPI_Comm comm)
   }
   std::sort(times.begin(), times.end());
   PetscCheck(sol.converged, comm, PETSC_ERR_NOT_CONVERGED, "online: %s", sol.message.c_str());
-  if (sol.outOfRange) PetscCall(PetscPrintf(comm, "rbcontact online: warning: %" PetscInt_FMT " contact projections fell at the edge of the stored contact data (outside the EIM's training range)\n", sol.outOfRange));
+  if (sol.outOfRange) // (it named the EIM for an ECSW model too)
+    PetscCall(PetscPrintf(comm, "rbcontact online: warning: %" PetscInt_FMT " contact projections fell at the edge of the stored contact data (the master facets stored for the %s's points: outside its training range; more -eim_patch_rings, or training parameters near this one)\n", sol.outOfRange, std::strcmp(model.HyperName(), "ecsw") ? "EIM" : "cubature"));
 
   rep.root["stage"] = "online";
   rep.root["rom_file"] = romPath;

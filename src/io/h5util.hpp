@@ -143,10 +143,18 @@ inline bool AttrExists(Ctx &c, hid_t obj, const char *name, bool *exists)
   return true;
 }
 
+// A scalar integer attribute (every caller's): one stored as a float (format_version 2.7 read as 2 by HDF5's conversion)
+// or holding several values (read past buf) is refused.
 inline bool ReadAttr(Ctx &c, hid_t obj, const char *name, hid_t mtype, void *buf)
 {
   H5Id a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
   if (!a.ok()) return c.Fail(std::string("missing attribute '") + name + "'");
+  {
+    H5Id t(H5Aget_type(a.get()), H5Tclose), sp(H5Aget_space(a.get()), H5Sclose);
+    if (!t.ok() || !sp.ok()) return c.Fail(std::string("cannot inspect attribute '") + name + "'");
+    if (H5Tget_class(mtype) == H5T_INTEGER && H5Tget_class(t.get()) != H5T_INTEGER) return c.Fail(std::string("attribute '") + name + "' is not an integer (corrupt file?)", false);
+    if (H5Sget_simple_extent_npoints(sp.get()) != 1) return c.Fail(std::string("attribute '") + name + "' holds " + std::to_string((long long)H5Sget_simple_extent_npoints(sp.get())) + " values, one expected (corrupt file?)", false);
+  }
   if (H5Aread(a.get(), mtype, buf) < 0) return c.Fail(std::string("cannot read attribute '") + name + "'");
   return true;
 }

@@ -161,6 +161,10 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
   PetscCall(ReadChecked(file, "/params/box", (size_t)-1, &box));
   PetscCall(ReadChecked(file, "/params/default", box.size() / 2, &def));
   params.assign(def.size(), ParamSpec());
+  { // one name per parameter (more names were accepted, the extra ones dropped)
+    size_t n = names.empty() ? 0 : 1 + (size_t)std::count(names.begin(), names.end(), ',');
+    PetscCheck(n == params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: attribute param_names '%s' holds %zu names for the %zu parameters of /params/box: a corrupt file", file.c_str(), names.c_str(), n, params.size());
+  }
   std::stringstream ss(names);
   for (size_t i = 0; i < params.size(); ++i) {
     std::getline(ss, params[i].name, ',');
@@ -606,6 +610,9 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   if (mg < 0) mg = MgDefault >= 0 ? std::min(MgDefault, MgFull) : MgFull;
   PetscCheck(n >= 1 && n <= Npod, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_N %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "] (POD modes in %s)", n, Npod, file.c_str());
   PetscCheck(r >= 1 && r <= Rfull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_R %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "]", r, Rfull);
+  // (a file without an EIM said "out of range [0, 0]")
+  PetscCheck(mk <= 0 || MkFull > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT ": the ROM file %s holds no EIM of kappa (its hyper-reduction is the cubature, -rom_hyper ecsw; its size is Mc, chosen offline)", mk, file.c_str());
+  PetscCheck(mg <= 0 || MgFull > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT ": the ROM file %s holds no EIM of the gap (its hyper-reduction is the cubature, -rom_hyper ecsw, or the gap is affine)", mg, file.c_str());
   PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mk, MkFull);
   PetscCheck(mg >= 0 && mg <= MgFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mg, MgFull);
   geomMu_.clear();
