@@ -839,6 +839,8 @@ def dual_select(args):
     for extra, words, what in ((["-dual_select_size", "6", "-dual_select_slack", "-1"], ["-dual_select_slack", "-1"], "negative slack"),
                                (["-dual_select_size", "6", "-dual_select_guard", "11"], ["-dual_select_guard", "11"], "guard out of range"),
                                (["-dual_select_snapshots", d + "/nosuch.h5"], ["-dual_select_snapshots", "nosuch.h5"], "missing held-out file"),
+                               (["-dual_select_snapshots", d + "/snap.h5"], ["-dual_select_snapshots", "snap.h5", "is this run's training snapshot file"], "the training file as the held-out set"),
+                               (["-dual_select_snapshots", d + "/./snap.h5"], ["-dual_select_snapshots", "is this run's training snapshot file"], "the training file under another name"),
                                (["-dual_select_size", "6", "-estimate"], ["-estimate", "-dual_select_size"], "with -estimate"),
                                (["-dual_select_size", "6", "-dual_select_R", "10,0"], ["-dual_select_R", "0"], "a candidate of 0 dual vectors")):
         expect_error(args, opts + ["-snapshots_restart", "-rom", d + "/bad.h5"] + extra, words, "offline " + what, stage="offline", np_=2)

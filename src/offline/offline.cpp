@@ -24,6 +24,7 @@
 #include "rbcontact/training_set.hpp"
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -243,6 +244,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));
     DualSelectionOptions dso;
     PetscCall(DualSelectionFromOptions(world, &dso));
+    if (!dso.snapshots.empty()) { // the training file as the held-out set: R chosen on the training states themselves
+      std::error_code ec;
+      const bool      same = dso.snapshots == s.snapshots || std::filesystem::equivalent(dso.snapshots, s.snapshots, ec);
+      PetscCheck(!same, world, PETSC_ERR_ARG_INCOMP, "-dual_select_snapshots %s is this run's training snapshot file (-snapshots): the dual basis size is chosen on held-out solutions, so give a test set's file (offline -offline_stop snapshots -train_type random -snapshots <heldout.h5>) or -dual_select_size", dso.snapshots.c_str());
+    }
     PetscCheck(slack >= 0, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_select_slack %g must be >= 0", (double)slack);
     PetscBool held = PETSC_FALSE;
     PetscCall(PetscOptionsHasName(NULL, NULL, "-eim_heldout_type", &held));
