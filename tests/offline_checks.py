@@ -292,6 +292,7 @@ def early_options(args):
              (["-pod_n", "6"], "-pod_n 6 must lie in [1, 5] (the number of snapshots)"), (["-estimate", "-estimate_safety", "0.5"], "-estimate_safety 0.5 out of range [1, 100]"),
              (["-estimate", "-estimate_calibration_size", "-1"], "-estimate_calibration_size -1 out of range"),
              (["-eim_quadrature_subdivisions", "0"], "-eim_quadrature_subdivisions 0 out of range [1, 64]"), (["-eim_patch_rings", "-1"], "-eim_patch_rings -1 out of range [0, 20]"),
+             (["-eim_patch_rings"], "option -eim_patch_rings is given without a value"),
              (["-dual_tol_relative", "0", "-dual_tol", "inf"], "-dual_tol inf. must be a finite number >= 0"),
              (["-estimate", "-estimate_pod_tol", "0.5"], "-estimate_pod_tol 0.5 must lie in [0, -pod_tol")]
     for extra, words in cases:

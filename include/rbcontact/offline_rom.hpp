@@ -21,6 +21,11 @@ struct HyperChoice {
 };
 PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h);
 
+// The contact patch's options (-eim_quadrature_subdivisions: candidate points per slave facet, default 4;
+// -eim_patch_rings: rings of master facets kept online, default 2), range-checked; either output may be NULL.
+// Read by the offline stage before the snapshots (their check) and by the hyper-reduction.
+PetscErrorCode ContactPatchOptions(MPI_Comm comm, PetscInt *nsub, PetscInt *rings);
+
 // V: the primal basis (Npod POD modes then nsup supremizers) on fom's DM; modes: the same, N x ndofs
 // row-major in canonical order, on every rank of fom's communicator. order's multipliers are numbered
 // here when a resumed run solved no snapshot. ecswTol > 0: the cubature's tolerance instead of -ecsw_tol's

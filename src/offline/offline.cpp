@@ -231,14 +231,7 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
         PetscCall(EstimateEnrichmentOptions(world, &e, &pt, &dt));
       }
     }
-    { // the contact patch's options of the last step (refused after the snapshots before 2026-12-01)
-      PetscInt  v = 4;
-      PetscBool set;
-      PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_quadrature_subdivisions", &v, &set));
-      PetscCheck(!set || (v >= 1 && v <= 64), world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", v);
-      PetscCall(PetscOptionsGetInt(NULL, NULL, "-eim_patch_rings", &v, &set));
-      PetscCheck(!set || (v >= 0 && v <= 20), world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", v);
-    }
+    PetscCall(ContactPatchOptions(world, NULL, NULL)); // the contact patch's options of the last step (refused after the snapshots before 2026-12-01)
     PetscCall(EIMOptionsFromOptions(world, "eim_kappa_", &eo));
     PetscCall(EIMOptionsFromOptions(world, "eim_gap_", &eo));
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-eim_select_slack", &slack, NULL));

@@ -5,6 +5,7 @@
 // with exact contact terms; their EIM (or their exact constant form when they do not vary); the patch
 // restricted to the facets around the EIM points; warm starts. Every rank of the group computes the
 // same (deterministic) data; world rank 0 writes it.
+#include "rbcontact/options_files.hpp"
 #include "rbcontact/offline_rom.hpp"
 #include "rbcontact/kacanov.hpp"
 #include "rbcontact/rom_fields.hpp"
@@ -123,6 +124,23 @@ PetscErrorCode HyperChoiceFromOptions(MPI_Comm comm, HyperChoice *h)
   PetscFunctionReturn(0);
 }
 
+PetscErrorCode ContactPatchOptions(MPI_Comm comm, PetscInt *nsub, PetscInt *rings)
+{
+  PetscInt n = 4, r = 2;
+
+  PetscFunctionBeginUser;
+  PetscCall(CheckValuesGiven(comm, "eim_", {"quadrature_subdivisions", "patch_rings"})); // (given without a value: the default, without a word)
+  PetscOptionsBegin(comm, "eim_", "The contact patch of the hyper-reduction (offline)", "ContactPatchOptions");
+  PetscCall(PetscOptionsInt("-quadrature_subdivisions", "pieces per slave facet of the candidate points (each with the contact Gauss rule)", "", n, &n, NULL));
+  PetscCall(PetscOptionsInt("-patch_rings", "rings of master facets around those the points projected onto, kept online", "", r, &r, NULL));
+  PetscOptionsEnd();
+  PetscCheck(n >= 1 && n <= 64, comm, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", n);
+  PetscCheck(r >= 0 && r <= 20, comm, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", r);
+  if (nsub) *nsub = n;
+  if (rings) *rings = r;
+  PetscFunctionReturn(0);
+}
+
 PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &cmap, CanonicalOrder &order, BV V, const std::vector<double> &modes, PetscInt Npod, PetscInt nsup, const DualBasisResult &dual, ReducedModel *rm, std::shared_ptr<ContactPatch> *fullOut, std::vector<PetscReal> *Pout, PetscInt *nsubOut)
 {
   PetscFunctionBeginUser;
@@ -176,11 +194,7 @@ PetscErrorCode BuildExactReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMa
 
   // --- the full contact patch on the support of the dual basis (Dirichlet values at the default mu)
   PetscInt &nsub = *nsubOut;
-  nsub           = 4;
-  PetscOptionsBegin(world, "eim_", "Contact quadrature of the hyper-reduction (offline)", "BuildExactReducedModel");
-  PetscCall(PetscOptionsInt("-quadrature_subdivisions", "pieces per slave facet of the candidate points (each with the contact Gauss rule)", "", nsub, &nsub, NULL));
-  PetscOptionsEnd();
-  PetscCheck(nsub >= 1 && nsub <= 64, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_quadrature_subdivisions %" PetscInt_FMT " out of range [1, 64]", nsub);
+  PetscCall(ContactPatchOptions(world, &nsub, NULL));
   std::vector<double> Wt((size_t)R * Rfom);
   for (PetscInt k = 0; k < R; ++k)
     for (PetscInt i = 0; i < Rfom; ++i) Wt[(size_t)k * Rfom + i] = dual.W(i, k);
@@ -448,11 +462,8 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
   }
   // --- the local data: slave facets of the points, master facets they projected onto (+ 2 rings)
-  PetscInt rings = 2;
-  PetscOptionsBegin(world, "eim_", "Local contact data (offline)", "OfflineReducedModel");
-  PetscCall(PetscOptionsInt("-patch_rings", "rings of master facets around those the points projected onto, kept online", "", rings, &rings, NULL));
-  PetscOptionsEnd();
-  PetscCheck(rings >= 0 && rings <= 20, world, PETSC_ERR_ARG_OUTOFRANGE, "-eim_patch_rings %" PetscInt_FMT " out of range [0, 20]", rings);
+  PetscInt rings;
+  PetscCall(ContactPatchOptions(world, NULL, &rings));
   std::vector<std::vector<PetscInt>> hitv(Q);
   for (PetscInt p = 0; p < Q; ++p) hitv[p].assign(hits[p].begin(), hits[p].end());
   full->Restrict(keep, hitv, rings, &rm.patch);
