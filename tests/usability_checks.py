@@ -170,6 +170,14 @@ def help_(args):
         check(("the stage needs %s, where it stops" % needs) in p.stdout, "%s -help: the note names %s" % (stage, needs))
         for opt in listed:
             check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "%s -help without %s lists %s" % (stage, needs, opt))
+    # its -report says so (an earlier run's report is not left in place)
+    hd = workdir()
+    with open(hd + "/old.json", "w") as f:
+        f.write('{"stage": "fom", "converged": true}')
+    p = run(args, 1, ["fom", "-help", "-report", hd + "/old.json"], expect_ok=False)
+    hr = load(hd + "/old.json")
+    check(p.returncode == 0 and hr.get("converged") is False and "-help: stopped before -mesh_file (nothing was run)" in hr.get("error", ""),
+          "fom -help -report without a mesh: the report replaced, saying nothing was run (%s)" % hr.get("error"))
     # without -help the missing input is still an error
     p = run(args, 1, ["online"], expect_ok=False)
     check(p.returncode != 0 and "online: give the ROM file with -rom" in p.stdout, "online without -rom and without -help: an error (exit %d)" % p.returncode)

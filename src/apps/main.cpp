@@ -233,7 +233,9 @@ int main(int argc, char **argv)
       PetscCall(PetscPrintf(PETSC_COMM_WORLD, "rbcontact: %s\n", firstError.c_str()));
       ierr = PETSC_ERR_ARG_UNKNOWN_TYPE;
     }
-  } catch (const rbc::HelpStop &) { // -help without the stage's input: the options read so far were listed (RequireInput)
+  } catch (const rbc::HelpStop &h) { // -help without the stage's input: the options read so far were listed (RequireInput)
+    firstError = std::string(h.what()) + " (nothing was run)"; // a -report is replaced all the same: never an earlier run's left in place
+    FailureReport(stage, 0);
     PetscCallMPI(MPI_Comm_free(&exitComm));
     PetscCall(SlepcFinalize());
     return 0;
