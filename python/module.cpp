@@ -3,18 +3,24 @@
 // the library (RunOffline, RunValidation) with their options scoped to the call. PETSc/SLEPc are initialized on the first
 // use (rbcontact.initialize(options) to pass PETSc options first) and finalized at exit; every PETSc error
 // becomes a Python RuntimeError carrying PETSc's message (the file, option or value it names).
+// Every call into PETSc and the library runs with the GIL released and a mutex held (PETSc's options database and
+// error state are global: concurrent calls from threads run one after the other); Ctrl-C is seen at the call's end.
+// Integer options beyond 32 bits are refused as by the executable (src/apps/petsc_int_option.cpp is linked in).
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
 #include "rbcontact/options_files.hpp"
 #include "rbcontact/rom_probe.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/offline.hpp"
 #include "rbcontact/reduced_model.hpp"
+#include "rbcontact/report.hpp"
 #include "rbcontact/validation.hpp"
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <slepcsys.h>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,7 +33,7 @@ std::string lastError; // the first message of the failing PETSc call (PETSC_ERR
 
 PetscErrorCode CaptureErrorHandler(MPI_Comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *)
 {
-  if (p == PETSC_ERROR_INITIAL) lastError = std::string(mess ? mess : "(no message)") + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
+  if (p == PETSC_ERROR_INITIAL) lastError = std::string(mess ? mess : "(no message)") + rbc::OptionsHoldingValue(mess) + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
   return n;
 }
 
@@ -40,9 +46,79 @@ void Check(PetscErrorCode ierr)
   throw std::runtime_error(msg);
 }
 
+// PETSc (its options database, its error handler) and the library's state are global and not thread-safe: every call
+// into them runs through Serialized, with this mutex held and the GIL released, so that other Python threads run
+// meanwhile (a stage takes minutes) and calls from several threads run one after the other. What runs there touches
+// no Python object; warnings are issued after, with the GIL held and the mutex free (a warning filter may call back
+// into the module). The mutex is never held while waiting for the GIL, so taking it with the GIL held (~Model) cannot
+// deadlock.
+std::mutex libraryMutex;
+
+template <class F>
+auto Serialized(F &&f) -> decltype(f())
+{
+  py::gil_scoped_release      nogil;
+  std::lock_guard<std::mutex> lock(libraryMutex); // released before the GIL is taken again
+  return f();
+}
+
+void Warn(PyObject *category, const std::string &message)
+{
+  if (PyErr_WarnEx(category, message.c_str(), 1) < 0) throw py::error_already_set(); // warnings turned into errors
+}
+
 bool initializedHere = false, exiting = false;
 int  liveModels      = 0; // PETSc is finalized at exit once no ReducedModel (which may hold PETSc objects) is alive
+std::vector<std::string> initOptions;              // initialize()'s, checked after the first model read them
+bool                     initOptionsChecked = false;
 
+std::string Shown(std::string w)
+{
+  for (size_t k; (k = w.find('\0')) != std::string::npos;) w.replace(k, 1, "\\0");
+  return w;
+}
+
+// The words of a call (initialize's options, a stage's keywords and words), before PETSc reads them: a NUL character
+// cuts a word where PETSc reads it (rom="a\0b" opened 'a'), an empty word makes the option before it a flag
+// (report="" wrote no report, sizes=[] ran the defaults), a list with an empty entry (sizes=[3, "", 5]) lost it
+// without a word (the executable refuses it: rbc::CheckListEntries), a double quote would end PETSc's quoting of
+// a value with spaces. Refused, naming the option (the keyword) and its value.
+void CheckWords(const std::vector<std::string> &words, const std::string &who)
+{
+  for (size_t i = 0; i < words.size(); ++i) {
+    const std::string &w      = words[i];
+    const bool         isName = rbc::IsOptionName(w);
+    const std::string  option = isName || i == 0 || !rbc::IsOptionName(words[i - 1]) ? "" : "option " + Shown(words[i - 1]) + " ";
+    if (w.find('\0') != std::string::npos) throw std::runtime_error(who + ": " + (option.empty() ? "the word '" + Shown(w) + "'" : option + "'" + Shown(w) + "'") + ": a NUL character in the value");
+    if (w.empty()) throw std::runtime_error(who + ": " + (option.empty() ? "an empty word" : option + "is given an empty value ('' or an empty list; None leaves an option out)"));
+    if (!isName && rbc::HasEmptyListEntry(w)) throw std::runtime_error(who + ": " + option + w + ": an empty entry in the list (a comma too many?)");
+    if (w.find('"') != std::string::npos) throw std::runtime_error(who + ": an option value may not hold a double quote: " + w);
+  }
+}
+
+// Once PETSc runs: whether its integer options go through the range check of src/apps/petsc_int_option.cpp, linked
+// into this module, which takes the place of PETSc's own when the module loaded PETSc (ELF symbol interposition),
+// not when PETSc was loaded before it (petsc4py imported first): tried on an options database of its own.
+bool IntRangeChecked()
+{
+  static int state = -1;
+  if (state < 0) {
+    PetscOptions o   = nullptr;
+    PetscInt     v   = 0;
+    PetscBool    set = PETSC_FALSE;
+    state            = 0;
+    if (!PetscPushErrorHandler(PetscReturnErrorHandler, NULL)) {
+      if (!PetscOptionsCreate(&o)) {
+        if (!PetscOptionsSetValue(o, "-rbc_int_range_check", "4294967297")) state = PetscOptionsGetInt(o, NULL, "-rbc_int_range_check", &v, &set) != 0;
+        (void)PetscOptionsDestroy(&o);
+      }
+      (void)PetscPopErrorHandler();
+    }
+  }
+  return state == 1;
+}
+
+// PETSc started with these options unless it runs already (under the mutex).
 void Initialize(const std::vector<std::string> &options)
 {
   // MPI cannot start again in a process: after rbcontact.finalize() every call raises (it aborted the interpreter)
@@ -51,6 +127,7 @@ void Initialize(const std::vector<std::string> &options)
     if (!options.empty()) throw std::runtime_error("rbcontact.initialize: PETSc is already initialized; pass the options before the first ReducedModel");
     return;
   }
+  CheckWords(options, "rbcontact.initialize");
   {
     const std::string bad = rbc::CheckOptionsFiles(options);
     if (!bad.empty()) throw std::runtime_error("rbcontact.initialize: " + bad);
@@ -67,7 +144,23 @@ void Initialize(const std::vector<std::string> &options)
   char **av   = argv.data();
   if (SlepcInitialize(&argc, &av, NULL, NULL)) throw std::runtime_error("rbcontact: SlepcInitialize failed");
   initializedHere = true;
+  initOptions     = options;
   if (PetscPushErrorHandler(CaptureErrorHandler, NULL)) throw std::runtime_error("rbcontact: PetscPushErrorHandler failed");
+}
+
+// Every entry point first: PETSc started (Initialize), and once a warning if the integer options are not range-checked.
+void Start(const std::vector<std::string> &options = {})
+{
+  static bool warned  = false;
+  const bool  checked = Serialized([&] {
+    Initialize(options);
+    return IntRangeChecked();
+  });
+  if (!checked && !warned) {
+    warned = true;
+    Warn(PyExc_RuntimeWarning, "rbcontact: PETSc was loaded before this module (by petsc4py?): integer options beyond 32 bits are not refused and "
+                               "wrap (4294967297 is read as 1); import rbcontact first");
+  }
 }
 
 void Finalize()
@@ -79,8 +172,10 @@ void Finalize()
 // At interpreter exit: finalize now, or when the last model goes.
 void AtExit()
 {
-  exiting = true;
-  if (liveModels == 0) Finalize();
+  Serialized([] {
+    exiting = true;
+    if (liveModels == 0) Finalize();
+  });
 }
 
 // One reduced solution, as Python sees it.
@@ -104,11 +199,11 @@ py::array_t<double> Array(const std::vector<PetscReal> &x)
   return a;
 }
 
+// Opened by Open (PETSc started, the constructor under the mutex).
 class Model {
 public:
   explicit Model(const std::string &file)
   {
-    Initialize({});
     ++liveModels;
     try {
       Check(model_.Open(file));
@@ -120,7 +215,8 @@ public:
   }
   ~Model()
   {
-    (void)model_.qp.Reset(); // its PETSc objects, while PETSc is up
+    std::lock_guard<std::mutex> lock(libraryMutex); // with the GIL (also during the interpreter's exit)
+    (void)model_.qp.Reset();                        // its PETSc objects, while PETSc is up
     if (--liveModels == 0 && exiting) Finalize();
   }
   Model(const Model &)            = delete;
@@ -147,9 +243,13 @@ public:
     auto a = RealArray(obj, "solve");
     if (a.ndim() > 1) throw py::type_error("solve: expected a sequence of parameter values (one point), got an array of " + std::to_string((long long)a.ndim()) + " dimensions");
     const std::vector<PetscReal> m(a.data(), a.data() + a.size());
-    Check(model_.par.CheckBox(PETSC_COMM_SELF, m)); // a clear error naming the parameter, its value and the box
-    rbc::ReducedSolution sol;
-    Check(model_.Solve(m, &sol));
+    rbc::ReducedSolution         sol;
+    rbc::SurfaceOutputValues     so;
+    Serialized([&] {
+      Check(model_.par.CheckBox(PETSC_COMM_SELF, m)); // a clear error naming the parameter, its value and the box
+      Check(model_.Solve(m, &sol));
+      if (sol.converged) model_.SurfaceOutputsOf(m, sol, &so);
+    });
     Solution s;
     s.v          = Array(sol.v);
     s.lambda_hat = Array(sol.lambda);
@@ -158,8 +258,6 @@ public:
     s.iterations = sol.iterations;
     if (!sol.force.empty() && sol.converged) s.contactForce = sol.ForceMagnitude();
     if (sol.converged) {
-      rbc::SurfaceOutputValues so;
-      model_.SurfaceOutputsOf(m, sol, &so);
       s.maxPressure   = so.maxPressure;
       s.halfwidth     = so.halfwidth;
       s.contactLength = so.contactLength;
@@ -184,20 +282,22 @@ public:
     if (mus.ndim() != 2 || mus.shape(1) != np) throw std::runtime_error("contact_forces: expected an array of shape (n, " + std::to_string(np) + ") (one row per parameter point)");
     const py::ssize_t   n = mus.shape(0);
     py::array_t<double> out(n);
-    auto                in = mus.unchecked<2>();
-    auto                o  = out.mutable_unchecked<1>();
-    std::vector<PetscReal> m(np);
-    rbc::ReducedSolution   sol;
-    for (py::ssize_t k = 0; k < n; ++k) {
-      for (PetscInt i = 0; i < np; ++i) m[i] = in(k, i);
-      Check(model_.par.CheckBox(PETSC_COMM_SELF, m, "contact_forces: row " + std::to_string((long long)k))); // (it blamed -mu, no row)
-      Check(model_.Solve(m, &sol));
-      if (sol.force.empty() && sol.converged) throw std::runtime_error("contact_forces: this ROM's hyper-reduction (" + std::string(model_.HyperName()) + ") computes no online force; use the ECSW cubature (-rom_hyper ecsw)");
-      if (!sol.converged) {
-        if (!nanOnFailure) throw std::runtime_error("contact_forces: the reduced model did not converge at row " + std::to_string((long long)k) + ": " + sol.message);
-        o(k) = std::numeric_limits<double>::quiet_NaN();
-      } else o(k) = sol.ForceMagnitude();
-    }
+    const double       *in = mus.data(); // C-contiguous (RealArray), n x np; both arrays stay alive through the call
+    double             *o  = out.mutable_data();
+    Serialized([&] {
+      std::vector<PetscReal> m(np);
+      rbc::ReducedSolution   sol;
+      for (py::ssize_t k = 0; k < n; ++k) {
+        for (PetscInt i = 0; i < np; ++i) m[i] = in[k * np + i];
+        Check(model_.par.CheckBox(PETSC_COMM_SELF, m, "contact_forces: row " + std::to_string((long long)k))); // (it blamed -mu, no row)
+        Check(model_.Solve(m, &sol));
+        if (sol.force.empty() && sol.converged) throw std::runtime_error("contact_forces: this ROM's hyper-reduction (" + std::string(model_.HyperName()) + ") computes no online force; use the ECSW cubature (-rom_hyper ecsw)");
+        if (!sol.converged) {
+          if (!nanOnFailure) throw std::runtime_error("contact_forces: the reduced model did not converge at row " + std::to_string((long long)k) + ": " + sol.message);
+          o[k] = std::numeric_limits<double>::quiet_NaN();
+        } else o[k] = sol.ForceMagnitude();
+      }
+    });
     return out;
   }
 
@@ -212,19 +312,15 @@ public:
 };
 
 // The options database of one stage call: pushed as PETSc's default for the call, popped and destroyed
-// after it (also on an error), so one call's options never leak into the next or into the models.
+// after it (also on an error), so one call's options never leak into the next or into the models. The words
+// were checked (CheckWords, CheckOptionsFiles: an options file that includes itself made PETSc recurse until the
+// interpreter crashed).
 class ScopedOptions {
 public:
   explicit ScopedOptions(const std::vector<std::string> &tokens)
   {
-    // an options file that includes itself: PETSc would recurse until the interpreter crashes
-    const std::string bad = rbc::CheckOptionsFiles(tokens);
-    if (!bad.empty()) throw std::runtime_error("rbcontact: " + bad);
     std::string line;
-    for (const auto &t : tokens) {
-      if (t.find('"') != std::string::npos) throw std::runtime_error("rbcontact: an option value may not hold a double quote: " + t);
-      line += (t.find(' ') != std::string::npos ? "\"" + t + "\"" : t) + " ";
-    }
+    for (const auto &t : tokens) line += (t.find(' ') != std::string::npos ? "\"" + t + "\"" : t) + " ";
     Check(PetscOptionsCreate(&opts_));
     try {
       Check(PetscOptionsInsertString(opts_, line.c_str())); // -options_file included
@@ -246,18 +342,43 @@ private:
   PetscOptions opts_ = nullptr;
 };
 
-// Runs the offline or validate stage of the library (RunOffline, RunValidation) with these command-line
-// options only (not those of initialize()); returns the stage's JSON report as text. -report is written too.
-std::string RunStage(const std::string &stage, const std::vector<std::string> &options)
+// The value of the last -report among the words (the one PETSc would read), "" if none or not a path.
+std::string ReportWord(const std::vector<std::string> &words)
 {
-  Initialize({});
+  std::string r;
+  for (size_t i = 0; i + 1 < words.size(); ++i)
+    if (words[i] == "-report") r = words[i + 1];
+  return r.find('\0') != std::string::npos || rbc::IsOptionName(r) ? "" : r;
+}
+
+// RunStage under the mutex: the report as text, the options nobody read in unused.
+std::string RunStageLocked(const std::string &stage, const std::vector<std::string> &options, std::vector<std::string> *unused)
+{
   if (stage != "offline" && stage != "validate" && stage != "probe") throw std::runtime_error("rbcontact: unknown stage '" + stage + "' (offline, validate or probe; online: ReducedModel)");
-  ScopedOptions scope(options);
-  char          reportPath[PETSC_MAX_PATH_LEN] = "";
+  rbc::ResetReportMarks(); // an earlier call's refused or written report does not keep this call's failure from its -report
+  PetscMPIInt rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  std::unique_ptr<ScopedOptions> scope;
+  {
+    long long code = PETSC_ERR_USER_INPUT;
+    try {
+      CheckWords(options, "rbcontact." + stage);
+      const std::string bad = rbc::CheckOptionsFiles(options);
+      code                  = PETSC_ERR_FILE_OPEN;
+      if (!bad.empty()) throw std::runtime_error("rbcontact." + stage + ": " + bad);
+      scope = std::make_unique<ScopedOptions>(options);
+    } catch (const std::exception &e) { // as the command line: options that cannot be read still replace the -report among the words
+      const std::string r = ReportWord(options);
+      if (rank == 0 && !r.empty()) rbc::WriteFailureReport(r.c_str(), stage, e.what(), code, false);
+      throw;
+    }
+  }
+  char reportPath[PETSC_MAX_PATH_LEN] = "";
   Check(PetscOptionsGetString(NULL, NULL, "-report", reportPath, sizeof reportPath, NULL));
   Check(rbc::CheckOutputPath(PETSC_COMM_WORLD, reportPath, "-report"));
   rbc::Report rep;
   try {
+    Check(rbc::CheckListEntries(PETSC_COMM_WORLD)); // those of its options files too
     if (stage == "offline") Check(rbc::RunOfflineFromOptions(PETSC_COMM_WORLD, &rep));
     else if (stage == "probe") { // the report whatever the failures (they are the answer; the command line's stage exits with an error)
       char romPath[PETSC_MAX_PATH_LEN] = "";
@@ -270,34 +391,65 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
       Check(rbc::ProbeRomFile(PETSC_COMM_WORLD, romPath, 1000, &rep.root["probe"], &ps));
     } else Check(rbc::RunValidationFromOptions(PETSC_COMM_WORLD, reportPath, &rep));
   } catch (const std::exception &e) { // as the command line: a failed run replaces an earlier report with its failure
-    PetscMPIInt rank = 0;
-    MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
     if (rank == 0 && reportPath[0]) rbc::WriteFailureReport(reportPath, stage, e.what(), 1, true);
     throw;
   }
   // options of this call nobody read (a misspelled keyword: trian_size=5 ran the file's 21 points without a word)
-  std::vector<std::string> unused;
-  Check(rbc::UnusedOptions(stage, &unused, options));
-  if (!unused.empty()) {
+  Check(rbc::UnusedOptions(stage, unused, options));
+  if (!unused->empty()) {
     rbc::JsonValue &w = rep.root["warnings"];
-    for (const auto &u : unused) {
-      w.Push(rbc::JsonValue::String(u));
-      if (PyErr_WarnEx(PyExc_UserWarning, ("rbcontact." + stage + ": " + u).c_str(), 1) < 0) throw py::error_already_set(); // warnings turned into errors
-    }
+    for (const auto &u : *unused) w.Push(rbc::JsonValue::String(u));
   }
   Check(rep.Write(PETSC_COMM_WORLD, reportPath));
   return rep.root.Dump();
+}
+
+// Runs the offline, validate or probe stage of the library (RunOffline, RunValidation, ProbeRomFile) with these
+// command-line options only (not those of initialize()); returns the stage's JSON report as text. -report is written
+// too (with the warnings, which are then issued: a filter turning them into errors raises after the report).
+std::string RunStage(const std::string &stage, const std::vector<std::string> &options)
+{
+  Start();
+  std::vector<std::string> unused;
+  std::string              text = Serialized([&] { return RunStageLocked(stage, options, &unused); });
+  for (const auto &u : unused) Warn(PyExc_UserWarning, "rbcontact." + stage + ": " + u);
+  return text;
+}
+
+// A ROM file opened (Python's ReducedModel(file)); the first one also says which options of initialize() nobody read
+// (misspelled: -rom_kacanov_monitr), as the command line's online stage does.
+std::unique_ptr<Model> OpenModel(const std::string &file)
+{
+  Start();
+  std::vector<std::string> unused;
+  auto                     model = Serialized([&] {
+    auto m = std::make_unique<Model>(file);
+    if (!initOptionsChecked && initializedHere) {
+      initOptionsChecked = true;
+      Check(rbc::UnusedOptions("online", &unused, initOptions));
+    }
+    return m;
+  });
+  for (const auto &u : unused) Warn(PyExc_UserWarning, "rbcontact.initialize: " + u);
+  return model;
 }
 
 } // namespace
 
 PYBIND11_MODULE(_rbcontact, m)
 {
-  m.doc() = "rbcontact: the online stage of a reduced contact model (ROM file from `rbcontact offline`)";
-  m.def("initialize", &Initialize, py::arg("options") = std::vector<std::string>{},
+  m.doc() = "rbcontact: the online stage of a reduced contact model (ROM file from `rbcontact offline`). Every call runs with "
+            "the GIL released; calls from several threads run one after the other (PETSc's options database is global). "
+            "Ctrl-C is seen when the running call ends.";
+  m.def("initialize", [](const std::vector<std::string> &options) { Start(options); }, py::arg("options") = std::vector<std::string>{},
         "Initialize PETSc/SLEPc with these command-line options (e.g. ['-rom_kacanov_monitor']); optional, "
-        "done with no options by the first ReducedModel");
-  m.def("finalize", [] { if (liveModels == 0) Finalize(); else throw std::runtime_error("rbcontact.finalize: delete the ReducedModel objects first"); }, "Finalize PETSc/SLEPc (done at exit)");
+        "done with no options by the first ReducedModel, which warns about the options nobody read");
+  m.def("finalize", [] {
+    Serialized([] {
+      if (liveModels == 0) Finalize();
+      else throw std::runtime_error("rbcontact.finalize: delete the ReducedModel objects first");
+    });
+  }, "Finalize PETSc/SLEPc (done at exit)");
   m.def("_run_stage", &RunStage, py::arg("stage"), py::arg("options"),
         "Run the offline, validate or probe stage with these command-line options; the JSON report as text");
   py::class_<Solution>(m, "Solution", "One reduced solution")
@@ -317,7 +469,7 @@ PYBIND11_MODULE(_rbcontact, m)
     .def_readonly("message", &Solution::message, "why the solve failed (empty on success)")
     .def("__repr__", [](const Solution &s) { return "<rbcontact.Solution converged=" + std::string(s.converged ? "True" : "False") + " iterations=" + std::to_string((long long)s.iterations) + " contact_force=" + std::to_string(s.contactForce) + ">"; });
   py::class_<Model>(m, "ReducedModel", "A ROM file opened for online solves (rbc::ReducedModel)")
-    .def(py::init<const std::string &>(), py::arg("file"))
+    .def(py::init(&OpenModel), py::arg("file"))
     .def("solve", &Model::Solve, py::arg("mu"), "The reduced solution at mu (a sequence of parameter values)")
     .def("contact_forces", &Model::ContactForces, py::arg("mus"), py::arg("nan_on_failure") = false,
          "The contact force at every row of mus (shape (n, number of parameters), or (n,) with one parameter)")

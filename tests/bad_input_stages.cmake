@@ -72,7 +72,7 @@ rbc_bad_stage_np2(msh22_tag_clash "is in gmsh format 2.2 and its entity 13 [(]of
 rbc_bad_stage_np2(saddle_rtol_forcing "-fom_saddle_rtol_forcing -1[.]? must be in" fom -options_file runs/ring_on_block.opts -fom_dual_matrix saddle -fom_saddle_rtol_forcing -1)
 # an integer beyond 32 bits (PETSc 3.18 cast it without a word: -mesh_refine 4294967296 ran as 0; src/apps/petsc_int_option.cpp)
 rbc_bad_stage(int_value_wraps "Input string 4294967296 is out of the range of a 32-bit integer [(]option -mesh_refine 4294967296[)]" fom -options_file runs/ring_on_block.opts -mesh_refine 4294967296)
-# an empty entry in a list option (PETSc named no option, or dropped the entry without a word; src/apps/main.cpp)
+# an empty entry in a list option (PETSc named no option, or dropped the entry without a word; rbc::CheckListEntries, src/io/options_files.cpp)
 rbc_bad_stage(list_empty_entry "option -body_E 100,,100: an empty entry in the list" fom -options_file runs/ring_on_block.opts -body_E 100,,100)
 # a body of -bodies with no physical group of the mesh's dimension: "not a valid gmsh file?" on 1 rank, a hang on 2 (rank 0
 # left PETSc's reader with an error while the other ranks waited in it); checked before the reader (src/mesh/mesh_loader.cpp)

@@ -10,16 +10,23 @@
     (the parameter), an array of the wrong shape; nan_on_failure keeps going past no failure here;
   - the offline and validate stages from Python (rbcontact.offline / validate, the library's RunOffline and
     RunValidation): the same ROM (forces to 1e-12) and the same validation errors as the command line with
-    the same options, the report returned and written, a bad option value raising with the option named.
+    the same options, the report returned and written, a bad option value raising with the option named;
+  - bad keywords and words refused naming the option, the earlier report replaced by the failure: integers beyond 32 bits
+    (also initialize()'s), empty list entries and values, NUL characters, a missing options file; a misspelled
+    initialize() option warned about; the GIL released during a call, calls from several threads serialized.
 Usage: python_checks.py --exe build/bin/rbcontact --pythonpath build/python
 """
 import argparse
+import glob
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
+import time
 
 failures = 0
 
@@ -137,13 +144,38 @@ def main():
             check(False, "a broadcast view of 1e13 rows: no exception")
         except MemoryError as e:
             check("cannot make a contiguous float64 copy" in str(e), "a broadcast view of 1e13 rows in contact_forces: MemoryError, no crash (%s)" % str(e)[:100])
-        # options before the first model, in a fresh interpreter: they reach the reduced model
-        code = ("import rbcontact; rbcontact.initialize(['-rom_kacanov_monitor', '-rom_R', '2']); m = rbcontact.ReducedModel(%r); "
-                "s = m.solve([1.02]); print('R', m.R, 'lambda_hat', len(s.lambda_hat), 'converged', s.converged)" % rom)
-        p = subprocess.run([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
-                           env=dict(os.environ, PYTHONPATH=args.pythonpath))
-        check(p.returncode == 0 and "R 2 lambda_hat 2 converged True" in p.stdout and "ROM Kacanov" in p.stdout,
-              "initialize(options) before the first model: -rom_R 2 and the Kacanov monitor take effect (exit %d)" % p.returncode)
+        def fresh(code):  # in a fresh interpreter (initialize() comes before the first model)
+            p = subprocess.run([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                               env=dict(os.environ, PYTHONPATH=args.pythonpath))
+            return p.returncode, p.stdout
+
+        # options before the first model: they reach the reduced model; a misspelled one is warned about once (the first
+        # model reads them), the others not; a NUL character refused before PETSc starts (it cut the word: '2\0x' read as 2)
+        rc, out = fresh("import warnings, rbcontact\n"
+                        "try:\n    rbcontact.initialize(['-rom_R', '2\\0x'])\nexcept RuntimeError as e:\n    print('NUL:', e)\n"
+                        "with warnings.catch_warnings(record=True) as w:\n    warnings.simplefilter('always')\n"
+                        "    rbcontact.initialize(['-rom_kacanov_monitor', '-rom_R', '2', '-rom_kacanov_monitr'])\n"
+                        "    m = rbcontact.ReducedModel(%r); m2 = rbcontact.ReducedModel(%r)\n"
+                        "print('WARN', [str(x.message) for x in w])\n"
+                        "s = m.solve([1.02]); print('R', m.R, 'lambda_hat', len(s.lambda_hat), 'converged', s.converged)" % (rom, rom))
+        check(rc == 0 and "R 2 lambda_hat 2 converged True" in out and "ROM Kacanov" in out,
+              "initialize(options) before the first model: -rom_R 2 and the Kacanov monitor take effect (exit %d)" % rc)
+        warned = [l for l in out.splitlines() if l.startswith("WARN ")]
+        check(len(warned) == 1 and warned[0].count("was not used") == 1 and "rbcontact.initialize: option -rom_kacanov_monitr was not used" in warned[0],
+              "initialize() with a misspelled option: one UserWarning naming it, at the first model only (%s)" % (warned[0][:120] if warned else out[-300:]))
+        check("NUL: rbcontact.initialize: option -rom_R '2\\0x': a NUL character in the value" in out, "initialize() with a NUL character: refused naming the option")
+        # integer options beyond 32 bits (PETSc casts them: -rom_N 4294967297 ran with N 1), as the executable refuses them
+        rc, out = fresh("import rbcontact; rbcontact.initialize(['-rom_N', '4294967297'])\n"
+                        "try:\n    rbcontact.ReducedModel(%r); print('accepted')\nexcept RuntimeError as e:\n    print('refused:', e)" % rom)
+        check(rc == 0 and "refused: Input string 4294967297 is out of the range of a 32-bit integer (option -rom_N 4294967297)" in out,
+              "initialize(['-rom_N', '4294967297']): the model refuses it, naming the option (%s)" % out.strip().splitlines()[-1][:110])
+        # ... unless PETSc was loaded before the module (petsc4py first): then a RuntimeWarning says the check is off
+        lib = re.search(r"=> (\S*libpetsc\S*)", subprocess.run(["ldd", glob.glob(os.path.join(args.pythonpath, "rbcontact", "_rbcontact*.so"))[0]],
+                                                                stdout=subprocess.PIPE, text=True).stdout)
+        rc, out = fresh("import ctypes, warnings; ctypes.CDLL(%r, mode=ctypes.RTLD_GLOBAL); warnings.simplefilter('always')\n"
+                        "import rbcontact; m = rbcontact.ReducedModel(%r); print('opened')" % (lib.group(1) if lib else "libpetsc.so", rom))
+        check(rc == 0 and "RuntimeWarning: rbcontact: PETSc was loaded before this module" in out and "opened" in out,
+              "PETSc loaded before the module: a RuntimeWarning that integer options are not range-checked (exit %d)" % rc)
         check(np.allclose(m.contact_forces(radii[:3], nan_on_failure=True), forces[:3], rtol=0, atol=0), "nan_on_failure: the same forces where every solve converges")
 
         # the offline and validate stages from Python, against the command line with the same options
@@ -189,6 +221,72 @@ def main():
             f.write('{"stage": "old", "converged": true}')
         raises(lambda: rbcontact.validate(options_file="runs/ring_on_block.opts", rom=missing, report=d + "/old.json"), ["nonexistent.h5"], "validate of a missing ROM from Python")
         check(json.load(open(d + "/old.json"))["converged"] is False, "the failed call replaced the earlier report with its failure")
+        # a call failing before the stage (a missing options file) replaces it too, as the command line does; and so does a
+        # failure after a call whose report was refused (the library's mark of that refusal outlived its call)
+        def mkold():
+            with open(d + "/old.json", "w") as f:
+                f.write('{"stage": "old", "converged": true}')
+        mkold()
+        raises(lambda: rbcontact.validate(options_file=d + "/nosuch.opts", rom=pyrom, report=d + "/old.json"), ["nosuch.opts", "No such file"], "a missing options file from Python")
+        old = json.load(open(d + "/old.json"))
+        check(old.get("converged") is False and old.get("stage") == "validate" and "nosuch.opts" in old.get("error", ""), "a missing options file: the earlier report replaced by the failure naming it")
+        os.mkdir(d + "/adir")
+        raises(lambda: rbcontact.validate(options_file="runs/ring_on_block.opts", rom=pyrom, report=d + "/adir"), ["-report", "directory"], "a report onto a directory")
+        mkold()
+        raises(lambda: rbcontact.validate(options_file="runs/ring_on_block.opts", rom=missing, report=d + "/old.json"), ["nonexistent.h5"], "validate of a missing ROM after a refused report")
+        check(json.load(open(d + "/old.json")).get("converged") is False, "after a call whose report was refused, a failed call still replaces its report")
+        # integer keywords beyond 32 bits (they wrapped: probe_size=2**32+1 ran 1 point), words too
+        raises(lambda: rbcontact.probe(rom=pyrom, probe_size=2 ** 32 + 1), ["out of the range of a 32-bit integer", "-probe_size 4294967297"], "probe_size=2**32+1")
+        raises(lambda: rbcontact.validate("-validate_repeat", str(2 ** 40), options_file="runs/ring_on_block.opts", rom=pyrom, test_size=2),
+               ["32-bit", "-validate_repeat 1099511627776"], "the word -validate_repeat 2**40")
+        # empty list entries (lost without a word: [0.5, '', 1] read as 0.5,1), empty values (the option a flag), NUL
+        # characters (the value cut there: rom='x.h5\0y' opened x.h5): refused naming the keyword, the report replaced
+        for kw, words in (({"validate_sweep_fractions": [0.5, "", 1]}, ["-validate_sweep_fractions 0.5,,1", "empty entry"]),
+                          ({"validate_sweep_fractions": [0.5, ""]}, ["-validate_sweep_fractions 0.5,", "empty entry"]),
+                          ({"validate_sweep_fractions": "1,,2"}, ["-validate_sweep_fractions 1,,2", "empty entry"]),
+                          ({"validate_sweep_fractions": []}, ["-validate_sweep_fractions", "empty value"]),
+                          ({"test_seed": ""}, ["-test_seed", "empty value"]),
+                          ({"rom": pyrom + "\0x"}, ["option -rom", "\\0x", "NUL character"])):
+            mkold()
+            raises(lambda: rbcontact.validate(options_file="runs/ring_on_block.opts", **dict({"rom": pyrom, "validate_sweep": True, "validate_sweep_output": d + "/sweep", "report": d + "/old.json"}, **kw)),
+                   words, "validate(%s)" % ", ".join("%s=%r" % x for x in kw.items()))
+            check(json.load(open(d + "/old.json")).get("converged") is False, "  ... and the earlier report replaced by the failure")
+        with open(d + "/list.opts", "w") as f:
+            f.write("-options_file runs/ring_on_block.opts\n-validate_sweep_fractions 0.25,,1\n")
+        raises(lambda: rbcontact.validate(options_file=d + "/list.opts", rom=pyrom, validate_sweep=True, validate_sweep_output=d + "/sweep"), ["-validate_sweep_fractions 0.25,,1", "empty entry"],
+               "an empty list entry in an options file")
+        # the GIL is released during a call: another thread runs meanwhile (it waited for the stage's end); calls from
+        # several threads run one after the other, each with its own options and the same answers as alone
+        ticks, done = [0], threading.Event()
+        def ticker():
+            while not done.is_set():
+                ticks[0] += 1
+                time.sleep(0.001)
+        tt = threading.Thread(target=ticker)
+        tt.start()
+        t0 = time.time()
+        p1 = rbcontact.probe(rom=pyrom, probe_size=20000)["probe"]
+        elapsed = time.time() - t0
+        done.set()
+        tt.join()
+        check(ticks[0] >= 10 and p1["failed"] == 0, "another Python thread runs during a stage: %d ticks of 1 ms in its %.2f s" % (ticks[0], elapsed))
+        results = {}
+        def work(name, f):
+            try:
+                results[name] = f()
+            except Exception as e:
+                results[name] = e
+        jobs = [threading.Thread(target=work, args=("forces%d" % k, lambda: m.contact_forces(radii))) for k in range(2)]
+        jobs += [threading.Thread(target=work, args=("probe%d" % k, lambda k=k: rbcontact.probe(rom=pyrom, probe_size=200 + k)["probe"])) for k in range(2)]
+        for j in jobs:
+            j.start()
+        for j in jobs:
+            j.join()
+        alone = [rbcontact.probe(rom=pyrom, probe_size=200 + k)["probe"] for k in range(2)]
+        same = [isinstance(results["forces%d" % k], np.ndarray) and np.array_equal(results["forces%d" % k], forces) for k in range(2)]
+        same += [isinstance(results["probe%d" % k], dict) and results["probe%d" % k]["size"] == 200 + k and dict(results["probe%d" % k], time_s=0) == dict(alone[k], time_s=0)
+                 for k in range(2)]
+        check(all(same), "4 threads (2 contact_forces, 2 probes of their own sizes): the answers of the calls alone (%s)" % same)
         del m
         # after finalize() PETSc cannot start again (MPI cannot): an exception, not an abort of the interpreter
         rbcontact.finalize()

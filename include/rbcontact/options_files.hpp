@@ -17,6 +17,12 @@ namespace rbc {
 // well, else the message ("options file a.opts includes itself through -options_file (a.opts -> b.opts -> a.opts)").
 std::string CheckOptionsFiles(const std::vector<std::string> &words);
 
+// A word of a command line that names an option (-rom, -rom_N), not a value (-1, -.5).
+bool IsOptionName(const std::string &word);
+
+// A list value with an empty entry: ",100,100", "100,,100", "100," (CheckListEntries).
+bool HasEmptyListEntry(const std::string &value);
+
 // The options database in use as (name with its dash, value) pairs, in PetscOptionsGetAll's order; a flag's value is
 // empty, a value of several words is joined by spaces. Empty when the database cannot be read (no PETSc error raised:
 // the error handler calls it).
@@ -27,6 +33,17 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse();
 // the other stages a shared scene file carries (-test_* for offline, -train_* for validate, ...). given: the words given
 // directly (the command line, the Python keywords): online, probe and dualbasis leave out every option of a scene file but
 // their own families, not those given directly.
+// For PETSc's messages on a value that does not parse ("Input string 100abc has no numeric value", "... has no integer
+// value", "... is out of the range of a 32-bit integer", "Unknown logical value: maybe"), which name no option: the
+// options in use whose value holds that word, as " (option -train_size 4294967301)"; "" for any other message. For
+// error handlers (the executable's, the Python module's).
+std::string OptionsHoldingValue(const char *mess);
+
+// No option in use has a list value with an empty entry (-body_E ,100,100: PETSc's "String of length zero has no
+// numerical value", naming no option; -body_E 100,,100 read as 100,100 without a word; a trailing comma dropped):
+// refused, naming the option. Collective on comm.
+PetscErrorCode CheckListEntries(MPI_Comm comm);
+
 // The options files the last CheckOptionsFiles visited (the whole -options_file chain, as named): inputs of the run,
 // which no output may replace (CheckDistinctFiles; `fom -report in.opts -options_file in.opts` overwrote it, exit 0).
 const std::vector<std::string> &OptionsFilesRead();

@@ -94,6 +94,10 @@ bool FailureReported();
 // is then not written there either.
 bool ReportPathRefused();
 
+// Clears both marks (ReportPathRefused, FailureReported) for the next run of a process that runs several stages (the
+// Python module: a report refused or written by one call kept every later failure from replacing its -report).
+void ResetReportMarks();
+
 PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputs);
 
 // The report of one stage run: filled by the stage, written by Write() if -report was given, with the

@@ -16,9 +16,15 @@ command-line words) and their JSON report returned as a dict::
     val["test"]["max_rel_err_u"]
     rbcontact.probe(rom="rom.h5")["probe"]["failed"]   # the ROM at 1000 parameters of its box, no FOM
 
-PETSc options (``-rom_*``, docs/online.md) go through ``rbcontact.initialize([...])`` before the first model.
-Errors (a missing or mismatched file, a parameter outside its box, a solve that does not converge) raise
-RuntimeError with the message of the command-line stages. docs/python.md.
+PETSc options (``-rom_*``, docs/online.md) go through ``rbcontact.initialize([...])`` before the first model
+(the first model warns about those nobody read). Errors (a missing or mismatched file, a parameter outside its box,
+a solve that does not converge, a bad option value: an integer beyond 32 bits, an empty list entry, a NUL character)
+raise RuntimeError with the message of the command-line stages, naming the option.
+
+Threads and Ctrl-C: every call releases the GIL while it runs, so other Python threads go on meanwhile; but PETSc's
+options database and error state are global, so calls from several threads run one after the other (a mutex), never
+at the same time, and other threads must not use PETSc or MPI themselves (petsc4py, mpi4py) during a call. Ctrl-C
+is seen when the running call ends (a stage of minutes runs to its end, then KeyboardInterrupt). docs/python.md.
 """
 import json as _json
 

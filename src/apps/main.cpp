@@ -9,7 +9,6 @@
 #include <dlfcn.h>
 #include <exception>
 #include <new>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <sys/stat.h>
@@ -42,29 +41,8 @@ static PetscErrorCode WarnUnusedOptions(const std::string &stage, const std::vec
 }
 
 // Error handler: the message and a short trace, without PETSc's configure banner; the first line
-// names the option, file or value at fault (every check in rbcontact says which).
-// PETSc's messages for a value that does not parse ("Input string 100abc has no numeric value",
-// "... has no integer value", "Unknown logical value: maybe") do not say which option: find the
-// options (command line or -options_file) whose value holds that word and name them.
-static std::string OptionsHoldingValue(const char *mess)
-{
-  std::string m = mess ? mess : "", word;
-  const std::string a = "Input string ", b = "Unknown logical value: ";
-  if (m.compare(0, a.size(), a) == 0) word = m.substr(a.size(), m.find(' ', a.size()) - a.size());
-  else if (m.compare(0, b.size(), b) == 0) word = m.substr(b.size());
-  if (word.empty()) return "";
-  std::string found;
-  for (const auto &o : rbc::OptionsInUse()) {
-    std::istringstream vals(o.second);
-    for (std::string v; std::getline(vals, v, ',');)
-      if (v == word) {
-        found += (found.empty() ? "" : ", ") + o.first + " " + o.second;
-        break;
-      }
-  }
-  return found.empty() ? "" : " (option " + found + ")";
-}
-
+// names the option, file or value at fault (every check in rbcontact says which; PETSc's messages for a value that does
+// not parse name the options holding it, rbc::OptionsHoldingValue).
 // The first error of the run, for the failure report (FailureReport).
 static std::string firstError;
 
@@ -73,8 +51,8 @@ static PetscErrorCode ConciseErrorHandler(MPI_Comm comm, int line, const char *f
   PetscMPIInt rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   if (p == PETSC_ERROR_INITIAL) {
-    std::fprintf(stderr, "[%d] rbcontact error: %s%s\n", (int)rank, mess ? mess : "(no message)", OptionsHoldingValue(mess).c_str());
-    if (firstError.empty()) firstError = std::string(mess ? mess : "(no message)") + OptionsHoldingValue(mess) + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
+    std::fprintf(stderr, "[%d] rbcontact error: %s%s\n", (int)rank, mess ? mess : "(no message)", rbc::OptionsHoldingValue(mess).c_str());
+    if (firstError.empty()) firstError = std::string(mess ? mess : "(no message)") + rbc::OptionsHoldingValue(mess) + " (in " + (fun ? fun : "?") + "() at " + (file ? file : "?") + ":" + std::to_string(line) + ")";
   }
   std::fprintf(stderr, "[%d]     in %s() at %s:%d\n", (int)rank, fun ? fun : "?", file ? file : "?", line);
   return n;
@@ -168,21 +146,6 @@ static PetscErrorCode TestFailRank(bool *doThrow)
   PetscFunctionReturn(0);
 }
 
-// A list value with an empty entry (-body_E ,100,100: PETSc's "String of length zero has no numerical value", naming no
-// option; -body_E 100,,100 read as 100,100 without a word; a trailing comma dropped): refused, naming the option.
-static PetscErrorCode EmptyListEntries()
-{
-  std::string bad;
-
-  PetscFunctionBeginUser;
-  for (const auto &o : rbc::OptionsInUse()) {
-    const std::string &v = o.second;
-    if (bad.empty() && !v.empty() && (v.front() == ',' || v.back() == ',' || v.find(",,") != std::string::npos)) bad = o.first + " " + v;
-  }
-  PetscCheck(bad.empty(), PETSC_COMM_WORLD, PETSC_ERR_USER_INPUT, "option %s: an empty entry in the list (a comma too many?)", bad.c_str());
-  PetscFunctionReturn(0);
-}
-
 int main(int argc, char **argv)
 {
   if (argc < 2 || argv[1][0] == '-') {
@@ -216,7 +179,7 @@ int main(int argc, char **argv)
     if (!full) PetscCall(PetscPushErrorHandler(ConciseErrorHandler, NULL));
   }
   PetscErrorCode ierr = ExitCommCreate();
-  if (!ierr) ierr = EmptyListEntries();
+  if (!ierr) ierr = rbc::CheckListEntries(PETSC_COMM_WORLD);
   bool doThrow = false;
   if (!ierr) ierr = TestFailRank(&doThrow);
   try {

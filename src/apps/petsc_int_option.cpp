@@ -3,8 +3,10 @@
 // converts with strtol and casts to the 32-bit PetscInt without a word, so -rom_N 4294967297 ran with N 1 and
 // -train_size 4294967299 trained 3 points (docs/bad_input.md). Defined in the executable, this definition
 // takes the place of the library's (ELF symbol interposition; the library calls it through its PLT):
-// the same special words and messages, plus "out of the range of a 32-bit integer". The Python module, loaded
-// after PETSc, keeps PETSc's own. tests: bad_input_stages.cmake `int_value_wraps`.
+// the same special words and messages, plus "out of the range of a 32-bit integer". Linked into the Python module
+// too (CMakeLists.txt), where it does the same when the module loads PETSc (it comes first in the lookup scope of the
+// libraries it loads), not when PETSc was loaded before it (petsc4py imported first: python/module.cpp warns).
+// tests: bad_input_stages.cmake `int_value_wraps`, python_checks.py.
 #include <petscsys.h>
 #include <cerrno>
 #include <climits>

@@ -54,6 +54,10 @@ static bool OtherStagesOption(const std::string &stage, const std::string &name,
   return !own && std::find(given.begin(), given.end(), "-" + name) == given.end();
 }
 
+bool IsOptionName(const std::string &word) { return word.size() > 1 && word[0] == '-' && !std::isdigit((unsigned char)word[1]) && word[1] != '.'; }
+
+bool HasEmptyListEntry(const std::string &value) { return !value.empty() && (value.front() == ',' || value.back() == ',' || value.find(",,") != std::string::npos); }
+
 std::vector<std::pair<std::string, std::string>> OptionsInUse()
 {
   std::vector<std::pair<std::string, std::string>> out;
@@ -61,8 +65,7 @@ std::vector<std::pair<std::string, std::string>> OptionsInUse()
   if (PetscOptionsGetAll(NULL, &all) || !all) return out;
   std::istringstream in(all);
   for (std::string tok; in >> tok;) {
-    const bool isName = tok.size() > 1 && tok[0] == '-' && !std::isdigit((unsigned char)tok[1]) && tok[1] != '.'; // not -1, -.5
-    if (isName) out.emplace_back(tok, "");
+    if (IsOptionName(tok)) out.emplace_back(tok, "");
     else if (!out.empty()) out.back().second += (out.back().second.empty() ? "" : " ") + tok;
   }
   (void)PetscFree(all);
@@ -84,6 +87,36 @@ PetscErrorCode RequireInput(MPI_Comm comm, bool given, const char *option, const
     throw HelpStop(std::string("-help: stopped before ") + option);
   }
   SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", message);
+}
+
+std::string OptionsHoldingValue(const char *mess)
+{
+  std::string       m = mess ? mess : "", word;
+  const std::string a = "Input string ", b = "Unknown logical value: ";
+  if (m.compare(0, a.size(), a) == 0) word = m.substr(a.size(), m.find(' ', a.size()) - a.size());
+  else if (m.compare(0, b.size(), b) == 0) word = m.substr(b.size());
+  if (word.empty()) return "";
+  std::string found;
+  for (const auto &o : OptionsInUse()) {
+    std::istringstream vals(o.second);
+    for (std::string v; std::getline(vals, v, ',');)
+      if (v == word) {
+        found += (found.empty() ? "" : ", ") + o.first + " " + o.second;
+        break;
+      }
+  }
+  return found.empty() ? "" : " (option " + found + ")";
+}
+
+PetscErrorCode CheckListEntries(MPI_Comm comm)
+{
+  std::string bad;
+
+  PetscFunctionBeginUser;
+  for (const auto &o : OptionsInUse())
+    if (bad.empty() && HasEmptyListEntry(o.second)) bad = o.first + " " + o.second;
+  PetscCheck(bad.empty(), comm, PETSC_ERR_USER_INPUT, "option %s: an empty entry in the list (a comma too many?)", bad.c_str());
+  PetscFunctionReturn(0);
 }
 
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names)

@@ -21,6 +21,11 @@ bool        ReportPathRefused() { return reportRefused; }
 static bool failureReported = false; // MarkFailureReported
 void        MarkFailureReported() { failureReported = true; }
 bool        FailureReported() { return failureReported; }
+void        ResetReportMarks()
+{
+  reportRefused   = false;
+  failureReported = false;
+}
 
 JsonValue JsonValue::Number(double v) { JsonValue j; j.kind_ = Kind::Number; j.num_ = v; return j; }
 JsonValue JsonValue::Integer(long long v) { JsonValue j; j.kind_ = Kind::Integer; j.int_ = v; return j; }
