@@ -704,9 +704,46 @@ def solver_input(args):
         check(abs(r2["contact_force"] - r0["contact_force"]) <= 1e-10 * r0["contact_force"], "-mesh_partitioner gather on 2 ranks: force %.14f = the default's %.14f" % (r2["contact_force"], r0["contact_force"]))
 
 
+def solver_options(args):
+    """The contact QP solvers' options out of range or without a value (-fom_dual_pdas_*, -fom_dual_shell_tao_support,
+    -fom_saddle_*, their KSPs' tolerances, -fom_dual_dense_max*): refused naming the option and its value before any
+    solve (until 2026-12-02 a NaN -fom_dual_pdas_tol, a negative -fom_dual_pdas_rtol_loose or -fom_saddle_reuse_max_changes
+    -5 ran without a word, exit 0); each path's solver reads them whatever -fom_dual_matrix picks."""
+    out = workdir("rbc_contact_")
+    ring = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts", "-report", os.path.join(out, "r.json")]
+    cases = [(["-fom_dual_pdas_tol", "nan"], r"-fom_dual_pdas_tol nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_pdas_tol", "-1e-3"], r"-fom_dual_pdas_tol -0\.001 must be in \[0, 1\)"),
+             (["-fom_dual_pdas_rtol_loose", "-1"], r"-fom_dual_pdas_rtol_loose -1\.? must be in \(0, 1\)"),
+             (["-fom_dual_pdas_rtol_loose", "inf"], r"-fom_dual_pdas_rtol_loose inf\.? must be in \(0, 1\)"),
+             (["-fom_dual_pdas_max_it", "0"], r"-fom_dual_pdas_max_it 0 must be >= 1"),
+             (["-fom_dual_shell_tao_support", "nan"], r"-fom_dual_shell_tao_support nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_reuse_max_changes", "-5"], r"-fom_saddle_reuse_max_changes -5 must be >= -1"),
+             (["-fom_saddle_pdas_tol", "nan"], r"-fom_saddle_pdas_tol nan\.? must be in \[0, 1\)"),
+             (["-fom_saddle_pdas_rtol_loose", "nan"], r"-fom_saddle_pdas_rtol_loose nan\.? must be in \(0, 1\)"),
+             (["-fom_saddle_rtol_forcing", "nan"], r"-fom_saddle_rtol_forcing nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_rtol", "nan"], r"-fom_saddle_ksp_rtol nan\.? must be a number in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_atol", "nan"], r"-fom_saddle_ksp_atol nan\.? must be a finite number >= 0"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_max_it", "-3"], r"-fom_saddle_ksp_max_it -3 must be >= 1"),
+             (["-fom_dual_matrix", "shell", "-fom_dual_ksp_rtol", "nan"], r"-fom_dual_ksp_rtol nan\.? must be a number in \[0, 1\)"),
+             (["-fom_dual_dense_max", "-1"], r"-fom_dual_dense_max -1 and -fom_dual_dense_max_dofs 8000 must be >= 0"),
+             (["-fom_saddle_pdas_tol"], r"option -fom_saddle_pdas_tol is given without a value"),
+             (["-fom_dual_pdas_max_it"], r"option -fom_dual_pdas_max_it is given without a value"),
+             (["-fom_saddle_ksp_rtol"], r"option -fom_saddle_ksp_rtol is given without a value")]
+    for extra, pattern in cases:
+        p = subprocess.run(ring + extra, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        ok = p.returncode != 0 and re.search(pattern, p.stdout) is not None and re.search(r"SEGV|Segmentation|Caught signal", p.stdout) is None
+        check(ok, "%s: refused, /%s/ (exit %d)" % (" ".join(extra), pattern, p.returncode))
+        if not ok:
+            print(p.stdout[-1500:])
+    # the limits themselves are accepted: a factorization on every step (-1), a zero threshold for adding multipliers
+    for extra in (["-fom_dual_matrix", "saddle", "-fom_saddle_reuse_max_changes", "-1"], ["-fom_dual_matrix", "shell", "-fom_dual_pdas_tol", "0"]):
+        r, _ = run(args, args.np, "runs/ring_on_block.opts", extra, "limit")
+        check(r["converged"], "%s: accepted, converged" % " ".join(extra))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input", "solver_options", "diagnoses"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

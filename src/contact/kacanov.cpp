@@ -91,6 +91,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, saddle above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscCall(PetscOptionsInt("-dual_dense_max_dofs", "auto: dense S only while the compliance G (contact dofs squared) has at most this many rows (memory)", NULL, dualDenseMaxDofs, &dualDenseMaxDofs, NULL));
   PetscOptionsEnd();
+  PetscCheck(dualDenseMax >= 0 && dualDenseMaxDofs >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_dual_dense_max %" PetscInt_FMT " and -fom_dual_dense_max_dofs %" PetscInt_FMT " must be >= 0 (0: auto always takes the saddle point)", dualDenseMax, dualDenseMaxDofs);
   PetscCheck(kktTol > 0 && std::isfinite(kktTol), comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be a finite number > 0", (double)kktTol);
   { // checked here for every QP path (the dense one alone read it: bogus passed with -fom_dual_matrix shell or saddle)
     char m[32] = "auto";

@@ -2,6 +2,7 @@
 // point, by a primal-dual active-set method (see rbcontact/saddle_active_set.hpp, docs/contact.md).
 // Owns the saddle-point matrix (its layout: each rank's u rows, then its lambda rows), its KSP and the set.
 #include "rbcontact/saddle_active_set.hpp"
+#include "rbcontact/options_files.hpp"
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +35,9 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     PetscCall(PetscLogEventRegister("RBCSaddleSolve", MAT_CLASSID, &SAS_Solve));
   }
   prefix_ = prefix + "saddle_";
+  // given without a value, PETSc kept the default without a word; the Krylov tolerances are checked before PETSc reads them
+  PetscCall(CheckValuesGiven(comm, prefix_, {"pdas_max_it", "pdas_tol", "solver", "pdas_rtol_loose", "rtol_forcing", "reuse_max_changes"}));
+  PetscCall(CheckKSPTolerances(comm, prefix_));
   PetscOptionsBegin(comm, prefix_.c_str(), "Contact QP on the saddle point (primal-dual active set, -fom_dual_matrix saddle)", "SaddleActiveSetSolver");
   PetscCall(PetscOptionsInt("-pdas_max_it", "Most active-set steps of one Kacanov iterate (cold start or -pdas_inner)", "docs/contact.md", maxIt, &maxIt, NULL));
   PetscCall(PetscOptionsReal("-pdas_tol", "A row joins the set when its penetration exceeds this times the constraint scale", "docs/contact.md", setTol, &setTol, NULL));
@@ -71,6 +75,7 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
   PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
   PetscCheck(looseRtol > 0 && looseRtol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_rtol_loose %g must be in (0, 1)", prefix_.c_str(), (double)looseRtol);
+  PetscCheck(reuseMaxChanges >= -1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sreuse_max_changes %" PetscInt_FMT " must be >= -1 (-1: a factorization on every step)", prefix_.c_str(), reuseMaxChanges);
   PetscCheck(forcing >= 0 && forcing < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%srtol_forcing %g must be in [0, 1) (0: every Kacanov iterate solved exactly)", prefix_.c_str(), (double)forcing);
   PetscFunctionReturn(0);
 }
