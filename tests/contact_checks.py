@@ -741,6 +741,45 @@ def solver_options(args):
         check(r["converged"], "%s: accepted, converged" % " ".join(extra))
 
 
+def diagnoses(args):
+    """Failures reported with their cause, not as the Kacanov loop's (audits of 2026-12-01): a contact QP that was not
+    solved (TAO stopped early, without the polish: 'did not converge ... try -kacanov_relaxation 0.5' before); a
+    -contact_master_search_margin below the reach of any slave point (1e-7: contact lost, the iterates cycled, the same
+    hint); the saddle path's inner solver too loose for the active-set test; a master facing away from the slave."""
+    out = workdir("rbc_contact_")
+    base = ["mpirun", "-n", str(args.np), args.exe, "fom"]
+    ring = base + ["-options_file", "runs/ring_on_block.opts"]
+
+    def fails(cmd, words, absent, what):
+        rep = os.path.join(out, "fail.json")
+        p = subprocess.run(cmd + ["-report", rep], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        err = json.load(open(rep)).get("error", "") if os.path.exists(rep) else ""
+        ok = p.returncode != 0 and all(w in p.stdout and w in err for w in words) and not any(a in p.stdout for a in absent)
+        check(ok, "%s: refused, the message (and the report's error) naming %s%s" % (what, "; ".join(words), ", not " + "; ".join(absent) if absent else ""))
+        if not ok:
+            print(p.stdout[-2500:])
+        os.path.exists(rep) and os.remove(rep)
+        return p
+
+    # a QP that was not solved (dense path): its cause and the options, not the relaxation hint
+    fails(ring + ["-fom_qp_tao_type", "bqpip", "-fom_qp_polish", "0", "-fom_qp_tao_max_it", "1"],
+          ["Kacanov iterations did not converge", "the contact QP (-fom_dual_matrix dense) was not solved at", "the first at iterate 1: TAO bqpip stopped with DIVERGED_MAXITS after 1 iterations",
+           "drop -fom_qp_polish 0"], ["-kacanov_relaxation"], "TAO bqpip stopped after 1 iteration, no polish")
+    fails(ring + ["-fom_qp_tao_type", "blmvm", "-fom_qp_polish", "0", "-fom_qp_tao_max_it", "2"],
+          ["Contact solve rejected", "the contact QP (-fom_dual_matrix dense) was not solved at", "TAO blmvm stopped with DIVERGED_MAXITS after 2 iterations"], [],
+          "TAO blmvm stopped after 2 iterations, no polish (converged to a wrong answer, rejected by the KKT check)")
+    # a margin below any point's reach: every assembly with the whole master (the answer of all), and a warning naming it
+    ra, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "all"], "margin_all")
+    for m, below in (("1e-7", True), ("0.05", True), ("0.3", False)):
+        rn, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "near", "-contact_master_search_margin", m], "margin_" + m)
+        cs = rn["contact_search"]
+        d = abs(rn["contact_force"] - ra["contact_force"]) / ra["contact_force"]
+        warned = [w for w in rn.get("warnings", []) if "-contact_master_search_margin" in w and "is below the reach of any slave point" in w]
+        check(rn["converged"] and d <= 1e-12 and (cs["below_reach"] == cs["assemblies"]) == below and bool(warned) == below,
+              "-contact_master_search_margin %s: converged, force as all's to %.1e <= 1e-12, %d of %d assemblies below reach, warned %s (want %s)"
+              % (m, d, cs["below_reach"], cs["assemblies"], bool(warned), below))
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input", "solver_options", "diagnoses"])

@@ -172,6 +172,8 @@ public:
   // from near to all (report key contact_search).
   struct MasterSearchStats {
     PetscInt held = 0, total = 0, fallbacks = 0, assemblies = 0, farPoints = 0; // farPoints: out of reach, last assembly
+    PetscInt  belowReach = 0; // fallbacks because the margin is below the least reach of a slave point (reach)
+    PetscReal reach      = 0; // 2 slave + 3 master facet diameters, the smallest (last assembly)
   };
   const MasterSearchStats &MasterSearch() const { return searchStats_; }
 
@@ -179,7 +181,7 @@ private:
   // masterAll_ := the master facets near this rank's slave facets (-contact_master_search near): those whose
   // deformed bounding box meets the slave facets' box grown by *margin (the option's, or the automatic one).
   // Collective; the relative order of the facets is that of Gather.
-  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin);
+  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *reach);
   MasterSearchStats searchStats_;
   size_t            kReserve_[2] = {0, 0}; // the last assembly's buffered K pieces and entries (the next one reserves as many)
   PetscErrorCode NumberMultipliers(const Elasticity &elas);

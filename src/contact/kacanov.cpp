@@ -332,6 +332,8 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscFunctionBeginUser;
   history = KacanovHistory();
   converged = PETSC_FALSE;
+  qpUnsolved_ = qpUnsolvedFirst_ = 0;
+  qpUnsolvedWorst_ = 0;
   // Elastic solution u0 = A^{-1} f (solve time)
   PetscCall(PetscTime(&t0));
   std::vector<PetscInt> D;
@@ -515,6 +517,13 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
     PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
     PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP, lamWarm.empty() ? nullptr : &lamWarm));
+    if (!(lastQP.kkt <= kktTol)) { // not solved: named if the loop fails (QPNotSolved), where it was blamed on the fixed point
+      if (!qpUnsolved_++) {
+        qpUnsolvedFirst_ = k;
+        qpUnsolvedInfo_  = lastQP;
+      }
+      qpUnsolvedWorst_ = std::max(qpUnsolvedWorst_, lastQP.kkt);
+    }
     lamWarm = lam;
     PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
     {
@@ -662,11 +671,12 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   if (!converged) {
     std::ostringstream o; // (a gross initial overlap failed with the relaxation hint alone)
     if (initialPenetrating > 0) o << "; the bodies overlapped before any load: " << initialPenetrating << " slave points inside the master, by up to " << initialPenetration << " (the mesh or -mesh_geo_set / the maps put them through each other?)";
-    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, o.str()).c_str());
+    const std::string qp = QPNotSolved(); // (a QP that was not solved failed with the relaxation hint alone)
+    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, qp + o.str(), qp.empty()).c_str());
   }
 
   PetscCall(ComputeKKT(fom));
-  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol);
+  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e%s", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol, QPNotSolved().c_str());
   PetscFunctionReturn(0);
 }
 
@@ -740,6 +750,23 @@ static std::string Point(PetscReal x, PetscReal y, PetscReal z, PetscInt dim)
   return o.str();
 }
 
+std::string KacanovSolver::QPNotSolved() const
+{
+  if (!qpUnsolved_) return "";
+  std::ostringstream o;
+  const DualQPInfo  &q = qpUnsolvedInfo_;
+  o << "; the cause: the contact QP (-fom_dual_matrix dense) was not solved at " << qpUnsolved_ << " of the " << iterations << " Kacanov iterates (scaled KKT residual up to " << qpUnsolvedWorst_ << " > -fom_kkt_tol " << kktTol << "; the first at iterate " << qpUnsolvedFirst_ << ": ";
+  if (qp_.UsesTao()) {
+    o << "TAO " << qp_.TaoType() << " stopped with " << TaoConvergedReasons[q.taoReason] << " after " << q.taoIterations << " iterations";
+    if (qp_.Polish()) o << ", then the active-set polish after " << q.polishIterations << " steps";
+    else o << ", kept as it is by -fom_qp_polish 0";
+  } else o << "the active-set method stopped after " << q.polishIterations << " steps";
+  o << "): the Kacanov iterates carry the QP's error; ";
+  if (qp_.UsesTao() && !qp_.Polish()) o << "drop -fom_qp_polish 0 (the active-set polish makes TAO's answer exact), let TAO converge (-fom_qp_tao_max_it, -fom_qp_tao_gatol) or use the default -fom_qp_tao_type activeset";
+  else o << "the dual matrix is too ill-conditioned for the dense QP: use -fom_dual_matrix saddle";
+  return o.str();
+}
+
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
   std::vector<PetscReal> lam, x[3], n[3];
@@ -751,6 +778,12 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
     std::ostringstream o;
     o << "initial overlap: " << kac.initialPenetrating << " slave node(s) lie inside the master body before any deformation (deepest " << kac.initialPenetration << " at " << Point(kac.initialPenetrationAt[0], kac.initialPenetrationAt[1], kac.initialPenetrationAt[2], dim)
       << "); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
+    warnings->push_back(o.str());
+  }
+  if (const auto &ms = map.MasterSearch(); ms.belowReach > 0) {
+    std::ostringstream o;
+    o << "-contact_master_search_margin " << map.masterSearchMargin << " is below the reach of any slave point (its distance plus 2 slave and 3 master facet diameters: at least " << ms.reach
+      << " here): " << ms.belowReach << " of the " << ms.assemblies << " contact assemblies used every master facet (-contact_master_search all), as no point could be found with the facets near it; give a margin of at least " << ms.reach << ", or leave the default";
     warnings->push_back(o.str());
   }
   // gathered once for the three checks below: multipliers, their largest value, slave vertex coordinates
