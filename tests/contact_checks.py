@@ -768,6 +768,16 @@ def diagnoses(args):
     fails(ring + ["-fom_qp_tao_type", "blmvm", "-fom_qp_polish", "0", "-fom_qp_tao_max_it", "2"],
           ["Contact solve rejected", "the contact QP (-fom_dual_matrix dense) was not solved at", "TAO blmvm stopped with DIVERGED_MAXITS after 2 iterations"], [],
           "TAO blmvm stopped after 2 iterations, no polish (converged to a wrong answer, rejected by the KKT check)")
+    # the saddle point's inner solves too loose: their tolerance named, not -fom_saddle_pdas_tol (a cycling set) nor the
+    # relaxation; both with the iterative preset (ring: the set cycles; hertz: the KKT check rejects the answer)
+    loose = ["the cause: the saddle-point solves stop at -fom_saddle_ksp_rtol 0.001", "tighten -fom_saddle_ksp_rtol to 1e-10 or below", "-fom_saddle_solver direct"]
+    fails(ring + ["-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact active set cycles"] + loose,
+          ["raise -fom_saddle_pdas_tol", "-kacanov_relaxation"], "saddle, gamg, -fom_saddle_ksp_rtol 1e-3 (the set cycles)")
+    fails(base + ["-options_file", "runs/hertz.opts", "-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact solve rejected"] + loose,
+          ["raise -fom_saddle_pdas_tol"], "saddle, gamg, -fom_saddle_ksp_rtol 1e-3 on hertz (the KKT check rejects the answer)")
+    # the direct solver with a loose GMRES on its earlier factors: a factorization on every step is the advice
+    fails(ring + ["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact solve rejected", "-fom_saddle_ksp_rtol 0.001", "-fom_saddle_reuse_max_changes -1"],
+          ["-fom_saddle_solver direct"], "saddle, direct, -fom_saddle_ksp_rtol 1e-3")
     # a margin below any point's reach: every assembly with the whole master (the answer of all), and a warning naming it
     ra, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "all"], "margin_all")
     for m, below in (("1e-7", True), ("0.05", True), ("0.3", False)):

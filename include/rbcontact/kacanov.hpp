@@ -122,9 +122,10 @@ public:
 
 private:
   PetscErrorCode ComputeKKT(ElasticFOM &fom);
-  // "; the contact QP was not solved ... : <advice>" when some iterate's dense QP ended above -fom_kkt_tol (its scaled
-  // KKT residual), else "": the cause of a non-convergence or a rejected solve, in place of the relaxation hint
-  std::string     QPNotSolved() const;
+  // "; the cause: the contact QP ... was not solved ...: <advice>" when some iterate's dense QP ended above -fom_kkt_tol
+  // (its scaled KKT residual), or the saddle point's solves were too loose (SaddleActiveSetSolver::LooseSolves), else "":
+  // the cause of a non-convergence or a rejected solve, in place of the relaxation hint
+  std::string     QPCause() const;
   PetscInt        qpUnsolved_ = 0, qpUnsolvedFirst_ = 0; // iterates whose QP was not solved, the first of them
   DualQPInfo      qpUnsolvedInfo_;                        // that first one's
   PetscReal       qpUnsolvedWorst_ = 0;                   // the largest scaled KKT residual of those QPs

@@ -517,7 +517,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
     PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
     PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP, lamWarm.empty() ? nullptr : &lamWarm));
-    if (!(lastQP.kkt <= kktTol)) { // not solved: named if the loop fails (QPNotSolved), where it was blamed on the fixed point
+    if (!(lastQP.kkt <= kktTol)) { // not solved: named if the loop fails (QPCause), where it was blamed on the fixed point
       if (!qpUnsolved_++) {
         qpUnsolvedFirst_ = k;
         qpUnsolvedInfo_  = lastQP;
@@ -671,12 +671,12 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   if (!converged) {
     std::ostringstream o; // (a gross initial overlap failed with the relaxation hint alone)
     if (initialPenetrating > 0) o << "; the bodies overlapped before any load: " << initialPenetrating << " slave points inside the master, by up to " << initialPenetration << " (the mesh or -mesh_geo_set / the maps put them through each other?)";
-    const std::string qp = QPNotSolved(); // (a QP that was not solved failed with the relaxation hint alone)
+    const std::string qp = QPCause(); // (a QP that was not solved failed with the relaxation hint alone)
     SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, qp + o.str(), qp.empty()).c_str());
   }
 
   PetscCall(ComputeKKT(fom));
-  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e%s", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol, QPNotSolved().c_str());
+  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e%s", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol, QPCause().c_str());
   PetscFunctionReturn(0);
 }
 
@@ -750,8 +750,12 @@ static std::string Point(PetscReal x, PetscReal y, PetscReal z, PetscInt dim)
   return o.str();
 }
 
-std::string KacanovSolver::QPNotSolved() const
+std::string KacanovSolver::QPCause() const
 {
+  if (dualMatrix == "saddle") {
+    const std::string why = saddle_.LooseSolves();
+    return why.empty() ? "" : "; the cause: " + why;
+  }
   if (!qpUnsolved_) return "";
   std::ostringstream o;
   const DualQPInfo  &q = qpUnsolvedInfo_;
