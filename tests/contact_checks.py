@@ -778,6 +778,18 @@ def diagnoses(args):
     # the direct solver with a loose GMRES on its earlier factors: a factorization on every step is the advice
     fails(ring + ["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact solve rejected", "-fom_saddle_ksp_rtol 0.001", "-fom_saddle_reuse_max_changes -1"],
           ["-fom_saddle_solver direct"], "saddle, direct, -fom_saddle_ksp_rtol 1e-3")
+    # a master facing away from the slave (the far side of the master body): refused naming -contact_master before any
+    # solve (was "initial overlap ... an interference fit" by 3.1 and an energy 8e4 times the right one, exit 0)
+    away = ["the master surface 'block_bottom' (-contact_master) faces away from the slave surface 'slave'", "name with -contact_master the surface of the master body that faces the slave"]
+    fails(base + ["-options_file", "runs/sphere_block3d.opts", "-contact_master", "block_bottom"], away, ["the solver pushes the bodies apart"], "sphere_block3d, -contact_master block_bottom (3D)")
+    fails(ring + ["-contact_master", "block_bottom"], away, ["the solver pushes the bodies apart"], "ring_on_block, -contact_master block_bottom (2D)")
+    # genuine interference fits still solved, with the overlap warning: a pin 0.2 % larger than its hole, a sphere dilated
+    # into the block (3D); ring_on_block's is in `warnings`
+    for opts, extra, tag in (("runs/hard_cases/pin_in_hole.opts", ["-mesh_geo_set", "c=-0.002"], "pin 0.2 % larger than its hole"),
+                             ("runs/sphere_block3d.opts", ["-mu", "1.1,0.04", "-map_sphere_dilation_center", "0,0,0.05"], "sphere dilated 0.005 into the block")):
+        r, _ = run(args, args.np, opts, extra, "interference")
+        w = [x for x in r.get("warnings", []) if "initial overlap" in x and "interference fit" in x]
+        check(r["converged"] and len(w) == 1 and r["initial_overlap"]["nodes"] > 0, "%s: solved, one initial-overlap warning (%d nodes, %.3g deep)" % (tag, r["initial_overlap"]["nodes"], r["initial_overlap"]["max_penetration"]))
     # a margin below any point's reach: every assembly with the whole master (the answer of all), and a warning naming it
     ra, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "all"], "margin_all")
     for m, below in (("1e-7", True), ("0.05", True), ("0.3", False)):

@@ -129,7 +129,8 @@ private:
   PetscInt        qpUnsolved_ = 0, qpUnsolvedFirst_ = 0; // iterates whose QP was not solved, the first of them
   DualQPInfo      qpUnsolvedInfo_;                        // that first one's
   PetscReal       qpUnsolvedWorst_ = 0;                   // the largest scaled KKT residual of those QPs
-  PetscErrorCode MeasureInitialOverlap(MPI_Comm comm);
+  // also refuses a master that faces away from the slave (most nodes behind it see its outward normal along their own)
+  PetscErrorCode MeasureInitialOverlap(MPI_Comm comm, const ContactMap &map);
   Vec             uInit_ = nullptr, lamInit_ = nullptr; // SetInitialGuess's, until the next Solve
   DualQPSolver    qp_;
   DualShellSolver shell_;

@@ -140,6 +140,8 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscCheck(slave != master, comm, PETSC_ERR_USER_INPUT, "-contact_slave and -contact_master name the same group '%s': contact is between two surfaces of two bodies", slave.c_str());
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));
+  slaveName_  = slave;
+  masterName_ = master;
   {
     PetscInt nb = 0;
     for (const auto *S : {&slave_, &master_})
@@ -1010,6 +1012,27 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       PetscCall(VecAssemblyEnd(v));
     }
   for (PetscInt d = 0; d < dim; ++d) PetscCall(VecPointwiseDivide(sys->normal[d], sys->normal[d], sys->weight));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ContactMap::SlaveOutwardNormals(MPI_Comm comm, std::vector<PetscReal> n[3]) const
+{
+  const PetscInt         dim = slave_.dim;
+  std::vector<PetscReal> sum((size_t)3 * R_, 0.0);
+
+  PetscFunctionBeginUser;
+  for (const auto &F : slave_.facets) {
+    PetscReal nf[3] = {0, 0, 0};
+    FacetNormal(F.X.data(), dim, F.outward, nf);
+    for (PetscInt k = 0; k < F.nv; ++k)
+      if (F.row[k] >= 0)
+        for (PetscInt d = 0; d < dim; ++d) sum[(size_t)3 * F.row[k] + d] += nf[d];
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum.data(), (int)sum.size(), MPIU_REAL, MPIU_SUM, comm));
+  for (PetscInt d = 0; d < 3; ++d) {
+    n[d].assign(R_, 0.0);
+    for (PetscInt r = 0; r < R_; ++r) n[d][r] = sum[(size_t)3 * r + d];
+  }
   PetscFunctionReturn(0);
 }
 

@@ -266,9 +266,9 @@ static PetscErrorCode GatherAt(Vec v, const std::vector<PetscInt> &D, std::vecto
 }
 
 // At u = 0: the weighted gaps g_i / weight_i < 0 beyond rounding are an initial overlap (the deepest, where, how many).
-PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
+PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm, const ContactMap &map)
 {
-  std::vector<PetscReal> g, w, x[3];
+  std::vector<PetscReal> g, w, x[3], nm[3], ns[3];
 
   PetscFunctionBeginUser;
   initialPenetration = 0;
@@ -280,6 +280,21 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
   PetscReal scale = 0; // size of the slave surface: the rounding level of a gap
   for (PetscInt d = 0; d < dim; ++d)
     for (PetscReal c : x[d]) scale = std::max(scale, std::abs(c));
+  // a master that faces away from the slave (the far side of the master body, -contact_master block_bottom on
+  // sphere_block3d: "an interference fit by 3.1", solved to an energy 8e4 times the right one, exit 0): the slave nodes
+  // behind it see master facets whose outward normal points the way their own does, where an interference fit's face each
+  // other (the slave inside the master body)
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.normal[d], &nm[d]));
+  PetscCall(map.SlaveOutwardNormals(comm, ns));
+  PetscInt  away = 0;
+  PetscReal awayDepth = 0, lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {-PETSC_MAX_REAL, -PETSC_MAX_REAL, -PETSC_MAX_REAL}, span = 0;
+  for (PetscInt d = 0; d < dim; ++d)
+    for (PetscReal c : x[d]) {
+      lo[d] = std::min(lo[d], c);
+      hi[d] = std::max(hi[d], c);
+    }
+  for (PetscInt d = 0; d < dim; ++d) span += g.empty() ? 0 : (hi[d] - lo[d]) * (hi[d] - lo[d]);
+  span = std::sqrt(span); // the slave surface's bounding-box diagonal
   for (size_t i = 0; i < g.size(); ++i) {
     if (!(w[i] > 0)) continue;
     const PetscReal gap = g[i] / w[i];
@@ -289,9 +304,22 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
         initialPenetration = -gap;
         for (PetscInt d = 0; d < dim; ++d) initialPenetrationAt[d] = x[d][i];
       }
+      PetscReal dot = 0, a = 0, b = 0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        dot += nm[d][i] * ns[d][i];
+        a += nm[d][i] * nm[d][i];
+        b += ns[d][i] * ns[d][i];
+      }
+      if (a > 0 && b > 0 && dot > 0.5 * std::sqrt(a * b)) { // within 60 degrees of the same direction
+        ++away;
+        awayDepth = std::max(awayDepth, -gap);
+      }
     }
   }
-  (void)comm;
+  // most of the nodes behind the master (not a few where an interference fit's surfaces curve away)
+  PetscCheck(!(away > 0 && 2 * away >= initialPenetrating), comm, PETSC_ERR_USER_INPUT,
+             "the master surface '%s' (-contact_master) faces away from the slave surface '%s': before any deformation %" PetscInt_FMT " of the slave nodes (of %" PetscInt_FMT " behind it, up to %g deep, where the slave surface spans %g) lie behind master facets whose outward normal points the same way as the slave's own outward normal, so the slave is on the side of the master body that surface does not bound; this is not an interference fit (where the two surfaces face each other): name with -contact_master the surface of the master body that faces the slave",
+             map.MasterName().c_str(), map.SlaveName().c_str(), away, initialPenetrating, (double)awayDepth, (double)span);
   PetscFunctionReturn(0);
 }
 
@@ -402,7 +430,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
-    PetscCall(MeasureInitialOverlap(comm));
+    PetscCall(MeasureInitialOverlap(comm, map));
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
       PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
@@ -443,7 +471,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
-    if (k == 1 && !guessed) PetscCall(MeasureInitialOverlap(comm));
+    if (k == 1 && !guessed) PetscCall(MeasureInitialOverlap(comm, map));
     const PetscBool warm = lambda ? PETSC_TRUE : PETSC_FALSE;
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
