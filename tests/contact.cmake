@@ -22,7 +22,9 @@ foreach(np 1 2)
   add_test(NAME contact_flat_punch3d_np${np} COMMAND ${RBC_CC} flat_punch3d --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_search_np${np} COMMAND ${RBC_CC} search --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME contact_solver_input_np${np} COMMAND ${RBC_CC} solver_input --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  set_tests_properties(contact_solver_input_np${np} contact_search_np${np} contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_saddle_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np} contact_flat_punch3d_np${np}
+  add_test(NAME contact_solver_options_np${np} COMMAND ${RBC_CC} solver_options --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  add_test(NAME contact_diagnoses_np${np} COMMAND ${RBC_CC} diagnoses --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(contact_diagnoses_np${np} contact_solver_options_np${np} contact_solver_input_np${np} contact_search_np${np} contact_hertz_np${np} contact_flat_punch_np${np} contact_no_contact_np${np} contact_kkt_all_np${np} contact_dual_shell_np${np} contact_saddle_np${np} contact_smooth_np${np} contact_nan_input_np${np} contact_floating_np${np} contact_warnings_np${np} contact_paths_np${np} contact_compliance_np${np} contact_segments_np${np} contact_flat_punch3d_np${np}
     PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 600 PROCESSORS ${np} LABELS contact)
 endforeach()
 # runs both rank counts itself and compares them

@@ -704,9 +704,107 @@ def solver_input(args):
         check(abs(r2["contact_force"] - r0["contact_force"]) <= 1e-10 * r0["contact_force"], "-mesh_partitioner gather on 2 ranks: force %.14f = the default's %.14f" % (r2["contact_force"], r0["contact_force"]))
 
 
+def solver_options(args):
+    """The contact QP solvers' options out of range or without a value (-fom_dual_pdas_*, -fom_dual_shell_tao_support,
+    -fom_saddle_*, their KSPs' tolerances, -fom_dual_dense_max*): refused naming the option and its value before any
+    solve (until 2026-12-02 a NaN -fom_dual_pdas_tol, a negative -fom_dual_pdas_rtol_loose or -fom_saddle_reuse_max_changes
+    -5 ran without a word, exit 0); each path's solver reads them whatever -fom_dual_matrix picks."""
+    out = workdir("rbc_contact_")
+    ring = ["mpirun", "-n", str(args.np), args.exe, "fom", "-options_file", "runs/ring_on_block.opts", "-report", os.path.join(out, "r.json")]
+    cases = [(["-fom_dual_pdas_tol", "nan"], r"-fom_dual_pdas_tol nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_pdas_tol", "-1e-3"], r"-fom_dual_pdas_tol -0\.001 must be in \[0, 1\)"),
+             (["-fom_dual_pdas_rtol_loose", "-1"], r"-fom_dual_pdas_rtol_loose -1\.? must be in \(0, 1\)"),
+             (["-fom_dual_pdas_rtol_loose", "inf"], r"-fom_dual_pdas_rtol_loose inf\.? must be in \(0, 1\)"),
+             (["-fom_dual_pdas_max_it", "0"], r"-fom_dual_pdas_max_it 0 must be >= 1"),
+             (["-fom_dual_shell_tao_support", "nan"], r"-fom_dual_shell_tao_support nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_reuse_max_changes", "-5"], r"-fom_saddle_reuse_max_changes -5 must be >= -1"),
+             (["-fom_saddle_pdas_tol", "nan"], r"-fom_saddle_pdas_tol nan\.? must be in \[0, 1\)"),
+             (["-fom_saddle_pdas_rtol_loose", "nan"], r"-fom_saddle_pdas_rtol_loose nan\.? must be in \(0, 1\)"),
+             (["-fom_saddle_rtol_forcing", "nan"], r"-fom_saddle_rtol_forcing nan\.? must be in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_rtol", "nan"], r"-fom_saddle_ksp_rtol nan\.? must be a number in \[0, 1\)"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_atol", "nan"], r"-fom_saddle_ksp_atol nan\.? must be a finite number >= 0"),
+             (["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_max_it", "-3"], r"-fom_saddle_ksp_max_it -3 must be >= 1"),
+             (["-fom_dual_matrix", "shell", "-fom_dual_ksp_rtol", "nan"], r"-fom_dual_ksp_rtol nan\.? must be a number in \[0, 1\)"),
+             (["-fom_dual_dense_max", "-1"], r"-fom_dual_dense_max -1 and -fom_dual_dense_max_dofs 8000 must be >= 0"),
+             (["-fom_saddle_pdas_tol"], r"option -fom_saddle_pdas_tol is given without a value"),
+             (["-fom_dual_pdas_max_it"], r"option -fom_dual_pdas_max_it is given without a value"),
+             (["-fom_saddle_ksp_rtol"], r"option -fom_saddle_ksp_rtol is given without a value")]
+    for extra, pattern in cases:
+        p = subprocess.run(ring + extra, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        ok = p.returncode != 0 and re.search(pattern, p.stdout) is not None and re.search(r"SEGV|Segmentation|Caught signal", p.stdout) is None
+        check(ok, "%s: refused, /%s/ (exit %d)" % (" ".join(extra), pattern, p.returncode))
+        if not ok:
+            print(p.stdout[-1500:])
+    # the limits themselves are accepted: a factorization on every step (-1), a zero threshold for adding multipliers
+    for extra in (["-fom_dual_matrix", "saddle", "-fom_saddle_reuse_max_changes", "-1"], ["-fom_dual_matrix", "shell", "-fom_dual_pdas_tol", "0"]):
+        r, _ = run(args, args.np, "runs/ring_on_block.opts", extra, "limit")
+        check(r["converged"], "%s: accepted, converged" % " ".join(extra))
+
+
+def diagnoses(args):
+    """Failures reported with their cause, not as the Kacanov loop's (audits of 2026-12-01): a contact QP that was not
+    solved (TAO stopped early, without the polish: 'did not converge ... try -kacanov_relaxation 0.5' before); a
+    -contact_master_search_margin below the reach of any slave point (1e-7: contact lost, the iterates cycled, the same
+    hint); the saddle path's inner solver too loose for the active-set test; a master facing away from the slave."""
+    out = workdir("rbc_contact_")
+    base = ["mpirun", "-n", str(args.np), args.exe, "fom"]
+    ring = base + ["-options_file", "runs/ring_on_block.opts"]
+
+    def fails(cmd, words, absent, what):
+        rep = os.path.join(out, "fail.json")
+        p = subprocess.run(cmd + ["-report", rep], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        err = json.load(open(rep)).get("error", "") if os.path.exists(rep) else ""
+        ok = p.returncode != 0 and all(w in p.stdout and w in err for w in words) and not any(a in p.stdout for a in absent)
+        check(ok, "%s: refused, the message (and the report's error) naming %s%s" % (what, "; ".join(words), ", not " + "; ".join(absent) if absent else ""))
+        if not ok:
+            print(p.stdout[-2500:])
+        os.path.exists(rep) and os.remove(rep)
+        return p
+
+    # a QP that was not solved (dense path): its cause and the options, not the relaxation hint
+    fails(ring + ["-fom_qp_tao_type", "bqpip", "-fom_qp_polish", "0", "-fom_qp_tao_max_it", "1"],
+          ["Kacanov iterations did not converge", "the contact QP (-fom_dual_matrix dense) was not solved at", "the first at iterate 1: TAO bqpip stopped with DIVERGED_MAXITS after 1 iterations",
+           "drop -fom_qp_polish 0"], ["-kacanov_relaxation"], "TAO bqpip stopped after 1 iteration, no polish")
+    fails(ring + ["-fom_qp_tao_type", "blmvm", "-fom_qp_polish", "0", "-fom_qp_tao_max_it", "2"],
+          ["Contact solve rejected", "the contact QP (-fom_dual_matrix dense) was not solved at", "TAO blmvm stopped with DIVERGED_MAXITS after 2 iterations"], [],
+          "TAO blmvm stopped after 2 iterations, no polish (converged to a wrong answer, rejected by the KKT check)")
+    # the saddle point's inner solves too loose: their tolerance named, not -fom_saddle_pdas_tol (a cycling set) nor the
+    # relaxation; both with the iterative preset (ring: the set cycles; hertz: the KKT check rejects the answer)
+    loose = ["the cause: the saddle-point solves stop at -fom_saddle_ksp_rtol 0.001", "tighten -fom_saddle_ksp_rtol to 1e-10 or below", "-fom_saddle_solver direct"]
+    fails(ring + ["-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact active set cycles"] + loose,
+          ["raise -fom_saddle_pdas_tol", "-kacanov_relaxation"], "saddle, gamg, -fom_saddle_ksp_rtol 1e-3 (the set cycles)")
+    fails(base + ["-options_file", "runs/hertz.opts", "-fom_dual_matrix", "saddle", "-fom_saddle_solver", "gamg", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact solve rejected"] + loose,
+          ["raise -fom_saddle_pdas_tol"], "saddle, gamg, -fom_saddle_ksp_rtol 1e-3 on hertz (the KKT check rejects the answer)")
+    # the direct solver with a loose GMRES on its earlier factors: a factorization on every step is the advice
+    fails(ring + ["-fom_dual_matrix", "saddle", "-fom_saddle_ksp_rtol", "1e-3"], ["Contact solve rejected", "-fom_saddle_ksp_rtol 0.001", "-fom_saddle_reuse_max_changes -1"],
+          ["-fom_saddle_solver direct"], "saddle, direct, -fom_saddle_ksp_rtol 1e-3")
+    # a master facing away from the slave (the far side of the master body): refused naming -contact_master before any
+    # solve (was "initial overlap ... an interference fit" by 3.1 and an energy 8e4 times the right one, exit 0)
+    away = ["the master surface 'block_bottom' (-contact_master) faces away from the slave surface 'slave'", "name with -contact_master the surface of the master body that faces the slave"]
+    fails(base + ["-options_file", "runs/sphere_block3d.opts", "-contact_master", "block_bottom"], away, ["the solver pushes the bodies apart"], "sphere_block3d, -contact_master block_bottom (3D)")
+    fails(ring + ["-contact_master", "block_bottom"], away, ["the solver pushes the bodies apart"], "ring_on_block, -contact_master block_bottom (2D)")
+    # genuine interference fits still solved, with the overlap warning: a pin 0.2 % larger than its hole, a sphere dilated
+    # into the block (3D); ring_on_block's is in `warnings`
+    for opts, extra, tag in (("runs/hard_cases/pin_in_hole.opts", ["-mesh_geo_set", "c=-0.002"], "pin 0.2 % larger than its hole"),
+                             ("runs/sphere_block3d.opts", ["-mu", "1.1,0.04", "-map_sphere_dilation_center", "0,0,0.05"], "sphere dilated 0.005 into the block")):
+        r, _ = run(args, args.np, opts, extra, "interference")
+        w = [x for x in r.get("warnings", []) if "initial overlap" in x and "interference fit" in x]
+        check(r["converged"] and len(w) == 1 and r["initial_overlap"]["nodes"] > 0, "%s: solved, one initial-overlap warning (%d nodes, %.3g deep)" % (tag, r["initial_overlap"]["nodes"], r["initial_overlap"]["max_penetration"]))
+    # a margin below any point's reach: every assembly with the whole master (the answer of all), and a warning naming it
+    ra, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "all"], "margin_all")
+    for m, below in (("1e-7", True), ("0.05", True), ("0.3", False)):
+        rn, _ = run(args, args.np, "runs/ring_on_block.opts", ["-contact_master_search", "near", "-contact_master_search_margin", m], "margin_" + m)
+        cs = rn["contact_search"]
+        d = abs(rn["contact_force"] - ra["contact_force"]) / ra["contact_force"]
+        warned = [w for w in rn.get("warnings", []) if "-contact_master_search_margin" in w and "is below the reach of any slave point" in w]
+        check(rn["converged"] and d <= 1e-12 and (cs["below_reach"] == cs["assemblies"]) == below and bool(warned) == below,
+              "-contact_master_search_margin %s: converged, force as all's to %.1e <= 1e-12, %d of %d assemblies below reach, warned %s (want %s)"
+              % (m, d, cs["below_reach"], cs["assemblies"], bool(warned), below))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input"])
+    ap.add_argument("check", choices=["hertz", "hertz3d", "flat_punch", "flat_punch3d", "no_contact", "ring", "kkt_all", "dual_shell", "saddle", "smooth", "nan_input", "floating", "warnings", "paths", "compliance", "segments", "partition", "search", "solver_input", "solver_options", "diagnoses"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--np", type=int, default=1)
     ap.add_argument("--clscale", type=float, nargs="+", default=[2.0, 1.0, 0.5])

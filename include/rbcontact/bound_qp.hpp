@@ -44,9 +44,13 @@ public:
   // S: R x R column-major SPD; minimizes 1/2 l'Sl - b'l over l >= 0. warm (optional, size R): a start,
   // e.g. the previous Kacanov iterate's multipliers (its support is the initial active set).
   PetscErrorCode Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info, const std::vector<PetscReal> *warm = nullptr);
+  // The settings Setup read (for the advice of a QP that was not solved): TAO in use, its -<prefix>qp_tao_type, the polish
+  bool               UsesTao() const { return useTao_; }
+  const std::string &TaoType() const { return type_; }
+  bool               Polish() const { return polish_; }
 
 private:
-  std::string prefix_;
+  std::string prefix_, type_ = "activeset";
   PetscBool   polish_ = PETSC_TRUE;
   PetscBool   useTao_ = PETSC_FALSE;
 };

@@ -129,8 +129,8 @@ public:
   // slave facets' bounding box: a slave point whose closest master facet lies within the margin less a band of
   // facet diameters gets the answer of all; a point beyond is out of reach, its row an inactive constraint (its
   // distance to the master as gap, K from the closest facet held); a rank with slave facets and no master facet,
-  // or a margin leaving less than 4 slave facet diameters of exact reach, makes every rank fall back to all for
-  // that assembly), -contact_master_search_margin m (default: half the slave surface's bounding-box diagonal +
+  // or a margin leaving less than 4 slave facet diameters of exact reach, or below the least reach of any point
+  // (2 slave + 3 master facet diameters), makes every rank fall back to all for that assembly), -contact_master_search_margin m (default: half the slave surface's bounding-box diagonal +
   // 4 master + 2 slave facet diameters).
   PetscErrorCode Setup(const Elasticity &elas, const std::string &slave, const std::string &master);
   // Moves both surfaces to the physical configuration at mu (reference configuration + map).
@@ -157,6 +157,12 @@ public:
   const std::vector<std::array<PetscReal, 3>> &SlaveEndNextNormals() const { return endNext_; }
   const ContactSurface &Slave() const { return slave_; }
   const ContactSurface &Master() const { return master_; }
+  const std::string    &SlaveName() const { return slaveName_; }   // -contact_slave
+  const std::string    &MasterName() const { return masterName_; } // -contact_master
+  // Per multiplier row, the sum of the outward normals (area-weighted, physical configuration at mu, u = 0) of the slave
+  // facets around its vertex: the slave body's outward direction there (n[d] of size R, the same on every rank).
+  // Collective.
+  PetscErrorCode SlaveOutwardNormals(MPI_Comm comm, std::vector<PetscReal> n[3]) const;
   // Reference facet rule: barycentric points (dim per point) and weights summing to 1.
   const std::vector<PetscReal> &QuadraturePoints() const { return quadPoints_; }
   const std::vector<PetscReal> &QuadratureWeights() const { return quadWeights_; }
@@ -172,6 +178,8 @@ public:
   // from near to all (report key contact_search).
   struct MasterSearchStats {
     PetscInt held = 0, total = 0, fallbacks = 0, assemblies = 0, farPoints = 0; // farPoints: out of reach, last assembly
+    PetscInt  belowReach = 0; // fallbacks because the margin is below the least reach of a slave point (reach)
+    PetscReal reach      = 0; // 2 slave + 3 master facet diameters, the smallest (last assembly)
   };
   const MasterSearchStats &MasterSearch() const { return searchStats_; }
 
@@ -179,8 +187,9 @@ private:
   // masterAll_ := the master facets near this rank's slave facets (-contact_master_search near): those whose
   // deformed bounding box meets the slave facets' box grown by *margin (the option's, or the automatic one).
   // Collective; the relative order of the facets is that of Gather.
-  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin);
+  PetscErrorCode GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *reach);
   MasterSearchStats searchStats_;
+  std::string       slaveName_, masterName_;
   size_t            kReserve_[2] = {0, 0}; // the last assembly's buffered K pieces and entries (the next one reserves as many)
   PetscErrorCode NumberMultipliers(const Elasticity &elas);
   PetscErrorCode FindSlaveEnds(const Elasticity &elas, const std::string &slave);

@@ -122,7 +122,15 @@ public:
 
 private:
   PetscErrorCode ComputeKKT(ElasticFOM &fom);
-  PetscErrorCode MeasureInitialOverlap(MPI_Comm comm);
+  // "; the cause: the contact QP ... was not solved ...: <advice>" when some iterate's dense QP ended above -fom_kkt_tol
+  // (its scaled KKT residual), or the saddle point's solves were too loose (SaddleActiveSetSolver::LooseSolves), else "":
+  // the cause of a non-convergence or a rejected solve, in place of the relaxation hint
+  std::string     QPCause() const;
+  PetscInt        qpUnsolved_ = 0, qpUnsolvedFirst_ = 0; // iterates whose QP was not solved, the first of them
+  DualQPInfo      qpUnsolvedInfo_;                        // that first one's
+  PetscReal       qpUnsolvedWorst_ = 0;                   // the largest scaled KKT residual of those QPs
+  // also refuses a master that faces away from the slave (most nodes behind it see its outward normal along their own)
+  PetscErrorCode MeasureInitialOverlap(MPI_Comm comm, const ContactMap &map);
   Vec             uInit_ = nullptr, lamInit_ = nullptr; // SetInitialGuess's, until the next Solve
   DualQPSolver    qp_;
   DualShellSolver shell_;

@@ -45,8 +45,9 @@ public:
   bool Next(const PetscReal *x, const PetscReal *g, PetscReal *next);
   // "did not converge in ... iterations (options); last changes ..." with the history when withHistory; when the
   // history ends in a cycle (Cycle), the message says so.
-  // cause: appended to the summary, before the history (e.g. the initial overlap the FOM measured)
-  std::string NotConverged(bool withHistory, const std::string &cause = "") const;
+  // cause: appended to the summary, before the history (e.g. the initial overlap the FOM measured); relaxationHint false
+  // when the cause is known not to be the fixed point's (a QP that was not solved): no "try -kacanov_relaxation 0.5"
+  std::string NotConverged(bool withHistory, const std::string &cause = "", bool relaxationHint = true) const;
   // The period p (2..12) of a cycle the history ends in: its last 2p iterates repeat the p before them (du and dl to
   // 1e-6 relative, the active counts exactly), the smallest such p; 0 when there is none. *from: the first iterate
   // (1-based) of the repeating stretch. A converging loop's changes fall, so they never repeat.

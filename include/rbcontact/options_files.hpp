@@ -53,6 +53,10 @@ const std::vector<std::string> &OptionsFilesRead();
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, std::initializer_list<const char *> names);
 // The same for -<prefix><name> (names without the dash: {"seed", "type"} with prefix "test_").
 PetscErrorCode CheckValuesGiven(MPI_Comm comm, const std::string &prefix, std::initializer_list<const char *> names);
+// The Krylov tolerances of the KSP of options prefix `prefix` ("fom_saddle_": -fom_saddle_ksp_rtol, _atol, _max_it), where
+// given, before PETSc reads them: rtol a finite number in [0, 1), atol finite and >= 0, max_it >= 1, each with a value.
+// (PETSc 3.18 refused a NaN rtol naming no option, and took a NaN atol or a negative max_it without a word.)
+PetscErrorCode CheckKSPTolerances(MPI_Comm comm, const std::string &prefix);
 
 PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> *unused, const std::vector<std::string> &given = {});
 

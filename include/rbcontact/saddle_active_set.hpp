@@ -66,6 +66,10 @@ public:
   PetscErrorCode SolveFixedSet(Vec f, Vec g, Vec u, Vec lambda);
   // Forget the set and the factorization.
   PetscErrorCode Reset();
+  // "" while the solves' tolerance (-ksp_rtol) is at most 1e-10; else why the inexact solves limit the active set and
+  // the KKT residuals, and the advice (the cause of a cycling set, a non-convergence or a rejected solve: raising
+  // -pdas_tol, the advice of a cycle, does not help there; audit of 2026-12-01)
+  std::string LooseSolves() const;
   // The rigid-body modes of A (for a PCFIELDSPLIT's GAMG on the u block; kept by reference), wanted only when
   // the options ask for a PCFIELDSPLIT (-fom_saddle_solver gamg or -fom_saddle_pc_type fieldsplit).
   PetscErrorCode SetNearNullSpace(MatNullSpace nsp);
@@ -112,6 +116,7 @@ private:
   PetscInt               changedSinceFactor_ = 0; // rows whose status changed since the last factorization
   PetscReal              freshSeconds_ = 0;       // wall time of the last solve with a new factorization
   PetscReal              exactRtol_ = 1e-12;      // the KSP's rtol after its options (-fom_saddle_ksp_rtol)
+  PetscReal              exactResidual_ = 0;      // the relative residual of the last solve to exactRtol_
 };
 
 } // namespace rbc

@@ -96,6 +96,7 @@ PetscErrorCode StageFom(MPI_Comm comm)
       j["master_facets_held_max"] = (long long)ms.held; // the largest count on one rank, last assembly
       j["master_facets_total"]    = (long long)ms.total;
       j["fallbacks"]              = (long long)ms.fallbacks; // near: assemblies that fell back to all
+      j["below_reach"]            = (long long)ms.belowReach; // of them: the margin below any point's reach
       j["assemblies"]             = (long long)ms.assemblies;
       j["far_points"]             = (long long)ms.farPoints; // near: integration points out of reach, last assembly
     }

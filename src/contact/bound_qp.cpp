@@ -124,6 +124,7 @@ PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
   PetscCall(PetscOptionsGetString(NULL, prefix_.c_str(), "-tao_type", type, sizeof type, NULL));
   // "-<prefix>tao_type activeset" skips TAO: the active-set method alone
   useTao_ = strcmp(type, "activeset") ? PETSC_TRUE : PETSC_FALSE;
+  type_   = type;
   PetscFunctionReturn(0);
 }
 

@@ -140,6 +140,8 @@ PetscErrorCode ContactMap::Setup(const Elasticity &elas, const std::string &slav
   PetscCheck(slave != master, comm, PETSC_ERR_USER_INPUT, "-contact_slave and -contact_master name the same group '%s': contact is between two surfaces of two bodies", slave.c_str());
   PetscCall(slave_.Build(elas, slave));
   PetscCall(master_.Build(elas, master));
+  slaveName_  = slave;
+  masterName_ = master;
   {
     PetscInt nb = 0;
     for (const auto *S : {&slave_, &master_})
@@ -527,7 +529,7 @@ static PetscReal FacetBox(const SurfaceFacet &F, PetscInt dim, PetscReal lo[3], 
   return std::sqrt(diag);
 }
 
-PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
+PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin, PetscReal *reach)
 {
   const PetscInt dim = slave_.facets.empty() ? (master_.facets.empty() ? 2 : master_.facets[0].nv) : slave_.facets[0].nv;
   PetscMPIInt    size;
@@ -546,6 +548,13 @@ PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
   }
   for (const auto &F : master_.facets) h[1] = std::max(h[1], FacetBox(F, dim, lo, hi));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, h, 2, MPIU_REAL, MPI_MAX, comm));
+  { // the least reach of a slave point (at distance 0: 2 slave + 3 master facet diameters, Assemble's test)
+    PetscReal hmin[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL};
+    for (const auto &F : slave_.facets) hmin[0] = std::min(hmin[0], FacetBox(F, dim, lo, hi));
+    for (const auto &F : master_.facets) hmin[1] = std::min(hmin[1], FacetBox(F, dim, lo, hi));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, hmin, 2, MPIU_REAL, MPI_MIN, comm));
+    *reach = hmin[0] < PETSC_MAX_REAL && hmin[1] < PETSC_MAX_REAL ? 2 * hmin[0] + 3 * hmin[1] : 0;
+  }
   std::vector<PetscReal> boxes(6 * size);
   PetscCallMPI(MPI_Allgather(box, 6, MPIU_REAL, boxes.data(), 6, MPIU_REAL, comm));
   PetscReal diag = 0;
@@ -562,6 +571,10 @@ PetscErrorCode ContactMap::GatherNearMaster(MPI_Comm comm, PetscReal *margin)
     diag = std::sqrt(diag);
   }
   *margin = masterSearchMargin > 0 ? masterSearchMargin : 0.5 * diag + 4 * h[1] + 2 * h[0];
+  if (*margin < *reach) { // no slave point can be within reach: Assemble uses every master facet (nothing to exchange)
+    masterAll_.clear();
+    PetscFunctionReturn(0);
+  }
   // each local master facet to every rank whose grown slave box it meets
   const int                      bytes = (int)sizeof(SurfaceFacet);
   std::vector<std::vector<char>> out(size);
@@ -670,15 +683,22 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
   // near (docs/contact.md "Parallel"): a point within reach of the margin (below, per point) sees the answer of
   // all; a point beyond is out of reach: its K entries come from the closest facet held and its gap is its distance
   // to the master (an inactive constraint, as in all); a rank with slave facets and no master facet, or a point out
-  // of reach at less than half the margin (large facets there), makes every rank assemble again with all
+  // of reach at less than half the margin (large facets there), makes every rank assemble again with all; so does a
+  // margin below the least reach of a point (2 slave + 3 master facet diameters): no point could be within reach, and
+  // those in contact were out of reach with their gap taken as their distance to the facets held, not to the master
+  // (a margin of 1e-7 on ring_on_block: contact lost, the Kacanov iterates cycled; until 2026-12-02)
   PetscReal searchMargin = PETSC_MAX_REAL; // near: the margin in use (PETSC_MAX_REAL: every master facet held)
   PetscInt  farPoints = 0, nearFar = 0;
   if (masterSearchNear) {
-    PetscCall(GatherNearMaster(comm, &searchMargin));
-    PetscCall(cp.Build(masterAll_, dim, true));
-    PetscInt bad = masterAll_.empty() && !slave_.facets.empty();
+    PetscReal reach = 0;
+    PetscCall(GatherNearMaster(comm, &searchMargin, &reach));
+    searchStats_.reach = reach;
+    const bool below = searchMargin < reach; // (the same on every rank)
+    PetscInt   bad   = below || (masterAll_.empty() && !slave_.facets.empty());
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, comm));
-    if (bad) {
+    if (!bad) PetscCall(cp.Build(masterAll_, dim, true));
+    else {
+      searchStats_.belowReach += below ? 1 : 0;
       ++searchStats_.fallbacks;
       searchMargin = PETSC_MAX_REAL;
       PetscCall(master_.Gather(comm, &masterAll_));
@@ -992,6 +1012,27 @@ PetscErrorCode ContactMap::Assemble(const Elasticity &elas, Vec uloc, ContactSys
       PetscCall(VecAssemblyEnd(v));
     }
   for (PetscInt d = 0; d < dim; ++d) PetscCall(VecPointwiseDivide(sys->normal[d], sys->normal[d], sys->weight));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode ContactMap::SlaveOutwardNormals(MPI_Comm comm, std::vector<PetscReal> n[3]) const
+{
+  const PetscInt         dim = slave_.dim;
+  std::vector<PetscReal> sum((size_t)3 * R_, 0.0);
+
+  PetscFunctionBeginUser;
+  for (const auto &F : slave_.facets) {
+    PetscReal nf[3] = {0, 0, 0};
+    FacetNormal(F.X.data(), dim, F.outward, nf);
+    for (PetscInt k = 0; k < F.nv; ++k)
+      if (F.row[k] >= 0)
+        for (PetscInt d = 0; d < dim; ++d) sum[(size_t)3 * F.row[k] + d] += nf[d];
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum.data(), (int)sum.size(), MPIU_REAL, MPIU_SUM, comm));
+  for (PetscInt d = 0; d < 3; ++d) {
+    n[d].assign(R_, 0.0);
+    for (PetscInt r = 0; r < R_; ++r) n[d][r] = sum[(size_t)3 * r + d];
+  }
   PetscFunctionReturn(0);
 }
 

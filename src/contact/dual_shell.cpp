@@ -3,6 +3,7 @@
 // free set (see rbcontact/dual_shell.hpp).
 #include "rbcontact/dual_shell.hpp"
 #include "rbcontact/tao_recipe.hpp"
+#include "rbcontact/options_files.hpp"
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -307,6 +308,9 @@ PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string 
     PetscCall(PetscLogEventRegister("RBCDualDiag", KSP_CLASSID, &DS_Diag));
   }
   prefix_ = prefix + "dual_";
+  // given without a value, PETSc kept the default without a word; the CG's tolerances are checked before PETSc reads them
+  PetscCall(CheckValuesGiven(comm, prefix_, {"pdas_max_it", "pdas_rtol_loose", "pdas_tol", "diag", "shell_tao_support"}));
+  PetscCall(CheckKSPTolerances(comm, prefix_));
   PetscOptionsBegin(comm, prefix_.c_str(), "Matrix-free dual QP (primal-dual active set + CG)", "DualShellSolver");
   PetscCall(PetscOptionsInt("-pdas_max_it", "Maximum active-set steps", NULL, maxIt, &maxIt, NULL));
   PetscCall(PetscOptionsReal("-pdas_rtol_loose", "CG rtol while the free set changes (then -ksp_rtol)", NULL, looseRtol, &looseRtol, NULL));
@@ -325,7 +329,12 @@ PetscErrorCode DualShellSolver::SetFromOptions(MPI_Comm comm, const std::string 
   }
   diag = dtype;
   PetscCheck(diag == "lumped" || diag == "exact", comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sdiag %s: use lumped or exact", prefix_.c_str(), dtype);
-  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it must be >= 1", prefix_.c_str());
+  PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
+  // (a NaN or negative value was taken without a word until 2026-12-02: NaN never adds a multiplier, a negative
+  // loose tolerance made every solve exact)
+  PetscCheck(looseRtol > 0 && looseRtol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_rtol_loose %g must be in (0, 1)", prefix_.c_str(), (double)looseRtol);
+  PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
+  PetscCheck(taoSupport >= 0 && taoSupport < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sshell_tao_support %g must be in [0, 1) (a fraction of the largest TAO multiplier)", prefix_.c_str(), (double)taoSupport);
   PetscCall(KSPDestroy(&ksp_));
   PetscCall(KSPCreate(comm, &ksp_));
   PetscCall(KSPSetOptionsPrefix(ksp_, prefix_.c_str()));

@@ -91,6 +91,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCall(PetscOptionsInt("-dual_dense_max", "auto: dense S up to this many multipliers, saddle above", NULL, dualDenseMax, &dualDenseMax, NULL));
   PetscCall(PetscOptionsInt("-dual_dense_max_dofs", "auto: dense S only while the compliance G (contact dofs squared) has at most this many rows (memory)", NULL, dualDenseMaxDofs, &dualDenseMaxDofs, NULL));
   PetscOptionsEnd();
+  PetscCheck(dualDenseMax >= 0 && dualDenseMaxDofs >= 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_dual_dense_max %" PetscInt_FMT " and -fom_dual_dense_max_dofs %" PetscInt_FMT " must be >= 0 (0: auto always takes the saddle point)", dualDenseMax, dualDenseMaxDofs);
   PetscCheck(kktTol > 0 && std::isfinite(kktTol), comm, PETSC_ERR_ARG_OUTOFRANGE, "-fom_kkt_tol %g must be a finite number > 0", (double)kktTol);
   { // checked here for every QP path (the dense one alone read it: bogus passed with -fom_dual_matrix shell or saddle)
     char m[32] = "auto";
@@ -265,9 +266,9 @@ static PetscErrorCode GatherAt(Vec v, const std::vector<PetscInt> &D, std::vecto
 }
 
 // At u = 0: the weighted gaps g_i / weight_i < 0 beyond rounding are an initial overlap (the deepest, where, how many).
-PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
+PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm, const ContactMap &map)
 {
-  std::vector<PetscReal> g, w, x[3];
+  std::vector<PetscReal> g, w, x[3], nm[3], ns[3];
 
   PetscFunctionBeginUser;
   initialPenetration = 0;
@@ -279,6 +280,21 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
   PetscReal scale = 0; // size of the slave surface: the rounding level of a gap
   for (PetscInt d = 0; d < dim; ++d)
     for (PetscReal c : x[d]) scale = std::max(scale, std::abs(c));
+  // a master that faces away from the slave (the far side of the master body, -contact_master block_bottom on
+  // sphere_block3d: "an interference fit by 3.1", solved to an energy 8e4 times the right one, exit 0): the slave nodes
+  // behind it see master facets whose outward normal points the way their own does, where an interference fit's face each
+  // other (the slave inside the master body)
+  for (PetscInt d = 0; d < dim; ++d) PetscCall(GatherVec(sys.normal[d], &nm[d]));
+  PetscCall(map.SlaveOutwardNormals(comm, ns));
+  PetscInt  away = 0;
+  PetscReal awayDepth = 0, lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {-PETSC_MAX_REAL, -PETSC_MAX_REAL, -PETSC_MAX_REAL}, span = 0;
+  for (PetscInt d = 0; d < dim; ++d)
+    for (PetscReal c : x[d]) {
+      lo[d] = std::min(lo[d], c);
+      hi[d] = std::max(hi[d], c);
+    }
+  for (PetscInt d = 0; d < dim; ++d) span += g.empty() ? 0 : (hi[d] - lo[d]) * (hi[d] - lo[d]);
+  span = std::sqrt(span); // the slave surface's bounding-box diagonal
   for (size_t i = 0; i < g.size(); ++i) {
     if (!(w[i] > 0)) continue;
     const PetscReal gap = g[i] / w[i];
@@ -288,9 +304,22 @@ PetscErrorCode KacanovSolver::MeasureInitialOverlap(MPI_Comm comm)
         initialPenetration = -gap;
         for (PetscInt d = 0; d < dim; ++d) initialPenetrationAt[d] = x[d][i];
       }
+      PetscReal dot = 0, a = 0, b = 0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        dot += nm[d][i] * ns[d][i];
+        a += nm[d][i] * nm[d][i];
+        b += ns[d][i] * ns[d][i];
+      }
+      if (a > 0 && b > 0 && dot > 0.5 * std::sqrt(a * b)) { // within 60 degrees of the same direction
+        ++away;
+        awayDepth = std::max(awayDepth, -gap);
+      }
     }
   }
-  (void)comm;
+  // most of the nodes behind the master (not a few where an interference fit's surfaces curve away)
+  PetscCheck(!(away > 0 && 2 * away >= initialPenetrating), comm, PETSC_ERR_USER_INPUT,
+             "the master surface '%s' (-contact_master) faces away from the slave surface '%s': before any deformation %" PetscInt_FMT " of the slave nodes (of %" PetscInt_FMT " behind it, up to %g deep, where the slave surface spans %g) lie behind master facets whose outward normal points the same way as the slave's own outward normal, so the slave is on the side of the master body that surface does not bound; this is not an interference fit (where the two surfaces face each other): name with -contact_master the surface of the master body that faces the slave",
+             map.MasterName().c_str(), map.SlaveName().c_str(), away, initialPenetrating, (double)awayDepth, (double)span);
   PetscFunctionReturn(0);
 }
 
@@ -331,6 +360,8 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   PetscFunctionBeginUser;
   history = KacanovHistory();
   converged = PETSC_FALSE;
+  qpUnsolved_ = qpUnsolvedFirst_ = 0;
+  qpUnsolvedWorst_ = 0;
   // Elastic solution u0 = A^{-1} f (solve time)
   PetscCall(PetscTime(&t0));
   std::vector<PetscInt> D;
@@ -399,7 +430,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
-    PetscCall(MeasureInitialOverlap(comm));
+    PetscCall(MeasureInitialOverlap(comm, map));
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
       PetscCall(PetscObjectSetName((PetscObject)lambda, "lambda"));
@@ -440,7 +471,7 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventBegin(KAC_Assemble, 0, 0, 0, 0));
     PetscCall(map.Assemble(fom.elas, uloc, &sys));
     PetscCall(PetscLogEventEnd(KAC_Assemble, 0, 0, 0, 0));
-    if (k == 1 && !guessed) PetscCall(MeasureInitialOverlap(comm));
+    if (k == 1 && !guessed) PetscCall(MeasureInitialOverlap(comm, map));
     const PetscBool warm = lambda ? PETSC_TRUE : PETSC_FALSE;
     if (!lambda) {
       PetscCall(MatCreateVecs(sys.K, NULL, &lambda));
@@ -514,6 +545,13 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
     PetscCall(PetscLogEventEnd(KAC_Schur, 0, 0, 0, 0));
     PetscCall(PetscLogEventBegin(KAC_QP, 0, 0, 0, 0));
     PetscCall(qp_.Solve(sys.R, Sfull, bfull, &lam, &lastQP, lamWarm.empty() ? nullptr : &lamWarm));
+    if (!(lastQP.kkt <= kktTol)) { // not solved: named if the loop fails (QPCause), where it was blamed on the fixed point
+      if (!qpUnsolved_++) {
+        qpUnsolvedFirst_ = k;
+        qpUnsolvedInfo_  = lastQP;
+      }
+      qpUnsolvedWorst_ = std::max(qpUnsolvedWorst_, lastQP.kkt);
+    }
     lamWarm = lam;
     PetscCall(PetscLogEventEnd(KAC_QP, 0, 0, 0, 0));
     {
@@ -661,11 +699,12 @@ PetscErrorCode KacanovSolver::Solve(ElasticFOM &fom, ContactMap &map)
   if (!converged) {
     std::ostringstream o; // (a gross initial overlap failed with the relaxation hint alone)
     if (initialPenetrating > 0) o << "; the bodies overlapped before any load: " << initialPenetrating << " slave points inside the master, by up to " << initialPenetration << " (the mesh or -mesh_geo_set / the maps put them through each other?)";
-    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, o.str()).c_str());
+    const std::string qp = QPCause(); // (a QP that was not solved failed with the relaxation hint alone)
+    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "%s", loop.NotConverged(true, qp + o.str(), qp.empty()).c_str());
   }
 
   PetscCall(ComputeKKT(fom));
-  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol);
+  PetscCheck(kkt.Max() <= kktTol, comm, PETSC_ERR_NOT_CONVERGED, "Contact solve rejected: scaled KKT residuals primal %.3e, dual %.3e, complementarity %.3e, stationarity %.3e exceed -fom_kkt_tol %.1e%s", (double)kkt.primal, (double)kkt.dual, (double)kkt.complementarity, (double)kkt.stationarity, (double)kktTol, QPCause().c_str());
   PetscFunctionReturn(0);
 }
 
@@ -739,6 +778,27 @@ static std::string Point(PetscReal x, PetscReal y, PetscReal z, PetscInt dim)
   return o.str();
 }
 
+std::string KacanovSolver::QPCause() const
+{
+  if (dualMatrix == "saddle") {
+    const std::string why = saddle_.LooseSolves();
+    return why.empty() ? "" : "; the cause: " + why;
+  }
+  if (!qpUnsolved_) return "";
+  std::ostringstream o;
+  const DualQPInfo  &q = qpUnsolvedInfo_;
+  o << "; the cause: the contact QP (-fom_dual_matrix dense) was not solved at " << qpUnsolved_ << " of the " << iterations << " Kacanov iterates (scaled KKT residual up to " << qpUnsolvedWorst_ << " > -fom_kkt_tol " << kktTol << "; the first at iterate " << qpUnsolvedFirst_ << ": ";
+  if (qp_.UsesTao()) {
+    o << "TAO " << qp_.TaoType() << " stopped with " << TaoConvergedReasons[q.taoReason] << " after " << q.taoIterations << " iterations";
+    if (qp_.Polish()) o << ", then the active-set polish after " << q.polishIterations << " steps";
+    else o << ", kept as it is by -fom_qp_polish 0";
+  } else o << "the active-set method stopped after " << q.polishIterations << " steps";
+  o << "): the Kacanov iterates carry the QP's error; ";
+  if (qp_.UsesTao() && !qp_.Polish()) o << "drop -fom_qp_polish 0 (the active-set polish makes TAO's answer exact), let TAO converge (-fom_qp_tao_max_it, -fom_qp_tao_gatol) or use the default -fom_qp_tao_type activeset";
+  else o << "the dual matrix is too ill-conditioned for the dense QP: use -fom_dual_matrix saddle";
+  return o.str();
+}
+
 PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, const ContactMap &map, std::vector<std::string> *warnings)
 {
   std::vector<PetscReal> lam, x[3], n[3];
@@ -750,6 +810,12 @@ PetscErrorCode ContactSurfaceWarnings(MPI_Comm comm, const KacanovSolver &kac, c
     std::ostringstream o;
     o << "initial overlap: " << kac.initialPenetrating << " slave node(s) lie inside the master body before any deformation (deepest " << kac.initialPenetration << " at " << Point(kac.initialPenetrationAt[0], kac.initialPenetrationAt[1], kac.initialPenetrationAt[2], dim)
       << "); the solver pushes the bodies apart as an interference fit. If that is not meant, check the bodies' positions (the mesh, -mesh_geo_set, the geometric map at this mu)";
+    warnings->push_back(o.str());
+  }
+  if (const auto &ms = map.MasterSearch(); ms.belowReach > 0) {
+    std::ostringstream o;
+    o << "-contact_master_search_margin " << map.masterSearchMargin << " is below the reach of any slave point (its distance plus 2 slave and 3 master facet diameters: at least " << ms.reach
+      << " here): " << ms.belowReach << " of the " << ms.assemblies << " contact assemblies used every master facet (-contact_master_search all), as no point could be found with the facets near it; give a margin of at least " << ms.reach << ", or leave the default";
     warnings->push_back(o.str());
   }
   // gathered once for the three checks below: multipliers, their largest value, slave vertex coordinates

@@ -98,15 +98,19 @@ PetscInt KacanovLoop::Cycle(PetscInt *from) const
   return 0;
 }
 
-std::string KacanovLoop::NotConverged(bool withHistory, const std::string &cause) const
+std::string KacanovLoop::NotConverged(bool withHistory, const std::string &cause, bool relaxationHint) const
 {
   const std::string  p = "-" + prefix_ + "kacanov_";
   std::ostringstream o;
-  o << label << " iterations did not converge in " << maxIt << " iterations (" << p << "max_it; tolerances " << p << "rtol_primal " << rtolPrimal << ", " << p << "rtol_dual " << rtolDual << "; try " << p << "relaxation 0.5)";
+  o << label << " iterations did not converge in " << maxIt << " iterations (" << p << "max_it; tolerances " << p << "rtol_primal " << rtolPrimal << ", " << p << "rtol_dual " << rtolDual;
+  if (relaxationHint) o << "; try " << p << "relaxation 0.5";
+  o << ")";
   if (!history.du.empty()) o << "; last changes du " << history.du.back() << ", dlambda " << history.dl.back();
   PetscInt from = 0;
-  if (const PetscInt per = Cycle(&from))
-    o << "; the changes repeat with period " << per << " from iterate " << from << ": a cycle, not a slow approach, so more iterations do not help (a smaller " << p << "relaxation may; for a reduced model, a cycle that damping does not remove says the training set does not resolve this parameter)";
+  if (const PetscInt per = Cycle(&from)) {
+    o << "; the changes repeat with period " << per << " from iterate " << from << ": a cycle, not a slow approach, so more iterations do not help";
+    if (relaxationHint) o << " (a smaller " << p << "relaxation may; for a reduced model, a cycle that damping does not remove says the training set does not resolve this parameter)";
+  }
   o << cause;
   if (withHistory) {
     o << ". History:";

@@ -2,8 +2,10 @@
 // point, by a primal-dual active-set method (see rbcontact/saddle_active_set.hpp, docs/contact.md).
 // Owns the saddle-point matrix (its layout: each rank's u rows, then its lambda rows), its KSP and the set.
 #include "rbcontact/saddle_active_set.hpp"
+#include "rbcontact/options_files.hpp"
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace rbc {
 
@@ -34,6 +36,9 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
     PetscCall(PetscLogEventRegister("RBCSaddleSolve", MAT_CLASSID, &SAS_Solve));
   }
   prefix_ = prefix + "saddle_";
+  // given without a value, PETSc kept the default without a word; the Krylov tolerances are checked before PETSc reads them
+  PetscCall(CheckValuesGiven(comm, prefix_, {"pdas_max_it", "pdas_tol", "solver", "pdas_rtol_loose", "rtol_forcing", "reuse_max_changes"}));
+  PetscCall(CheckKSPTolerances(comm, prefix_));
   PetscOptionsBegin(comm, prefix_.c_str(), "Contact QP on the saddle point (primal-dual active set, -fom_dual_matrix saddle)", "SaddleActiveSetSolver");
   PetscCall(PetscOptionsInt("-pdas_max_it", "Most active-set steps of one Kacanov iterate (cold start or -pdas_inner)", "docs/contact.md", maxIt, &maxIt, NULL));
   PetscCall(PetscOptionsReal("-pdas_tol", "A row joins the set when its penetration exceeds this times the constraint scale", "docs/contact.md", setTol, &setTol, NULL));
@@ -71,8 +76,21 @@ PetscErrorCode SaddleActiveSetSolver::SetFromOptions(MPI_Comm comm, const std::s
   PetscCheck(maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_max_it %" PetscInt_FMT " must be >= 1", prefix_.c_str(), maxIt);
   PetscCheck(setTol >= 0 && setTol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_tol %g must be in [0, 1)", prefix_.c_str(), (double)setTol);
   PetscCheck(looseRtol > 0 && looseRtol < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%spdas_rtol_loose %g must be in (0, 1)", prefix_.c_str(), (double)looseRtol);
+  PetscCheck(reuseMaxChanges >= -1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%sreuse_max_changes %" PetscInt_FMT " must be >= -1 (-1: a factorization on every step)", prefix_.c_str(), reuseMaxChanges);
   PetscCheck(forcing >= 0 && forcing < 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "-%srtol_forcing %g must be in [0, 1) (0: every Kacanov iterate solved exactly)", prefix_.c_str(), (double)forcing);
   PetscFunctionReturn(0);
+}
+
+std::string SaddleActiveSetSolver::LooseSolves() const
+{
+  if (!(exactRtol_ > 1e-10)) return "";
+  std::ostringstream o;
+  o << "the saddle-point solves stop at -" << prefix_ << "ksp_rtol " << exactRtol_;
+  if (exactResidual_ > 0) o << " (the last one at a relative residual " << exactResidual_ << ")";
+  o << ", above 1e-10: the active-set test reads signs that the solves' error decides (raising -" << prefix_ << "pdas_tol does not help), and the error stays in the KKT residuals; tighten -" << prefix_ << "ksp_rtol to 1e-10 or below (the default is 1e-12) or solve directly (";
+  if (fieldsplit_) o << "-" << prefix_ << "solver direct, ";
+  o << "-" << prefix_ << "reuse_max_changes -1: a new factorization on every step, exact whatever the tolerance)";
+  return o.str();
 }
 
 PetscErrorCode SaddleActiveSetSolver::SetNearNullSpace(MatNullSpace nsp)
@@ -452,6 +470,12 @@ PetscErrorCode SaddleActiveSetSolver::Step(Mat A, Vec f, Mat K, Vec g, PetscReal
   PetscCall(KSPGetConvergedReason(ksp_, &reason));
   PetscCheck(reason > 0, comm, PETSC_ERR_NOT_CONVERGED, "Contact saddle-point solve failed (%s) at active-set step %" PetscInt_FMT ": a failed factorization (-%spc_type, -%spc_factor_mat_solver_type; MUMPS workspace: -%smat_mumps_icntl_14) or the iterative solver's -%sksp_* settings",
              KSPConvergedReasons[reason], info->steps + 1, prefix_.c_str(), prefix_.c_str(), prefix_.c_str(), prefix_.c_str());
+  if (rtol <= exactRtol_) { // the residual an exact step reached (LooseSolves; KSPPREONLY computes none: 0)
+    PetscReal rn, bn;
+    PetscCall(KSPGetResidualNorm(ksp_, &rn));
+    PetscCall(VecNorm(b_, NORM_2, &bn));
+    exactResidual_ = bn > 0 ? rn / bn : 0;
+  }
   PetscCall(GetSolution(u, lambda));
   guess_ = true;
   PetscReal nx;
@@ -538,8 +562,10 @@ PetscErrorCode SaddleActiveSetSolver::Solve(Mat A, Vec f, Mat K, Vec g, PetscBoo
     std::vector<PetscMPIInt> back(seen.size());
     for (size_t s = 0; s < seen.size(); ++s) back[s] = seen[s] == active_;
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, back.data(), (int)back.size(), MPI_INT, MPI_LAND, comm));
-    PetscCheck(std::find(back.begin(), back.end(), 1) == back.end(), comm, PETSC_ERR_NOT_CONVERGED, "Contact active set cycles after %" PetscInt_FMT " steps (-%spdas_*: a set came back; %" PetscInt_FMT " rows change): raise -%spdas_tol", info->steps, prefix_.c_str(), info->changed, prefix_.c_str());
-    PetscCheck(info->steps < maxIt, comm, PETSC_ERR_NOT_CONVERGED, "Contact active set not settled in -%spdas_max_it %" PetscInt_FMT " steps (%" PetscInt_FMT " rows still change)", prefix_.c_str(), maxIt, info->changed);
+    // (inexact solves: their cause, not -pdas_tol, which does not help)
+    const std::string why = LooseSolves(), cause = why.empty() ? ": raise -" + prefix_ + "pdas_tol" : "; the cause: " + why;
+    PetscCheck(std::find(back.begin(), back.end(), 1) == back.end(), comm, PETSC_ERR_NOT_CONVERGED, "Contact active set cycles after %" PetscInt_FMT " steps (-%spdas_*: a set came back; %" PetscInt_FMT " rows change)%s", info->steps, prefix_.c_str(), info->changed, cause.c_str());
+    PetscCheck(info->steps < maxIt, comm, PETSC_ERR_NOT_CONVERGED, "Contact active set not settled in -%spdas_max_it %" PetscInt_FMT " steps (%" PetscInt_FMT " rows still change)%s", prefix_.c_str(), maxIt, info->changed, why.empty() ? "" : ("; the cause: " + why).c_str());
   }
   PetscCall(PetscTime(&t1));
   info->seconds = t1 - t0;

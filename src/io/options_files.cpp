@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cerrno>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -139,6 +140,24 @@ PetscErrorCode CheckValuesGiven(MPI_Comm comm, const std::string &prefix, std::i
     const std::string full = "-" + prefix + n;
     PetscCall(CheckValuesGiven(comm, {full.c_str()}));
   }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode CheckKSPTolerances(MPI_Comm comm, const std::string &prefix)
+{
+  const std::string p = "-" + prefix + "ksp_";
+  PetscReal         rtol = 0, atol = 0;
+  PetscInt          maxIt = 1;
+  PetscBool         set;
+
+  PetscFunctionBeginUser;
+  PetscCall(CheckValuesGiven(comm, prefix + "ksp_", {"rtol", "atol", "max_it"}));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, (p + "rtol").c_str(), &rtol, &set));
+  PetscCheck(!set || (rtol >= 0 && rtol < 1), comm, PETSC_ERR_ARG_OUTOFRANGE, "%srtol %g must be a number in [0, 1)", p.c_str(), (double)rtol);
+  PetscCall(PetscOptionsGetReal(NULL, NULL, (p + "atol").c_str(), &atol, &set));
+  PetscCheck(!set || (atol >= 0 && std::isfinite(atol)), comm, PETSC_ERR_ARG_OUTOFRANGE, "%satol %g must be a finite number >= 0", p.c_str(), (double)atol);
+  PetscCall(PetscOptionsGetInt(NULL, NULL, (p + "max_it").c_str(), &maxIt, &set));
+  PetscCheck(!set || maxIt >= 1, comm, PETSC_ERR_ARG_OUTOFRANGE, "%smax_it %" PetscInt_FMT " must be >= 1", p.c_str(), maxIt);
   PetscFunctionReturn(0);
 }
 
