@@ -155,7 +155,8 @@ def failure(args):
 def help_(args):
     p = run(args, 1, ["fom", "-options_file", "runs/ring_on_block.opts", "-help"])
     for opt in ("-mesh_file", "-mesh_refine", "-bodies", "-body_E", "-dirichlet", "-dirichlet_ring_top_u", "-mu_names", "-mu", "-map_ring",
-                "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type"):
+                "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type",
+                "-fom_kkt_view", "-fom_qp_polish", "-fom_qp_tao_type"):  # (the last three missing until 2026-12-02)
         check(re.search(r"^\s+%s[ :<]" % re.escape(opt), p.stdout, re.M) is not None, "fom -help lists %s" % opt)
     check("rbcontact: warning" not in p.stdout, "the shipped scene: no rbcontact warning (deprecated or unused option)")
     m = re.search(r"^\s+-mu <([-0-9.e+]+)", p.stdout, re.M)

@@ -40,7 +40,7 @@ public:
   // TAO's inner KSP -fom_qp_ksp_type: apart from the elastic solver's -fom_ksp_*); -<prefix>qp_polish.
   // Default -<prefix>tao_type activeset: the active-set method alone, warm-started; bqpip (or any
   // bound-constrained TAO type) runs TAO from zero, then the active-set polish.
-  PetscErrorCode Setup(const std::string &prefix);
+  PetscErrorCode Setup(const std::string &prefix, MPI_Comm comm = PETSC_COMM_SELF); // comm: where -help lists the options
   // S: R x R column-major SPD; minimizes 1/2 l'Sl - b'l over l >= 0. warm (optional, size R): a start,
   // e.g. the previous Kacanov iterate's multipliers (its support is the initial active set).
   PetscErrorCode Solve(PetscInt R, const std::vector<PetscReal> &S, const std::vector<PetscReal> &b, std::vector<PetscReal> *lambda, DualQPInfo *info, const std::vector<PetscReal> *warm = nullptr);

@@ -105,6 +105,7 @@ public:
   PetscReal      newtonMaxRatio = 10;
   PetscInt       newtonSteps = 0; // accepted Newton steps of the last Solve
   PetscReal      kktTol = 1e-8;
+  PetscBool      kktView = PETSC_FALSE; // -fom_kkt_view: print lambda, K u - g and g at each KKT check
   DualQPInfo     lastQP;
   DualShellInfo  lastShell;
   SaddleInfo     lastSaddle;

@@ -114,14 +114,17 @@ PetscErrorCode BoundQPActiveSet(PetscInt n, const PetscReal *H, const PetscReal 
 
 DualQPSolver::~DualQPSolver() = default;
 
-PetscErrorCode DualQPSolver::Setup(const std::string &prefix)
+PetscErrorCode DualQPSolver::Setup(const std::string &prefix, MPI_Comm comm)
 {
   char type[64] = "activeset";
 
   PetscFunctionBeginUser;
   prefix_ = prefix + "qp_"; // the QP's own prefix: its TAO (and TAO's KSP/PC) never read the elastic solver's options
-  PetscCall(PetscOptionsGetBool(NULL, prefix.c_str(), "-qp_polish", &polish_, NULL));
-  PetscCall(PetscOptionsGetString(NULL, prefix_.c_str(), "-tao_type", type, sizeof type, NULL));
+  // (read with PetscOptionsGet* before 2026-12-02: missing from -help)
+  PetscOptionsBegin(comm, prefix_.c_str(), "Contact QP (the dense dual problem)", "DualQPSolver");
+  PetscCall(PetscOptionsBool("-polish", "After TAO, the active-set method from its support (exact complementarity)", "docs/contact.md", polish_, &polish_, NULL));
+  PetscCall(PetscOptionsString("-tao_type", "activeset (the active-set method alone) or a TAO bound-constrained solver (bqpip, blmvm, tron, ...)", "docs/contact.md", type, type, sizeof type, NULL));
+  PetscOptionsEnd();
   // "-<prefix>tao_type activeset" skips TAO: the active-set method alone
   useTao_ = strcmp(type, "activeset") ? PETSC_TRUE : PETSC_FALSE;
   type_   = type;

@@ -82,6 +82,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
   PetscCheck(newtonMaxRatio > 0, comm, PETSC_ERR_ARG_OUTOFRANGE, "-kacanov_newton_max_ratio %g must be > 0", (double)newtonMaxRatio);
   PetscOptionsBegin(comm, "fom_", "Contact FOM", "KacanovSolver");
   PetscCall(PetscOptionsReal("-kkt_tol", "Largest scaled KKT residual accepted", NULL, kktTol, &kktTol, NULL));
+  PetscCall(PetscOptionsBool("-kkt_view", "Print lambda, K u - g and g per multiplier at each KKT check", NULL, kktView, &kktView, NULL)); // (read where used before: missing from -help)
   {
     const char *types[] = {"dense", "shell", "saddle", "auto"};
     PetscInt    t       = dualMatrixOption == "dense" ? 0 : dualMatrixOption == "shell" ? 1 : dualMatrixOption == "saddle" ? 2 : 3;
@@ -99,7 +100,7 @@ PetscErrorCode KacanovSolver::SetFromOptions(MPI_Comm comm)
     PetscCheck(!strcmp(m, "auto") || !strcmp(m, "schur") || !strcmp(m, "inverse") || !strcmp(m, "redundant") || !strcmp(m, "solves"), comm, PETSC_ERR_ARG_UNKNOWN_TYPE, "-contact_compliance: unknown value '%s' (auto, schur, inverse, redundant or solves)", m);
   }
   PetscCall(RenameTaoOptions(comm));
-  PetscCall(qp_.Setup("fom_"));
+  PetscCall(qp_.Setup("fom_", comm));
   PetscCall(shell_.SetFromOptions(comm, "fom_"));
   PetscCall(saddle_.SetFromOptions(comm, "fom_"));
   PetscFunctionReturn(0);
@@ -150,9 +151,7 @@ PetscErrorCode KacanovSolver::ComputeKKT(ElasticFOM &fom)
     comp = std::abs(PetscRealPart(c));
   }
   {
-    PetscBool view = PETSC_FALSE;
-    PetscCall(PetscOptionsGetBool(NULL, NULL, "-fom_kkt_view", &view, NULL));
-    if (view) {
+    if (kktView) {
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)r), "KKT view: lambda, K u - g, g per multiplier\n"));
       PetscCall(VecView(lambda, PETSC_VIEWER_STDOUT_(PetscObjectComm((PetscObject)r))));
       PetscCall(VecView(r, PETSC_VIEWER_STDOUT_(PetscObjectComm((PetscObject)r))));
