@@ -20,6 +20,9 @@
   probe       the ROM solved over its box without the FOM: offline's warning on a training set whose reduced loop
               fails (half_disks 2 x 5), the `online -mu` it names, the probe stage on 1 and 2 ranks, -offline_probe_fail,
               the largest estimated errors against online's, bad input.
+  p2          -fem_degree 2 (half_disks, 2 x 2 training points, 2 ranks): offline and validate run (they crashed in the
+              canonical order), the same snapshots on 1 and 2 ranks, the reconstructed fields at a training point equal
+              the FOM's (they were 13 % off, exit 0).
   estimate    offline -estimate (docs/error_estimate.md): the enrichment and calibration in the ROM file, the same on
               1 and 2 ranks; online reports the estimate (and why not with -rom_error_estimate false or without an
               enrichment); its raw changes against a separate solve with every stored basis function; validate's
@@ -1408,9 +1411,34 @@ def files(args):
     shutil.rmtree(d, ignore_errors=True)
 
 
+def p2(args):
+    d = tempfile.mkdtemp(prefix="rbc_rom_p2_")
+    opts = ["-options_file", "runs/half_disks.opts", "-fem_degree", "2"]
+    train = ["-train_size", "2,2", "-offline_probe", "0"]
+    run(args, 2, "offline", opts + train + ["-rom", d + "/r2.h5", "-report", d + "/off2.json"])
+    run(args, 1, "offline", opts + train + ["-snapshots", d + "/r1.snapshots.h5", "-offline_stop", "snapshots"])
+    with h5py.File(d + "/r1.snapshots.h5", "r") as a, h5py.File(d + "/r2.snapshots.h5", "r") as b:
+        u1, u2 = np.array(a["snapshots/u"]), np.array(b["snapshots/u"])
+    dev = np.abs(u1 - u2).max() / np.abs(u1).max()
+    check(u1.shape == u2.shape and dev <= 1e-8, "P2 snapshots on 1 and 2 ranks in the canonical order: the same to %.1e (<= 1e-8)" % dev)
+    mu = "1.3,0.12"  # a corner of the box: a training point of the 2 x 2 grid
+    run(args, 2, "online", opts + ["-rom", d + "/r2.h5", "-mu", mu, "-rom_reconstruct", d + "/rec.h5"])
+    run(args, 2, "fom", opts + ["-mu", mu, "-fom_output", d + "/fom.h5"])
+    with h5py.File(d + "/rec.h5", "r") as a, h5py.File(d + "/fom.h5", "r") as b:
+        r, f = np.array(a["fields/displacement"]), np.array(b["fields/displacement"])
+    err = np.linalg.norm(r - f) / np.linalg.norm(f)
+    check(err <= 1e-3, "P2: the reconstructed displacement at the training point mu = %s against the FOM's: %.1e (<= 1e-3; 0.13 before 2026-12-02)" % (mu, err))
+    p = run(args, 2, "validate", opts + ["-rom", d + "/r2.h5", "-test_size", "2", "-validate_repeat", "1", "-report", d + "/val.json"], expect_ok=False)
+    check(p.returncode == 0, "P2: validate runs (it crashed in the canonical order), exit %d" % p.returncode)
+    if p.returncode == 0:
+        t = report(d + "/val.json")["test"]
+        check(np.isfinite(t["max_rel_err_u"]) and t["max_rel_err_u"] < 1e-1, "P2 validate: max rel err u %.2e finite and < 0.1 (4 training points)" % t["max_rel_err_u"])
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit", "probe", "guards"])
+    ap.add_argument("check", choices=["pipeline", "bad_input", "infeasible", "half_disks", "eim_train", "eim_select", "files", "sphere_block3d", "residual", "estimate", "dual_select", "dual_refit", "probe", "guards", "p2"])
     ap.add_argument("--exe", required=True)
     ap.add_argument("--contact-terms-exe", help="tests/test_rom_contact_terms (sphere_block3d runs it on its ROM)")
     args = ap.parse_args()

@@ -34,7 +34,7 @@ PetscErrorCode CanonicalOrder::BuildDofs(const Elasticity &elas)
   DM           dm = elas.dm, cdm;
   PetscSection gsec, lsec, csec;
   Vec          coords;
-  PetscInt     pStart, pEnd, cStart, cEnd, n, dim = elas.dim;
+  PetscInt     pStart, pEnd, cStart, cEnd, vStart, vEnd, n, dim = elas.dim;
   const PetscScalar *xc;
 
   PetscFunctionBeginUser;
@@ -45,6 +45,7 @@ PetscErrorCode CanonicalOrder::BuildDofs(const Elasticity &elas)
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   {
     Vec g;
     PetscCall(DMGetGlobalVector(dm, &g));
@@ -59,12 +60,15 @@ PetscErrorCode CanonicalOrder::BuildDofs(const Elasticity &elas)
     PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
     PetscCall(PetscSectionGetOffset(gsec, p, &off)); // < 0: owned by another rank
     if (dof <= 0 || off < 0 || dof - cdof <= 0) continue; // not owned, or fully constrained
-    // point coordinates: mean of its vertices
+    // point coordinates: mean of its vertices. Only the vertices are asked: the coordinate section's chart holds them
+    // alone, and PETSc's optimized build read an edge's (P2) dof count and offset from outside it, garbage: a segfault
+    // or a node order that changed from run to run (a P2 ROM's fields 13 % off, exit 0; fixed 2026-12-02)
     PetscInt *closure = NULL, ncl, nvert = 0;
     PetscReal x[3] = {0, 0, 0};
     PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &closure));
     for (PetscInt k = 0; k < ncl; ++k) {
       PetscInt cd, co;
+      if (closure[2 * k] < vStart || closure[2 * k] >= vEnd) continue;
       PetscCall(PetscSectionGetDof(csec, closure[2 * k], &cd));
       if (!cd) continue;
       PetscCall(PetscSectionGetOffset(csec, closure[2 * k], &co));
@@ -72,6 +76,7 @@ PetscErrorCode CanonicalOrder::BuildDofs(const Elasticity &elas)
       ++nvert;
     }
     PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &closure));
+    PetscCheck(nvert > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "canonical order: mesh point %" PetscInt_FMT " holds dofs but no vertex with coordinates", p);
     for (PetscInt d = 0; d < dim; ++d) x[d] /= nvert;
     // body: any cell in the star of p
     PetscInt *star = NULL, nst, body = -1;
