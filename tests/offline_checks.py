@@ -442,7 +442,7 @@ def dualbasis_import(args):
 
 def greedy(args):
     d = workdir("rbc_off_")
-    base = ["-options_file", "runs/ring_on_block.opts", "-train_type", "greedy", "-greedy_candidates_size", "60", "-greedy_batch", "2", "-greedy_tol", "1e-12"]
+    base = ["-options_file", "runs/ring_on_block.opts", "-train_type", "greedy", "-greedy_candidates_size", "60", "-greedy_tol", "1e-12"]
 
     def off(np_, tag, budget, extra=()):
         c = ["mpirun", "-n", str(np_), args.exe, "offline"] + base + ["-greedy_max_solves", str(budget), "-rom", "%s/%s.h5" % (d, tag), "-report", "%s/%s.json" % (d, tag)] + list(extra)
@@ -452,8 +452,10 @@ def greedy(args):
             sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
         return report("%s/%s.json" % (d, tag))
 
-    r1, r2 = off(1, "g1", 6, ["-greedy_monitor"]), off(2, "g2", 6)
+    # the default batch (2) on 1 rank, given on 2: the same picks (the default was the number of groups of ranks, 1 here)
+    r1, r2 = off(1, "g1", 6, ["-greedy_monitor"]), off(2, "g2", 6, ["-greedy_batch", "2"])
     g1, g2 = r1["greedy"], r2["greedy"]
+    check(g1["batch"] == 2 and g2["batch"] == 2, "-greedy_batch: 2 by default on 1 rank (%d), as given on 2 (%d)" % (g1["batch"], g2["batch"]))
     for rd in g1["rounds"]:
         print("  round %d: %d solves, N %d, R %d, max indicator %.3e (residual %.3e, penetration %.3e), picked %s"
               % (rd["round"], rd["solves"], rd["N"], rd["R"], rd["max_indicator"], rd["max_residual"], rd["max_penetration"], rd["picked"]))

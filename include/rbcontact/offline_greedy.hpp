@@ -19,8 +19,8 @@
 namespace rbc {
 
 // -greedy_tol (1e-4): stop once the largest indicator over the candidates not solved is at most this;
-// -greedy_max_solves (100): FOM solves in all, initial set included; -greedy_batch (0: the number of
-// groups of ranks): parameters solved per round; -greedy_separation (2): the picks of one round lie at
+// -greedy_max_solves (100): FOM solves in all, initial set included; -greedy_batch (2; 0: the number of
+// groups of ranks, rank-dependent picks): parameters solved per round; -greedy_separation (2): the picks of one round lie at
 // least this many typical candidate spacings apart (unit box); -greedy_indicator residual|penetration|max|estimate
 // (residual: the penetration of the reduced constraint is bounded below by the dual basis' truncation,
 // which more snapshots do not lower; estimate: the online error estimate's raw u change, with -estimate, the
@@ -29,7 +29,7 @@ struct GreedyOptions {
   PetscReal tol        = 1e-4;
   GreedyCriterion criterion = GreedyCriterion::Residual;
   PetscInt  maxSolves  = 100;
-  PetscInt  batch      = 0;
+  PetscInt  batch      = 2; // (0, the number of groups of ranks, was the default: picks that depended on the rank count)
   PetscReal separation = 2;
   PetscBool monitor    = PETSC_FALSE;
   bool      sensitivities = false; // the snapshots carry their derivatives (OfflineSettings::sensitivities): the rounds' bases use them

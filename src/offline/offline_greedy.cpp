@@ -22,7 +22,7 @@ PetscErrorCode GreedyOptionsFromOptions(MPI_Comm comm, GreedyOptions *o)
   PetscOptionsBegin(comm, "greedy_", "Greedy training (offline -train_type greedy)", "rbcontact");
   PetscCall(PetscOptionsReal("-tol", "Stop once the largest indicator over the candidates is at most this", "", o->tol, &o->tol, NULL));
   PetscCall(PetscOptionsInt("-max_solves", "FOM solves in all (initial set included)", "", o->maxSolves, &o->maxSolves, NULL));
-  PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks)", "", o->batch, &o->batch, NULL));
+  PetscCall(PetscOptionsInt("-batch", "Parameters solved per round (0: the number of groups of ranks, whose picks then depend on the rank count)", "", o->batch, &o->batch, NULL));
   PetscCall(PetscOptionsReal("-separation", "Picks of one round at least this many candidate spacings apart", "", o->separation, &o->separation, NULL));
   { // a list option on a PetscInt: a PetscEnum may not hold 3 (UBSan: outside the range of PETSc's one-value enum type)
     PetscInt c = (PetscInt)o->criterion;
