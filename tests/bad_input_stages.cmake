@@ -140,3 +140,7 @@ rbc_bad_stage(contact_all_fixed "the contact surfaces have no free degree of fre
 rbc_bad_stage(moduli_apart "or moduli too far apart for double precision [(]-body_E from 1e-12 to 100[)]" fom -options_file runs/ring_on_block.opts -body_E 1e-12,100)
 # a gross initial overlap: the Kacanov failure now says the bodies overlapped before any load (the relaxation hint alone before)
 rbc_bad_stage(overlap_not_converged "the bodies overlapped before any load: [0-9]+ slave points inside the master, by up to 0[.]5" fom -options_file runs/ring_on_block.opts -mesh_geo_set g0=-0.5)
+# a list given with spaces (one quoted word): PETSc's "Input string 1.0 0.09 has no numeric value" named -mu_default, whose
+# value holds the first word, or no option at all (audit H, 2026-12-02)
+rbc_bad_stage(list_with_spaces "option -mu 1.0 0.09; a list takes commas, not spaces" fom -options_file runs/half_disks.opts -mu "1.0 0.09")
+rbc_bad_stage(list_with_spaces_body_E "option -body_E 15 15; a list takes commas, not spaces" fom -options_file runs/half_disks.opts -body_E "15 15")

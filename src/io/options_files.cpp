@@ -94,7 +94,12 @@ std::string OptionsHoldingValue(const char *mess)
 {
   std::string       m = mess ? mess : "", word;
   const std::string a = "Input string ", b = "Unknown logical value: ";
-  if (m.compare(0, a.size(), a) == 0) word = m.substr(a.size(), m.find(' ', a.size()) - a.size());
+  if (m.compare(0, a.size(), a) == 0) { // the value may hold spaces ("-mu '1.0 0.09'": the first word named -mu_default 1.0,0.09)
+    size_t e = std::string::npos;
+    for (const char *tail : {" has no ", " is out of "})
+      if (m.find(tail, a.size()) != std::string::npos) e = std::min(e, m.find(tail, a.size()));
+    word = m.substr(a.size(), (e == std::string::npos ? m.find(' ', a.size()) : e) - a.size());
+  }
   else if (m.compare(0, b.size(), b) == 0) word = m.substr(b.size());
   if (word.empty()) return "";
   std::string found;
@@ -106,7 +111,8 @@ std::string OptionsHoldingValue(const char *mess)
         break;
       }
   }
-  return found.empty() ? "" : " (option " + found + ")";
+  const std::string spaces = word.find(' ') != std::string::npos ? "; a list takes commas, not spaces" : "";
+  return found.empty() ? (spaces.empty() ? "" : " (" + spaces.substr(2) + ")") : " (option " + found + spaces + ")";
 }
 
 PetscErrorCode CheckListEntries(MPI_Comm comm)
