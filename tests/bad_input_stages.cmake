@@ -144,3 +144,5 @@ rbc_bad_stage(overlap_not_converged "the bodies overlapped before any load: [0-9
 # value holds the first word, or no option at all (audit H, 2026-12-02)
 rbc_bad_stage(list_with_spaces "option -mu 1.0 0.09; a list takes commas, not spaces" fom -options_file runs/half_disks.opts -mu "1.0 0.09")
 rbc_bad_stage(list_with_spaces_body_E "option -body_E 15 15; a list takes commas, not spaces" fom -options_file runs/half_disks.opts -body_E "15 15")
+# the relaxation hint with a relaxation in use: half of it (it repeated "try -kacanov_relaxation 0.5" with 0.5 given; audit H)
+rbc_bad_stage(kacanov_relaxation_hint "try -kacanov_relaxation 0.25 [(]0.5 in use[)]" fom -options_file runs/ring_on_block.opts -kacanov_max_it 2 -kacanov_relaxation 0.5)

@@ -103,7 +103,11 @@ std::string KacanovLoop::NotConverged(bool withHistory, const std::string &cause
   const std::string  p = "-" + prefix_ + "kacanov_";
   std::ostringstream o;
   o << label << " iterations did not converge in " << maxIt << " iterations (" << p << "max_it; tolerances " << p << "rtol_primal " << rtolPrimal << ", " << p << "rtol_dual " << rtolDual;
-  if (relaxationHint) o << "; try " << p << "relaxation 0.5";
+  // (it said "try ...relaxation 0.5" with 0.5 in use)
+  if (relaxationHint) {
+    o << "; try " << p << "relaxation " << 0.5 * relaxation;
+    if (relaxation < 1) o << " (" << relaxation << " in use)";
+  }
   o << ")";
   if (!history.du.empty()) o << "; last changes du " << history.du.back() << ", dlambda " << history.dl.back();
   PetscInt from = 0;
