@@ -345,7 +345,7 @@ def bases_warnings(args):
     check(p.returncode != 0 and "the dual basis is empty: the tolerance 10" in p.stdout and "-dual_tol" in p.stdout and "supremizers" not in p.stdout,
           "an absolute -dual_tol above every snapshot: refused naming -dual_tol (2 ranks)")
     p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ok.snapshots.h5:/snapshots/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    check(p.returncode != 0 and "is a dataset of the rbcontact snapshot file" in p.stdout, "dualbasis on s.h5:/snapshots/lambda: refused, naming the file form")
+    check(p.returncode != 0 and "names a dataset in the rbcontact snapshot file" in p.stdout, "dualbasis on s.h5:/snapshots/lambda: refused, naming the file form")
     p = subprocess.run(["/usr/bin/python3", "share/plot_fields.py", d + "/view.h5", "-o", d + "/view.png"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "is a basis view" in p.stdout and not os.path.exists(d + "/view.png"), "plot_fields.py on a basis view: refused, no picture")
 

@@ -658,7 +658,7 @@ PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatr
       PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
       const PetscErrorCode e = SnapshotFile::ReadHeader(s.substr(0, colon), &h);
       PetscCall(PetscPopErrorHandler());
-      PetscCheck(e != 0, comm, PETSC_ERR_USER_INPUT, "dualbasis: %s is a dataset of the rbcontact snapshot file %s: give the file itself (-snapshots %s), whose finished rows are read as snapshots", s.c_str(), s.substr(0, colon).c_str(), s.substr(0, colon).c_str());
+      PetscCheck(e != 0, comm, PETSC_ERR_USER_INPUT, "dualbasis: %s names a dataset in the rbcontact snapshot file %s: give the file itself (-snapshots %s), whose finished rows are read as snapshots", s.c_str(), s.substr(0, colon).c_str(), s.substr(0, colon).c_str());
     }
     PetscCall(ImportSnapshotMatrix(comm, s, &cols));
   }
