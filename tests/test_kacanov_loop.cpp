@@ -7,7 +7,7 @@
 //   3. max_it 1 is the linearized model (converged after one iterate); a loop that runs out of iterations
 //      reports it with the option names and the history;
 //   4. the options: -t_kacanov_max_it, _anderson, _relaxation read with the prefix; out-of-range values refused;
-//   5. Cycle: the period and start of a cycle the history ends in, and the message naming it.
+//   5. Cycle: the period and start of a cycle the history ends in, and the message naming it; a stall named too.
 #include "rbcontact/kacanov_loop.hpp"
 #include <petscblaslapack.h>
 #include <cmath>
@@ -212,6 +212,19 @@ int main(int argc, char **argv)
     Check(loop.Cycle() == 0, "the same history with another active count at the last iterate: no cycle", (double)loop.Cycle(), 0);
     PetscCall(record(loop, std::vector<double>(du.end() - 8, du.end()), std::vector<double>(dl.end() - 8, dl.end()), std::vector<PetscInt>(8, 7)));
     Check(loop.Cycle() == 0, "8 iterates of a period-3 cycle (fewer than three periods): not called one", (double)loop.Cycle(), 0);
+    // a stall that is not periodic to 1e-6 (half_disks's ROM of 6 training points at one parameter: du 5.7e-5 for 20
+    // iterates, broken once; no word before 2026-12-02), named; a linear approach at rate 0.8 is not
+    std::vector<double> ds, ls;
+    for (int k = 0; k < 30; ++k) {
+      ds.push_back(k == 24 || k == 25 ? 2.772e-5 : 5.675e-5 * (1 + 1e-4 * (k % 2)));
+      ls.push_back(4.94e-4);
+    }
+    PetscCall(record(loop, ds, ls, std::vector<PetscInt>(30, 3)));
+    Check(loop.Cycle() == 0 && loop.NotConverged(false).find("the primal change stalls between") != std::string::npos, "a stall without a period: named as a stall", 0, 0);
+    std::vector<double> dr(30);
+    for (int k = 0; k < 30; ++k) dr[k] = 1e-2 * std::pow(0.8, k);
+    PetscCall(record(loop, dr, std::vector<double>(30, 1e-3), std::vector<PetscInt>(30, 3)));
+    Check(loop.NotConverged(false).find("stalls") == std::string::npos, "a linear approach at rate 0.8: not called a stall", 0, 0);
   }
   {
     // the dual change against multipliers the loop did not compute (a warm start's): recorded, not tested

@@ -44,7 +44,8 @@ public:
   // when next differs from g (a mix was used).
   bool Next(const PetscReal *x, const PetscReal *g, PetscReal *next);
   // "did not converge in ... iterations (options); last changes ..." with the history when withHistory; when the
-  // history ends in a cycle (Cycle), the message says so.
+  // history ends in a cycle (Cycle), the message says so; otherwise when the primal change of the last 10 iterates stalls
+  // (the mean of the last 5 at least 0.9 of the 5 before, all above rtol_primal), it says that.
   // cause: appended to the summary, before the history (e.g. the initial overlap the FOM measured); relaxationHint false
   // when the cause is known not to be the fixed point's (a QP that was not solved): no "try -kacanov_relaxation 0.5"
   std::string NotConverged(bool withHistory, const std::string &cause = "", bool relaxationHint = true) const;

@@ -114,6 +114,13 @@ std::string KacanovLoop::NotConverged(bool withHistory, const std::string &cause
   if (const PetscInt per = Cycle(&from)) {
     o << "; the changes repeat with period " << per << " from iterate " << from << ": a cycle, not a slow approach, so more iterations do not help";
     if (relaxationHint) o << " (a smaller " << p << "relaxation may; for a reduced model, a cycle that damping does not remove says the training set does not resolve this parameter)";
+  } else if (history.du.size() >= 10) { // not periodic to 1e-6, but not going down either (half_disks's ROM at du 5.7e-5 for 20 iterates: no word)
+    const auto      last = history.du.end() - 10, mid = history.du.end() - 5;
+    const PetscReal lo = *std::min_element(last, history.du.end()), hi = *std::max_element(last, history.du.end());
+    PetscReal       before = 0, after = 0; // the means of the last 5 and the 5 before: a linear rate of 0.98 or worse
+    for (auto it = last; it != mid; ++it) before += *it;
+    for (auto it = mid; it != history.du.end(); ++it) after += *it;
+    if (lo > rtolPrimal && after >= 0.9 * before) o << "; the primal change stalls between " << lo << " and " << hi << " over the last 10 iterations: not a slow approach, so more iterations do not help (for a reduced model: the training set does not resolve this parameter)";
   }
   o << cause;
   if (withHistory) {
