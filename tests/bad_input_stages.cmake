@@ -146,3 +146,5 @@ rbc_bad_stage(list_with_spaces "option -mu 1.0 0.09; a list takes commas, not sp
 rbc_bad_stage(list_with_spaces_body_E "option -body_E 15 15; a list takes commas, not spaces" fom -options_file runs/half_disks.opts -body_E "15 15")
 # the relaxation hint with a relaxation in use: half of it (it repeated "try -kacanov_relaxation 0.5" with 0.5 given; audit H)
 rbc_bad_stage(kacanov_relaxation_hint "try -kacanov_relaxation 0.25 [(]0.5 in use[)]" fom -options_file runs/ring_on_block.opts -kacanov_max_it 2 -kacanov_relaxation 0.5)
+# a ROM of a nodal-collocation FOM: the reduced contact terms are the Gauss rule's (another contact model, exit 0; audit I)
+rbc_bad_stage(offline_nodal "-contact_quadrature nodal: the reduced model evaluates the contact terms with the segment-based Gauss rule" offline -options_file runs/ring_on_block.opts -contact_quadrature nodal -train_size 3 -rom /tmp/rbc_never.h5)

@@ -388,6 +388,11 @@ def bad_input(args):
     expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")
     # scene options that contradict the ROM were ignored without a word (the ROM's own answer, exit 0; audit 2026-11-29)
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-body_E", "200,100"], ["option -body_E is a scene option", "-options_file runs/<scene>.opts"], "online -body_E without the scene")
+    # the contact discretization's options are scene options too (they were "not used (misspelled?)", exit 0; audit I)
+    for o, v in (("-contact_normal", "facet"), ("-contact_multiplier", "standard"), ("-contact_quadrature_points", "2")):
+        expect_error(args, ["-rom", rom, "-mu", "1.02", o, v], ["option %s is a scene option" % o], "online %s without the scene" % o)
+    # -rom_reconstruct without the scene: said (it blamed -mu: "the scene declares no parameters")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_reconstruct", d + "/nosc.h5"], ["-rom_reconstruct", "writes the fields on the scene's mesh"], "online -rom_reconstruct without the scene")
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts", "-body_E", "200,100"], ["was built for another configuration of scene 'ring_on_block'"],
                  "online with the scene's options and another -body_E")
     run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-options_file", "runs/ring_on_block.opts"])  # the scene it was built with: accepted

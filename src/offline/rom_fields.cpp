@@ -69,8 +69,9 @@ PetscErrorCode CheckRomScene(MPI_Comm comm, const std::string &romPath, const Sc
 
 PetscErrorCode CheckSceneOptions(MPI_Comm comm, const std::string &stage, const std::string &romPath)
 {
+  // (-contact_normal, -contact_multiplier, -contact_quadrature* were "not used (misspelled?)" until 2026-12-02: they enter the scene hash)
   static const char *const sceneFamilies[] = {"-scene", "-bodies", "-body_", "-mesh_file", "-mesh_refine", "-mesh_clscale", "-mesh_geo_set", "-dirichlet", "-traction", "-contact_slave",
-                                              "-contact_master", "-mu_names", "-mu_min", "-mu_max", "-mu_default", "-mu_geo_set", "-map_", "-fem_degree", "-param_"};
+                                              "-contact_master", "-contact_normal", "-contact_multiplier", "-contact_quadrature", "-mu_names", "-mu_min", "-mu_max", "-mu_default", "-mu_geo_set", "-map_", "-fem_degree", "-param_"};
   std::string first;
   char        sceneName[256] = "";
   PetscBool   hasScene       = PETSC_FALSE;
@@ -316,6 +317,11 @@ PetscErrorCode ReconstructFields(MPI_Comm comm, const ReducedModel &model, const
   ContactSystem  sys;
 
   PetscFunctionBeginUser;
+  { // without the scene, SceneSpecFromOptions blamed -mu ("the scene declares no parameters") or the mesh
+    PetscBool hasMesh = PETSC_FALSE;
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-mesh_file", &hasMesh));
+    PetscCheck(hasMesh, comm, PETSC_ERR_USER_INPUT, "-rom_reconstruct %s writes the fields on the scene's mesh: give the scene's options the ROM was built with (-options_file runs/<scene>.opts; the ROM file holds no mesh)", path.c_str());
+  }
   PetscCall(SceneSpecFromOptions(comm, &scene));
   PetscCall(SceneOfRom(comm, scene, model, mu, "-rom_reconstruct", &fom, &order, &bases, &cmap));
   PetscCall(bases.Displacement(model, order, sol.v, fom.u));

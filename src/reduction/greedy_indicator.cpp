@@ -29,11 +29,14 @@ PetscErrorCode GreedyIndicator::Setup(ElasticFOM &fom)
   PetscCall(KSPSetType(ksp_, KSPPREONLY));
   PetscCall(KSPGetPC(ksp_, &pc));
   PetscCall(PCSetType(pc, PCCHOLESKY));
-  { // one rank: PETSc's Cholesky in nested dissection order (half_disks, 11,514 dofs: 0.7 ms a solve against
-    // 3.4 ms with MUMPS, whose single right-hand-side solve dominated the indicator); several: MUMPS
+  { // one rank, 2D: PETSc's Cholesky in nested dissection order (half_disks, 11,514 dofs: 0.7 ms a solve against
+    // 3.4 ms with MUMPS, whose single right-hand-side solve dominated the indicator); several ranks, or 3D: MUMPS
+    // (PETSc's symbolic and numeric Cholesky of sphere_block3d with P2, 55k dofs, took 194 s against MUMPS's 6 s)
     PetscMPIInt size;
+    PetscInt    dim;
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)fom.dm), &size));
-    if (size == 1) PetscCall(PCFactorSetMatOrderingType(pc, MATORDERINGND));
+    PetscCall(DMGetDimension(fom.dm, &dim));
+    if (size == 1 && dim == 2) PetscCall(PCFactorSetMatOrderingType(pc, MATORDERINGND));
     else PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   }
   PetscCall(KSPSetOperators(ksp_, X_, X_));
