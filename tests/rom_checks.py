@@ -1020,6 +1020,10 @@ def residual(args):
 def estimate(args):
     """offline -estimate: enrichment, calibration, the online estimate and its effectivity (docs/error_estimate.md)."""
     d = tempfile.mkdtemp(prefix="rbc_rom_est_")
+    # a training set too small for an enrichment: said (the ROM had no estimate, without a word; audit I)
+    p = run(args, 1, "offline", ["-options_file", "runs/ring_on_block.opts", "-train_size", "4", "-estimate", "-offline_probe", "0", "-rom", d + "/small.h5", "-report", d + "/small.json"])
+    check("warning: -estimate: the bases hold no function beyond the answer's" in p.stdout and report(d + "/small.json")["estimate"]["enrichment"] is False,
+          "offline -estimate on 4 training radii: no enrichment, and a warning saying so")
     roms, offs = {}, {}
     for np_ in (1, 2):
         os.makedirs("%s/%d" % (d, np_))

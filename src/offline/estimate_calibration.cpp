@@ -36,6 +36,8 @@ PetscErrorCode CalibrateErrorEstimate(MPI_Comm world, const SceneSpec &scene, co
   PetscCall(RomReadOptional(romPath, "/online/estimate/default_sizes", &sizes, &has));
   JsonValue &e = rep->root["estimate"];
   e["enrichment"] = (bool)has;
+  // (a small training set left nothing beyond the answer's bases: no estimate, without a word; audit I)
+  if (!has) PetscCall(PetscPrintf(world, "rbcontact offline: warning: -estimate: the bases hold no function beyond the answer's (every POD mode within -estimate_pod_tol and every dual vector within -estimate_dual_tol is the answer's, or -pod_n fixes N), so the ROM %s has no online error estimate: use more training parameters, or a smaller -estimate_pod_tol / -estimate_dual_tol (docs/error_estimate.md)\n", romPath.c_str()));
   if (has && n == 0) PetscCall(PetscPrintf(world, "rbcontact offline: warning: -estimate_calibration_size 0: the online error estimate is not calibrated (scale 1, floor 0): a raw residual-based indicator, not a bound (docs/error_estimate.md)\n"));
   if (!has || n == 0) PetscFunctionReturn(0); // nothing to calibrate (the bases need every basis function) or not asked
 
