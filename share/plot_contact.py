@@ -5,7 +5,7 @@ Reads the /contact group that `rbcontact fom -fom_output f.h5` writes when conta
   /contact/lambda    (R)  nodal contact pressure of each slave vertex (coefficient of the hat
                           function psi_i; lambda >= 0, > 0 on the active nodes)
   /contact/weight    (R)  int psi_i over the slave surface (resultant = sum lambda_i weight_i n_i)
-  /contact/x, /contact/y  reference coordinates of the slave vertices
+  /contact/x, /contact/y  the slave vertices' undeformed positions at the run's mu (the geometric map applied)
 and plots lambda against the position along the slave surface (x by default, sorted), markers +
 line, with the active nodes (lambda > --active-tol) highlighted. 3D slave surfaces (/contact/z present):
 by default against r, the distance to the pressure centroid in the plane normal to the resultant (a
@@ -102,7 +102,7 @@ def main(argv=None):
     p.add_argument("-o", "--output", help="PNG to write (default: <h5 without .h5>_pressure.png)")
     p.add_argument("--title", default=None, help="scene name shown in the title (default: file name)")
     p.add_argument("--coord", choices=("x", "y", "r"), default=None,
-                   help="abscissa: a reference coordinate of the slave vertices (x, y; default x in 2D) or, in 3D, r "
+                   help="abscissa: an undeformed coordinate (at the run's mu) of the slave vertices (x, y; default x in 2D) or, in 3D, r "
                         "(the default there): the distance to the pressure centroid in the plane normal to the "
                         "resultant, with a second panel showing the pressure on that plane")
     p.add_argument("--hertz-a", type=float, default=None, help="Hertz contact half-width a (overlay)")
@@ -187,8 +187,8 @@ def main(argv=None):
         ax.set_xlim(max(lo, float(s.min()) - 0.02 * width), min(hi, float(s.max()) + 0.02 * width))
     ax.set_ylim(bottom=0.0, top=1.12 * max(pmax, hp0 or 0.0, 1e-300))
     ax.axhline(0.0, color="0.6", linewidth=0.6, zorder=1)
-    ax.set_xlabel("%s (reference position of the slave vertex)" % coord if plane is None else
-                  "r: distance to the pressure centroid in the contact plane (reference positions)")
+    ax.set_xlabel("%s (undeformed position of the slave vertex at this mu)" % coord if plane is None else
+                  "r: distance to the pressure centroid in the contact plane (undeformed positions)")
     if plane is not None:
         sc = axp.scatter(plane[0], plane[1], c=lam, s=6, cmap="viridis", vmin=0.0)
         if ha is not None:
