@@ -191,6 +191,23 @@ int main(int argc, char **argv)
     } else Check(info.kept < r, "ratio 0.5: fewer directions than supremizers", (double)info.kept, (double)r);
     PetscCall(BVDestroy(&out));
   }
+  { // a supremizer in span V up to 2e-8 of its norm (rounding: the Gram eigenvalues' noise is eps |G|, sqrt(eps) ~ 1.5e-8):
+    // not a direction. The cut was 1e-9 until 2026-12-02: such a direction was kept on 1 rank and dropped on 2 (audit I)
+    std::vector<Vec> sup2(r);
+    PetscReal        s0;
+    PetscCall(VecNorm(sup[0], NORM_2, &s0));
+    for (PetscInt k = 0; k < r; ++k) PetscCall(VecDuplicate(sup[k], &sup2[k]));
+    for (PetscInt k = 0; k + 1 < r; ++k) PetscCall(VecCopy(sup[k], sup2[k]));
+    for (PetscInt d = lo; d < hi; ++d) PetscCall(VecSetValue(sup2[r - 1], d, s0 * V0[d] + (d == 0 ? 2e-8 * s0 : 0.0), INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(sup2[r - 1]));
+    PetscCall(VecAssemblyEnd(sup2[r - 1]));
+    BV                        out;
+    rbc::SupremizerEnrichment info;
+    PetscCall(rbc::EnrichWithSupremizers(pod, sup2, snaps, W, canonical, 1.0, &out, &info));
+    Check(info.rank == r - 1, "a supremizer in span V up to 2e-8 of its norm: not counted (rank r - 1)", (double)info.rank, (double)(r - 1));
+    PetscCall(BVDestroy(&out));
+    for (auto &v : sup2) PetscCall(VecDestroy(&v));
+  }
   for (auto &v : sup) PetscCall(VecDestroy(&v));
   PetscCall(BVDestroy(&pod));
   PetscCall(VecDestroy(&tmpl));

@@ -89,11 +89,13 @@ PetscErrorCode EnrichWithSupremizers(BV pod, const std::vector<Vec> &sup, const 
   PetscCall(MatDestroy(&G));
   PetscCallMPI(MPI_Bcast(g.data(), (int)g.size(), MPIU_REAL, 0, comm));
   PetscCall(SymmetricEigen(r, true, &g, &ev));
-  // descending; directions below 1e-9 of the largest supremizer are rounding (already in span V)
+  // descending; directions below 1e-7 of the largest supremizer are rounding (already in span V): the Gram matrix's
+  // eigenvalues carry errors of eps |G|, so a singular value below sqrt(eps) ~ 1.5e-8 of the largest is noise. (The
+  // cut was 1e-9: a direction of 1.1e-8 was kept on 1 rank and dropped on 2, another ROM; audit I, 2026-12-02.)
   PetscInt q = 0;
   for (PetscInt i = r - 1; i >= 0; --i) {
     const PetscReal s = std::sqrt(std::max<PetscReal>(ev[i], 0));
-    if (!(s > 1e-9 * smax)) break;
+    if (!(s > 1e-7 * smax)) break;
     info->sigma.push_back(s);
     ++q;
   }
