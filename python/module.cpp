@@ -20,7 +20,10 @@
 #include <slepcsys.h>
 #include <limits>
 #include <memory>
+#include <cxxabi.h>
 #include <mutex>
+#include <type_traits>
+#include <unistd.h>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -54,12 +57,36 @@ void Check(PetscErrorCode ierr)
 // deadlock.
 std::mutex libraryMutex;
 
+// The GIL is taken back in the function's body, never in a destructor: a daemon thread that asks for it while the
+// interpreter finalizes is ended by pthread_exit, whose forced unwind out of a destructor (pybind11's
+// gil_scoped_release) was std::terminate, SIGABRT at the exit (audit J, 2026-12-02). During finalization the thread
+// does not take it back at all: it waits for the process to end.
 template <class F>
 auto Serialized(F &&f) -> decltype(f())
 {
-  py::gil_scoped_release      nogil;
-  std::lock_guard<std::mutex> lock(libraryMutex); // released before the GIL is taken again
-  return f();
+  PyThreadState *ts      = PyEval_SaveThread();
+  auto           restore = [ts] {
+    while (_Py_IsFinalizing()) pause(); // the process is exiting: this (daemon) thread must not run Python again
+    PyEval_RestoreThread(ts);
+  };
+  try {
+    std::unique_lock<std::mutex> lock(libraryMutex); // released before the GIL is taken again
+    if constexpr (std::is_void_v<decltype(f())>) {
+      f();
+      lock.unlock();
+      restore();
+    } else {
+      auto r = f();
+      lock.unlock();
+      restore();
+      return r;
+    }
+  } catch (abi::__forced_unwind &) {
+    throw; // the thread is being ended (by restore): let it go
+  } catch (...) {
+    restore(); // the mutex was released by the unwinding
+    throw;
+  }
 }
 
 void Warn(PyObject *category, const std::string &message)
@@ -418,8 +445,12 @@ std::string RunStage(const std::string &stage, const std::vector<std::string> &o
 
 // A ROM file opened (Python's ReducedModel(file)); the first one also says which options of initialize() nobody read
 // (misspelled: -rom_kacanov_monitr), as the command line's online stage does.
-std::unique_ptr<Model> OpenModel(const std::string &file)
+std::unique_ptr<Model> OpenModel(py::object path)
 {
+  // a str or an os.PathLike (pathlib.Path was a TypeError); a NUL character refused (the path was cut there: another file
+  // opened without a word; audit J)
+  const std::string file = py::str(py::module_::import("os").attr("fsdecode")(path));
+  if (file.find('\0') != std::string::npos) throw std::runtime_error("rbcontact.ReducedModel: the file name '" + Shown(file) + "' holds a NUL character");
   Start();
   std::vector<std::string> unused;
   auto                     model = Serialized([&] {

@@ -118,6 +118,10 @@ def main():
 
         missing = os.path.join(d, "nonexistent.h5")
         raises(lambda: rbcontact.ReducedModel(missing), [missing], "a missing ROM file")
+        # a pathlib.Path (a TypeError) and a name with a NUL character (cut there: the file before it opened; audit J)
+        import pathlib
+        check(rbcontact.ReducedModel(pathlib.Path(rom)).solve([1.02]).contact_force == m.solve([1.02]).contact_force, "ReducedModel(pathlib.Path): the same model")
+        raises(lambda: rbcontact.ReducedModel(rom + "\0garbage"), ["holds a NUL character"], "a ROM file name with a NUL character")
         raises(lambda: m.solve([1.3]), ["radius", "1.3"], "a radius outside the box")
         raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["contact_forces: row 1", "radius"], "a radius outside the box in contact_forces (the row named, not -mu)")
         raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
@@ -164,6 +168,12 @@ def main():
         check(len(warned) == 1 and warned[0].count("was not used") == 1 and "rbcontact.initialize: option -rom_kacanov_monitr was not used" in warned[0],
               "initialize() with a misspelled option: one UserWarning naming it, at the first model only (%s)" % (warned[0][:120] if warned else out[-300:]))
         check("NUL: rbcontact.initialize: option -rom_R '2\\0x': a NUL character in the value" in out, "initialize() with a NUL character: refused naming the option")
+        # a daemon thread inside solve when the interpreter exits: a clean exit (pybind11's GIL guard took the GIL back in
+        # a destructor, and the thread's forced unwind there was std::terminate: SIGABRT, exit 134; audit J)
+        codes = [fresh("import rbcontact, threading, time\nm = rbcontact.ReducedModel(%r)\n"
+                       "def bg():\n    while True: m.solve([1.02])\n"
+                       "threading.Thread(target=bg, daemon=True).start(); time.sleep(0.2); print('main done')" % rom)[0] for _ in range(3)]
+        check(codes == [0, 0, 0], "a daemon thread solving while the interpreter exits: exit codes %s (0)" % codes)
         # integer options beyond 32 bits (PETSc casts them: -rom_N 4294967297 ran with N 1), as the executable refuses them
         rc, out = fresh("import rbcontact; rbcontact.initialize(['-rom_N', '4294967297'])\n"
                         "try:\n    rbcontact.ReducedModel(%r); print('accepted')\nexcept RuntimeError as e:\n    print('refused:', e)" % rom)
