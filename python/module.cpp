@@ -216,6 +216,7 @@ struct Solution {
   // the online error estimate (docs/error_estimate.md): estimated relative errors, nan when the ROM file has none
   double              estU = std::numeric_limits<double>::quiet_NaN(), estLambda = std::numeric_limits<double>::quiet_NaN(), estForce = std::numeric_limits<double>::quiet_NaN();
   std::string         message;
+  PetscInt            outOfRange = 0; // contact projections at the edge of the stored contact data (the command line warns)
 };
 
 py::array_t<double> Array(const std::vector<PetscReal> &x)
@@ -295,7 +296,10 @@ public:
         s.estForce  = sol.estimate.force;
       }
     }
-    s.message = sol.message;
+    s.message    = sol.message;
+    s.outOfRange = sol.outOfRange;
+    // (said by the command line's online, silent here until 2026-12-02; audit J)
+    if (sol.converged && sol.outOfRange > 0) Warn(PyExc_RuntimeWarning, "rbcontact: " + std::to_string((long long)sol.outOfRange) + " contact projections fell at the edge of the stored contact data (outside the training range): the answer may be wrong; more -eim_patch_rings offline, or training parameters near this one (Solution.out_of_range)");
     return s;
   }
 
@@ -311,6 +315,7 @@ public:
     py::array_t<double> out(n);
     const double       *in = mus.data(); // C-contiguous (RealArray), n x np; both arrays stay alive through the call
     double             *o  = out.mutable_data();
+    py::ssize_t         edgeRows = 0, firstEdge = -1;
     Serialized([&] {
       std::vector<PetscReal> m(np);
       rbc::ReducedSolution   sol;
@@ -323,8 +328,10 @@ public:
           if (!nanOnFailure) throw std::runtime_error("contact_forces: the reduced model did not converge at row " + std::to_string((long long)k) + ": " + sol.message);
           o[k] = std::numeric_limits<double>::quiet_NaN();
         } else o[k] = sol.ForceMagnitude();
+        if (sol.converged && sol.outOfRange > 0 && edgeRows++ == 0) firstEdge = k;
       }
     });
+    if (edgeRows > 0) Warn(PyExc_RuntimeWarning, "rbcontact: contact_forces: at " + std::to_string((long long)edgeRows) + " row(s) (first: row " + std::to_string((long long)firstEdge) + ") contact projections fell at the edge of the stored contact data: those forces may be wrong (solve() gives Solution.out_of_range per point)");
     return out;
   }
 
@@ -498,6 +505,7 @@ PYBIND11_MODULE(_rbcontact, m)
     .def_readonly("converged", &Solution::converged)
     .def_readonly("iterations", &Solution::iterations, "reduced Kacanov iterations")
     .def_readonly("message", &Solution::message, "why the solve failed (empty on success)")
+    .def_readonly("out_of_range", &Solution::outOfRange, "contact projections at the edge of the stored contact data (> 0: the answer may be wrong; a RuntimeWarning says so)")
     .def("__repr__", [](const Solution &s) { return "<rbcontact.Solution converged=" + std::string(s.converged ? "True" : "False") + " iterations=" + std::to_string((long long)s.iterations) + " contact_force=" + std::to_string(s.contactForce) + ">"; });
   py::class_<Model>(m, "ReducedModel", "A ROM file opened for online solves (rbc::ReducedModel)")
     .def(py::init(&OpenModel), py::arg("file"))

@@ -187,6 +187,22 @@ def main():
         check(rc == 0 and "RuntimeWarning: rbcontact: PETSc was loaded before this module" in out and "opened" in out,
               "PETSc loaded before the module: a RuntimeWarning that integer options are not range-checked (exit %d)" % rc)
         check(np.allclose(m.contact_forces(radii[:3], nan_on_failure=True), forces[:3], rtol=0, atol=0), "nan_on_failure: the same forces where every solve converges")
+        # contact projections at the edge of the stored data (a half_disks ROM of 2 x 2 points): the command line warns, and
+        # so do solve() and contact_forces(), with Solution.out_of_range (silent before; audit J)
+        run(args.exe, 1, ["offline", "-options_file", "runs/half_disks.opts", "-train_size", "2,2", "-offline_probe", "0", "-rom", d + "/hd22.h5"])
+        import warnings
+        hd = rbcontact.ReducedModel(d + "/hd22.h5")
+        edge = [0.86064982349869057, 0.063233953393474707]
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            se = hd.solve(edge)
+            hd.contact_forces(np.array([edge, edge]))
+        msgs = [str(x.message) for x in w if issubclass(x.category, RuntimeWarning)]
+        check(se.converged and se.out_of_range > 0 and len(msgs) == 2 and "fell at the edge of the stored contact data" in msgs[0] and "at 2 row(s)" in msgs[1],
+              "projections at the edge of the stored data: out_of_range %d and a RuntimeWarning from solve() and contact_forces() (%s)" % (se.out_of_range, [x[:60] for x in msgs]))
+        cli = run(args.exe, 1, ["online", "-rom", d + "/hd22.h5", "-mu", "%.17g,%.17g" % tuple(edge)])
+        check("%d contact projections fell at the edge" % se.out_of_range in cli, "the command line's online counts the same %d projections" % se.out_of_range)
+        del hd
 
         # the offline and validate stages from Python, against the command line with the same options
         pyrom, clirom = d + "/py5.h5", d + "/cli5.h5"
