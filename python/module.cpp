@@ -274,7 +274,7 @@ public:
     rbc::ReducedSolution         sol;
     rbc::SurfaceOutputValues     so;
     Serialized([&] {
-      Check(model_.par.CheckBox(PETSC_COMM_SELF, m)); // a clear error naming the parameter, its value and the box
+      Check(model_.par.CheckBox(PETSC_COMM_SELF, m, "solve")); // a clear error naming the parameter, its value and the box (it blamed -mu)
       Check(model_.Solve(m, &sol));
       if (sol.converged) model_.SurfaceOutputsOf(m, sol, &so);
     });

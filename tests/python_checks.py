@@ -122,7 +122,7 @@ def main():
         import pathlib
         check(rbcontact.ReducedModel(pathlib.Path(rom)).solve([1.02]).contact_force == m.solve([1.02]).contact_force, "ReducedModel(pathlib.Path): the same model")
         raises(lambda: rbcontact.ReducedModel(rom + "\0garbage"), ["holds a NUL character"], "a ROM file name with a NUL character")
-        raises(lambda: m.solve([1.3]), ["radius", "1.3"], "a radius outside the box")
+        raises(lambda: m.solve([1.3]), ["solve: parameter 'radius' = 1.3 is outside its box"], "a radius outside the box (named as solve's, not -mu's)")
         raises(lambda: m.contact_forces(np.array([1.0, 1.2])), ["contact_forces: row 1", "radius"], "a radius outside the box in contact_forces (the row named, not -mu)")
         raises(lambda: m.contact_forces(np.zeros((3, 2))), ["(n, 1)"], "an array of the wrong shape")
         raises(lambda: rbcontact.initialize(["-rom_kacanov_monitor"]), ["already initialized"], "options after the first model")

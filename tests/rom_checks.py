@@ -383,7 +383,7 @@ def bad_input(args):
     # cancelled a file's -rom_N 3), a negative size meant the default, inf tolerances one iterate or no KKT check
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_N"], ["option -rom_N is given without a value"], "-rom_N without a value")
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_max_it"], ["option -rom_kacanov_max_it is given without a value"], "-rom_kacanov_max_it without a value")
-    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_R", "-5"], ["-rom_R -5: a size >= 0, or -1 for the file's default"], "-rom_R -5")
+    expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_R", "-5"], ["-rom_R -5: a size >= 1, or -1 for the file's default"], "-rom_R -5")
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kacanov_rtol_primal", "inf"], ["-rom_kacanov_rtol_primal (inf", "must be finite numbers > 0"], "-rom_kacanov_rtol_primal inf")
     expect_error(args, ["-rom", rom, "-mu", "1.02", "-rom_kkt_tol", "inf"], ["-rom_kkt_tol inf", "must be a finite number > 0"], "-rom_kkt_tol inf")
     expect_error(args, ["-rom", rom, "-mu"], ["-mu", "without a value"], "online -mu without a value")

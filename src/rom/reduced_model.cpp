@@ -562,8 +562,9 @@ PetscErrorCode ReducedModel::SetFromOptions()
   PetscCheck(warmDegree == 1 || warmDegree == 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_warm_start_degree %" PetscInt_FMT ": 1 (affine) or 2 (quadratic) expected", warmDegree);
   PetscCheck(kktTol > 0 && std::isfinite(kktTol), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_kkt_tol %g must be a finite number > 0", (double)kktTol);
   // -1 is the default; another negative size meant it too without a word
+  // (it said "a size >= 0" where 0 was refused next)
   for (const auto &o : {std::make_pair("-rom_N", n), std::make_pair("-rom_R", r), std::make_pair("-rom_Mk", mk), std::make_pair("-rom_Mg", mg)})
-    PetscCheck(o.second >= -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": a size >= 0, or -1 for the file's default", o.first, o.second);
+    PetscCheck(o.second >= -1, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "%s %" PetscInt_FMT ": a size >= 1, or -1 for the file's default", o.first, o.second);
   PetscCheck(threads >= 1 && threads <= 256, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_threads %" PetscInt_FMT " must be in [1, 256]", threads);
   // no EIM term at all is no contact term (Mk) or no gap (Mg): a converged answer without contact; the internal
   // callers (the EIM's size selection) may still truncate to 0
@@ -613,8 +614,9 @@ PetscErrorCode ReducedModel::Truncate(PetscInt n, PetscInt r, PetscInt mk, Petsc
   // (a file without an EIM said "out of range [0, 0]")
   PetscCheck(mk <= 0 || MkFull > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT ": the ROM file %s holds no EIM of kappa (its hyper-reduction is the cubature, -rom_hyper ecsw; its size is Mc, chosen offline)", mk, file.c_str());
   PetscCheck(mg <= 0 || MgFull > 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT ": the ROM file %s holds no EIM of the gap (its hyper-reduction is the cubature, -rom_hyper ecsw, or the gap is affine)", mg, file.c_str());
-  PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mk, MkFull);
-  PetscCheck(mg >= 0 && mg <= MgFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT " out of range [0, %" PetscInt_FMT "]", mg, MgFull);
+  // (the range said [0, M] where -rom_Mk 0 was refused as out of [1, M]; 0 stays for the internal callers)
+  PetscCheck(mk >= 0 && mk <= MkFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mk %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "]", mk, MkFull);
+  PetscCheck(mg >= 0 && mg <= MgFull, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-rom_Mg %" PetscInt_FMT " out of range [1, %" PetscInt_FMT "]", mg, MgFull);
   geomMu_.clear();
   cols_ = ReducedColumns(Npod, nsup, n, r);
   r_  = r;
