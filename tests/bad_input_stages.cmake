@@ -129,6 +129,11 @@ rbc_bad_stage(mesh_inf_coordinate "has non-finite node coordinates" fom -options
 rbc_bad_stage(bodies_twice "-bodies: the body 'ring' appears twice" fom -options_file runs/ring_on_block.opts -bodies ring,block,ring -body_E 100,100,50)
 # a generated mesh PETSc's reader refuses on rank 0 (a physical curve in no surface): "not a valid gmsh file?" on 1 rank,
 # a hang on 2 (the other rank waited in the reader); now named, and on 2 ranks ended by the failed rank's abort
+# a .geo that includes itself (through another file, three times: the mesh cache key read 3^16 files, a hang before gmsh
+# ran), and one whose Include'd file makes gmsh's parser give up (gmsh 4.8 then hung in 2 runs of 4: the stage waited
+# forever)
+rbc_bad_stage(geo_includes_itself "mesh '[^']*selfinc[.]geo' includes itself through Include or Merge [(]selfinc[.]geo -> selfinc_b[.]geo -> selfinc[.]geo[)]" fom -options_file runs/ring_on_block.opts -mesh_file @SELFINC_GEO@)
+rbc_bad_stage(geo_parser_gave_up "gmsh failed on '[^']*twice[.]geo' [(](it hung after its parser gave up, and was ended|killed by signal 6|exit code [1-9][0-9]*)[^)]*[)]: Error *: GEO point with tag 1 already exists" fom -options_file runs/ring_on_block.opts -mesh_file @TWICE_GEO@)
 rbc_bad_stage(generated_mesh_refused "PETSc's reader refused the mesh gmsh made of .*freecurve[.]geo" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@)
 rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this failure within 3 s" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@ -rbc_error_wait 3)
 # offline values that ran without a word: a negative number of groups (ran as 0), a greedy budget below its initial set

@@ -13,7 +13,9 @@
 # by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
 # @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
 # @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf;
-# @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface; @MIXED3D_GEO@ by a 3D mesh of tetrahedra and hexahedra.
+# @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface; @MIXED3D_GEO@ by a 3D mesh of tetrahedra and hexahedra;
+# @SELFINC_GEO@ by a .geo including, through a second file, itself three times; @TWICE_GEO@ by a .geo that includes
+# ring_on_block.geo twice (gmsh's parser gives up inside the Include, and gmsh 4.8 then hangs or aborts).
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -119,6 +121,14 @@ GEO
     { cat "$(dirname "$0")/../meshes/ring_on_block.geo"
       echo 'Point(301) = {-0.6,-0.001,0,0.0167}; Point(302) = {0.6,-0.001,0,0.0167}; Line(301) = {301,302}; Physical Curve("freeline",16) = {301};'; } > "$tmpdir/freecurve.geo"
     args+=("$tmpdir/freecurve.geo")
+  elif [ "$a" = "@SELFINC_GEO@" ]; then
+    printf 'lc = 0.1;\nInclude "selfinc_b.geo";\n' > "$tmpdir/selfinc.geo"
+    printf 'Include "selfinc.geo";\nInclude "selfinc.geo";\nInclude "selfinc.geo";\n' > "$tmpdir/selfinc_b.geo"
+    args+=("$tmpdir/selfinc.geo")
+  elif [ "$a" = "@TWICE_GEO@" ]; then
+    cp "$(dirname "$0")/../meshes/ring_on_block.geo" "$tmpdir/ring_on_block.geo"
+    printf 'Include "ring_on_block.geo";\nInclude "ring_on_block.geo";\n' > "$tmpdir/twice.geo"
+    args+=("$tmpdir/twice.geo")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

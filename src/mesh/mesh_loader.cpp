@@ -7,6 +7,8 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cstring>
 #include <cctype>
 #include <cmath>
@@ -15,7 +17,9 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <climits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -97,9 +101,22 @@ static bool EndsWith(const std::string &s, const std::string &suf) { return s.si
 
 // The text of a .geo and of every file it pulls in (Include "f", Merge "f", relative to the including file's directory,
 // recursively): the mesh cache key (an edited included file reused the stale mesh), and where -mesh_geo_set's names
-// are looked for. A file that cannot be read adds a mark only (gmsh then says what is wrong).
-static void GeoSources(const std::string &path, int depth, std::string *text)
+// are looked for. A file that cannot be read adds a mark only (gmsh then says what is wrong). Each file is read once
+// (seen, by its resolved path): a .geo that included itself several times took time and memory exponential in the
+// depth (3 self-includes: 3^16 reads, a hang before gmsh ran). A file that includes itself, directly or through
+// others (chain: the files being read), is an error, the chain in *cycle (gmsh said "Unable to open file").
+static void GeoSources(const std::string &path, std::vector<std::string> *chain, std::set<std::string> *seen, std::string *text, std::string *cycle)
 {
+  char              real[PATH_MAX];
+  const std::string id = realpath(path.c_str(), real) ? std::string(real) : path;
+  if (std::find(chain->begin(), chain->end(), id) != chain->end()) {
+    if (cycle->empty()) {
+      for (const auto &c : *chain) *cycle += (cycle->empty() ? "" : " -> ") + c.substr(c.find_last_of('/') + 1);
+      *cycle += " -> " + id.substr(id.find_last_of('/') + 1);
+    }
+    return;
+  }
+  if (!seen->insert(id).second) return; // (its text is in the key already)
   std::ifstream f(path);
   if (!f) {
     *text += "|unreadable";
@@ -110,15 +127,17 @@ static void GeoSources(const std::string &path, int depth, std::string *text)
   const std::string t   = all.str();
   const auto        cut = path.find_last_of('/');
   const std::string dir = cut == std::string::npos ? "" : path.substr(0, cut + 1);
-  *text += (depth ? "|include\n" : "") + t; // (not the paths: a clone elsewhere shares the cache)
-  if (depth >= 16) return;
+  *text += (chain->empty() ? "" : "|include\n") + t; // (not the paths: a clone elsewhere shares the cache)
+  if (chain->size() >= 16) return;
+  chain->push_back(id);
   for (const char *kw : {"Include", "Merge"})
     for (size_t at = t.find(kw); at != std::string::npos; at = t.find(kw, at + 1)) {
       const size_t q0 = t.find('"', at), q1 = q0 == std::string::npos ? q0 : t.find('"', q0 + 1);
       if (q1 == std::string::npos || t.find_first_not_of(" \t", at + std::strlen(kw)) != q0) continue;
       const std::string inc = t.substr(q0 + 1, q1 - q0 - 1);
-      GeoSources(!inc.empty() && inc[0] == '/' ? inc : dir + inc, depth + 1, text);
+      GeoSources(!inc.empty() && inc[0] == '/' ? inc : dir + inc, chain, seen, text, cycle);
     }
+  chain->pop_back();
 }
 
 // Whether the .geo sources assign the variable name (NAME = ... or a DefineConstant entry NAME = {...}): gmsh
@@ -135,26 +154,68 @@ static bool GeoAssigns(const std::string &text, const std::string &name)
   return false;
 }
 
-// Runs argv[0] with argv (no shell: the names and paths are passed as they are), its output to log; the exit code, or
-// -1 when it could not be started or did not exit.
-static int RunLogged(const std::vector<std::string> &args, const std::string &log)
+// How a child process ended (RunLogged).
+struct ChildEnd {
+  int  code   = -1;    // exit code, -1 when it did not exit normally
+  int  signal = 0;     // the signal that ended it
+  bool hung   = false; // still running 10 s after its log said its parser gave up: killed
+};
+
+// Whether the log holds gmsh's last parser error: gmsh 4.8, aborting its parser inside an Include'd file, may close a
+// file twice and then wait forever on the stdio lock (measured: a .geo including ring_on_block.geo twice hung 2 runs
+// in 4, "glibc detected an invalid stdio handle" and an abort in the others).
+static bool ParserGaveUp(const std::string &log)
 {
+  std::ifstream f(log);
+  std::string   line;
+  while (std::getline(f, line))
+    if (line.find("Too many errors") != std::string::npos) return true;
+  return false;
+}
+
+// Runs argv[0] with argv (no shell: the names and paths are passed as they are), its output to log; how it ended
+// (started false: it could not be started).
+static ChildEnd RunLogged(const std::vector<std::string> &args, const std::string &log, bool *started)
+{
+  ChildEnd            end;
   std::vector<char *> argv;
   for (const auto &a : args) argv.push_back(const_cast<char *>(a.c_str()));
   argv.push_back(nullptr);
+  *started = false;
   posix_spawn_file_actions_t fa;
-  if (posix_spawn_file_actions_init(&fa) != 0) return -1;
+  if (posix_spawn_file_actions_init(&fa) != 0) return end;
   posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&fa, 1, 2);
   posix_spawn_file_actions_addclose(&fa, 0);
   pid_t pid;
   const int rc = posix_spawnp(&pid, argv[0], &fa, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) return -1;
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (rc != 0) return end;
+  *started    = true;
+  int        status = 0;
+  const auto t0     = std::chrono::steady_clock::now();
+  auto       since  = [&]() { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  double     gaveUp = -1, checked = 0; // when the log said the parser gave up; when it was last read
+  for (;;) {
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0 && errno != EINTR) return end;
+    const double t = since();
+    if (gaveUp < 0 && t - checked >= 1) {
+      checked = t;
+      if (ParserGaveUp(log)) gaveUp = t;
+    }
+    if (gaveUp >= 0 && t - gaveUp > 10) {
+      kill(pid, SIGKILL);
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+      end.hung = true;
+      return end;
+    }
+    usleep(t < 1 ? 2000 : 50000); // (most meshes take well under a second)
+  }
+  if (WIFEXITED(status)) end.code = WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) end.signal = WTERMSIG(status);
+  return end;
 }
 
 // mkdir -p
@@ -174,7 +235,7 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   PetscMPIInt rank;
   std::string src;
   int         ok = 1;
-  char        msg[1024] = "";
+  char        msg[2048] = "";
 
   PetscFunctionBeginUser;
   if (!MESH_Generate) PetscCall(PetscLogEventRegister("RBCMeshGenerate", DM_CLASSID, &MESH_Generate));
@@ -188,7 +249,11 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
   // Cache key: the text of the .geo and of the files it includes + numbers + clscale + output format.
   std::ostringstream key;
   std::string        sources;
-  GeoSources(src, 0, &sources);
+  std::set<std::string>    seen;
+  std::vector<std::string> chain;
+  std::string              cycle;
+  GeoSources(src, &chain, &seen, &sources, &cycle);
+  PetscCheck(cycle.empty(), comm, PETSC_ERR_USER_INPUT, "mesh '%s' includes itself through Include or Merge (%s): gmsh cannot read it", src.c_str(), cycle.c_str());
   key << sources;
   for (const auto &kv : spec.geoNumbers)
     PetscCheck(GeoAssigns(sources, kv.first), comm, PETSC_ERR_USER_INPUT, "-mesh_geo_set / -mu_geo_set: '%s' is not a variable of '%s' (nor of the files it includes): gmsh would ignore it and mesh the default geometry", kv.first.c_str(), src.c_str());
@@ -224,7 +289,9 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
       std::string cmd; // (shown in the message)
       for (const auto &a : args) cmd += (cmd.empty() ? "" : " ") + a;
       // no shell (std::system before 2026-11-29: a -mesh_geo_set name ran as a command, a ' in a path broke the line)
-      const int rc = RunLogged(args, log);
+      bool           started = false;
+      const ChildEnd end     = RunLogged(args, log, &started);
+      const int      rc      = started ? end.code : -1;
       {
         // gmsh exits 0 after some errors (an unknown -setnumber, a file it cannot read): its log decides too
         std::ifstream lf(log);
@@ -236,9 +303,9 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
       if (rc != 0 || !FileExists(tmp)) {
         ok = 0;
         std::remove(tmp.c_str());
-        // gmsh's exit code (-1: it could not be started), and its first error line
+        // how gmsh ended, and its first error line
         // (e.g. "Error : 'x.geo', line 2: syntax error") so the user need not open the log.
-        const int   code = rc;
+        std::string how = !started ? "it could not be started" : end.hung ? "it hung after its parser gave up, and was ended: a gmsh 4.8 fault on errors in an Include'd file" : end.signal ? "killed by signal " + std::to_string(end.signal) : "exit code " + std::to_string(end.code);
         std::string first;
         {
           std::ifstream lf(log);
@@ -246,7 +313,7 @@ PetscErrorCode MeshGenerate(MPI_Comm comm, const MeshSpec &spec, std::string *ms
           while (first.empty() && std::getline(lf, line))
             if (line.find("Error") != std::string::npos) first = line.substr(0, 300);
         }
-        std::snprintf(msg, sizeof msg, "gmsh failed on '%s' (exit code %d)%s%s; command: %s; see %s", src.c_str(), code, first.empty() ? "" : ": ", first.c_str(), cmd.c_str(), log.c_str());
+        std::snprintf(msg, sizeof msg, "gmsh failed on '%s' (%s)%s%s; command: %s; see %s", src.c_str(), how.c_str(), first.empty() ? "" : ": ", first.c_str(), cmd.c_str(), log.c_str());
       } else if (std::rename(tmp.c_str(), mshPath->c_str()) != 0) {
         ok = 0;
         std::snprintf(msg, sizeof msg, "cannot move generated mesh to '%s'", mshPath->c_str());
