@@ -54,7 +54,10 @@ cmake --build "$t/app/build" > "$t/app/build.log" 2>&1 || { tail -30 "$t/app/bui
 "$t/app/build/outside" -rom rom.h5 > cmake_app.log 2>&1 || { cat cmake_app.log; fail "the find_package program"; }
 [ "$(grep -c 'iterations' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: 11 solves expected"; }
 [ "$(grep -c 'force [0-9]' cmake_app.log)" = 11 ] || { cat cmake_app.log; fail "the find_package program: the online contact force of each solve expected"; }
-echo "ok: outside program with find_package(rbcontact): 11 online solves with their contact force"
+"$t/app/build/outside" -rom rom.h5 -rom_kacanov_monitr > cmake_typo.log 2>&1 || { cat cmake_typo.log; fail "the find_package program with a misspelled option"; }
+grep -q "^Option left: name:-rom_kacanov_monitr" cmake_typo.log || { tail -3 cmake_typo.log; fail "the example did not name the misspelled option -rom_kacanov_monitr (PetscOptionsLeft)"; }
+! grep -q "^Option left" cmake_app.log || { grep "^Option left" cmake_app.log; fail "the example named options left without a misspelling"; }
+echo "ok: outside program with find_package(rbcontact): 11 online solves with their contact force; a misspelled option named"
 
 # an outside program running the whole pipeline through the library (RunOffline, RunValidation,
 # ReducedModel) for the installed scene, its mesh found through RBC_DATA_DIR = the installed share

@@ -54,6 +54,7 @@ int main(int argc, char **argv)
     if (!sol.force.empty()) PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  force %.6e", (double)sol.ForceMagnitude()));
     PetscCall(PetscPrintf(PETSC_COMM_WORLD, "  time %.2e s\n", (double)(t1 - t0)));
   }
+  PetscCall(PetscOptionsLeft(NULL)); // PETSc's list of the options nobody read ("Option left: name:-rom_kacanov_monitr"): a misspelling
   PetscCall(SlepcFinalize());
   return 0;
 }
