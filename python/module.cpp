@@ -8,6 +8,7 @@
 // Integer options beyond 32 bits are refused as by the executable (src/apps/petsc_int_option.cpp is linked in).
 // The Python side (python/rbcontact/__init__.py) re-exports these names. docs/python.md.
 #include "rbcontact/options_files.hpp"
+#include "rbcontact/provenance.hpp"
 #include "rbcontact/rom_probe.hpp"
 #include "rbcontact/rom_fields.hpp"
 #include "rbcontact/offline.hpp"
@@ -479,6 +480,8 @@ PYBIND11_MODULE(_rbcontact, m)
   m.doc() = "rbcontact: the online stage of a reduced contact model (ROM file from `rbcontact offline`). Every call runs with "
             "the GIL released; calls from several threads run one after the other (PETSc's options database is global). "
             "Ctrl-C is seen when the running call ends.";
+  m.attr("__version__")  = rbc::CodeVersion();  // the project's version (CMakeLists.txt)
+  m.attr("version_line") = rbc::VersionLine(); // as `rbcontact --version`: version, git commit, PETSc and SLEPc
   m.def("initialize", [](const std::vector<std::string> &options) { Start(options); }, py::arg("options") = std::vector<std::string>{},
         "Initialize PETSc/SLEPc with these command-line options (e.g. ['-rom_kacanov_monitor']); optional, "
         "done with no options by the first ReducedModel, which warns about the options nobody read");

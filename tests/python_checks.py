@@ -67,6 +67,9 @@ def main():
         rom3 = os.path.join(d, "rom3.h5")
         run(args.exe, 2, ["offline", "-options_file", "runs/sphere_block3d.opts", "-train_size", "2", "-rom", rom3, "-report", d + "/off3.json"])
         run(args.exe, 1, ["online", "-rom", rom3, "-mu", "1.1,0.045", "-online_repeat", "1", "-report", d + "/on3.json"])
+        exe_version = subprocess.run([args.exe, "--version"], stdout=subprocess.PIPE, text=True).stdout.strip()
+        check(rbcontact.version_line == exe_version and exe_version.startswith("rbcontact " + rbcontact.__version__ + " (commit "),
+              "rbcontact.__version__ %s and version_line as `rbcontact --version` (%s)" % (rbcontact.__version__, rbcontact.version_line))
         m = rbcontact.ReducedModel(rom)
         (name, lo, hi), = m.parameters
         check(name == "radius" and abs(lo - 0.95) < 1e-14 and abs(hi - 1.15) < 1e-14, "parameter box from the file: %s in [%g, %g]" % (name, lo, hi))

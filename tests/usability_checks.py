@@ -153,6 +153,18 @@ def failure(args):
 
 
 def help_(args):
+    # without a stage: --help prints the usage and --version the version, exit 0 (both were "error: the first argument
+    # must be a stage word", exit 1, until 2026-12-02); no argument or another option stays an error
+    for w in ("--help", "-help", "-h", "help"):
+        p = run(args, 1, [w], expect_ok=False)
+        check(p.returncode == 0 and "Usage: rbcontact <stage>" in p.stdout and "error:" not in p.stdout, "rbcontact %s: the usage, exit %d (0)" % (w, p.returncode))
+    p = run(args, 1, ["--version"], expect_ok=False)
+    c = source_commit()
+    check(p.returncode == 0 and p.stdout.startswith("rbcontact %s (commit " % project_version()) and "3.18" in p.stdout and (c is None or c in p.stdout),
+          "rbcontact --version: version, commit and PETSc/SLEPc, exit %d (%s)" % (p.returncode, p.stdout.strip()))
+    for w in ([], ["-x"]):
+        p = run(args, 1, w, expect_ok=False)
+        check(p.returncode == 1 and "the first argument must be a stage word" in p.stdout, "rbcontact %s: an error, exit %d (1)" % (" ".join(w) or "(nothing)", p.returncode))
     p = run(args, 1, ["fom", "-options_file", "runs/ring_on_block.opts", "-help"])
     for opt in ("-mesh_file", "-mesh_refine", "-bodies", "-body_E", "-dirichlet", "-dirichlet_ring_top_u", "-mu_names", "-mu", "-map_ring",
                 "-contact_slave", "-contact_quadrature", "-report", "-fom_output", "-kacanov_max_it", "-fom_ksp_type",

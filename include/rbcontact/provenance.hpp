@@ -30,5 +30,8 @@ JsonValue  ProvenanceJson(const Provenance &p);
 std::vector<std::pair<std::string, std::string>> ProvenanceAttributes(const Provenance &p);
 // The project version ("0.1.0"): the snapshot file's code_version.
 std::string CodeVersion();
+// One line for `rbcontact --version`: "rbcontact 0.1.0 (commit <sha>), PETSc Release Version 3.18.4, ..., SLEPc ...".
+// Needs neither MPI nor PETSc initialized.
+std::string VersionLine();
 
 } // namespace rbc

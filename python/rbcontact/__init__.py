@@ -28,7 +28,7 @@ is seen when the running call ends (a stage of minutes runs to its end, then Key
 """
 import json as _json
 
-from ._rbcontact import ReducedModel, Solution, initialize, finalize, _run_stage
+from ._rbcontact import ReducedModel, Solution, initialize, finalize, _run_stage, __version__, version_line
 
 
 def _words(args, kw):
@@ -72,4 +72,4 @@ def probe(*args, **options):
     return _json.loads(_run_stage("probe", _words(args, options)))
 
 
-__all__ = ["ReducedModel", "Solution", "initialize", "finalize", "offline", "validate", "probe"]
+__all__ = ["ReducedModel", "Solution", "initialize", "finalize", "offline", "validate", "probe", "version_line"]

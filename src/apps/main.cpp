@@ -148,8 +148,16 @@ static PetscErrorCode TestFailRank(bool *doThrow)
 
 int main(int argc, char **argv)
 {
+  if (argc == 2 && (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "-version") || !std::strcmp(argv[1], "version"))) {
+    std::printf("%s\n", rbc::VersionLine().c_str());
+    return 0;
+  }
+  if (argc == 2 && (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-help") || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "help"))) {
+    std::printf("%s(`rbcontact <stage> -help` lists the options of a stage; `rbcontact --version` the version.)\n", help); // (was "error: the first argument must be a stage word", exit 1)
+    return 0;
+  }
   if (argc < 2 || argv[1][0] == '-') {
-    std::fprintf(stderr, "%s\nerror: the first argument must be a stage word (fom, ...)\n", help);
+    std::fprintf(stderr, "%s\nerror: the first argument must be a stage word (fom, ...); `rbcontact --help` prints this, `rbcontact <stage> -help` a stage's options\n", help);
     return 1;
   }
   const std::string stage = argv[1];

@@ -56,6 +56,14 @@ Provenance LocalProvenance()
   return p;
 }
 
+std::string VersionLine()
+{
+  char v[256] = "", w[256] = "";
+  (void)PetscGetVersion(v, sizeof v); // (formats the headers' version macros: no PETSc call)
+  (void)SlepcGetVersion(w, sizeof w);
+  return std::string("rbcontact ") + RBC_VERSION + " (commit " + RBC_GIT_COMMIT + "), " + Trimmed(v) + ", " + Trimmed(w);
+}
+
 PetscErrorCode GetProvenance(MPI_Comm comm, Provenance *p)
 {
   PetscMPIInt size;
