@@ -1321,7 +1321,13 @@ def guards(args):
     # options files: one that includes itself, one missing; the previous report replaced by the failure's
     with open(d + "/self.opts", "w") as f:
         f.write("-options_file %s/self.opts\n" % d)
-    for opts, words in ((d + "/self.opts", ["includes itself"]), (d + "/nosuch.opts", ["nosuch.opts", "No such file"])):
+    # a chain of 15 files each naming the next three times: PETSc would read 3^15 files (the check hung for minutes);
+    # refused in well under the test's time, naming the repeated include
+    for k in range(15):
+        with open(d + "/diamond%d.opts" % k, "w") as f:
+            f.write(("-options_file %s/diamond%d.opts\n" % (d, k + 1)) * 3 if k < 14 else "-rom_kacanov_max_it 30\n")
+    for opts, words in ((d + "/self.opts", ["includes itself"]), (d + "/nosuch.opts", ["nosuch.opts", "No such file"]),
+                        (d + "/diamond0.opts", ["makes PETSc read options files", "include each file once"])):
         with open(d + "/old.json", "w") as f:
             f.write('{"stage": "old", "converged": true}')
         for np_ in (1, 2):

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <functional>
 #include <sstream>
 
@@ -190,9 +191,13 @@ const std::vector<std::string> &OptionsFilesRead() { return optionsFilesRead; }
 
 std::string CheckOptionsFiles(const std::vector<std::string> &words)
 {
-  std::vector<std::string>                             chain, shown;
+  std::vector<std::string>                                      chain, shown;
+  std::map<std::string, double>                                 reads; // by resolved path: the files PETSc reads for it (itself and its -options_file's)
+  const double                                                  maxReads = 256;
   optionsFilesRead.clear();
-  std::function<std::string(const std::string &, int)> visit = [&](const std::string &file, int depth) -> std::string {
+  // *n: the files PETSc reads when it inserts this one. A file included several times is read as often (3 -options_file
+  // lines naming one file, nested 15 deep: 3^15 reads, a hang in this check and in PETSc); each file is parsed here once.
+  std::function<std::string(const std::string &, int, double *)> visit = [&](const std::string &file, int depth, double *n) -> std::string {
     char buf[PATH_MAX];
     if (!realpath(file.c_str(), buf)) return "options file " + file + " (-options_file): " + std::strerror(errno);
     const std::string canon = buf;
@@ -201,12 +206,17 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
       for (const auto &s : shown) path += s + " -> ";
       return "options file " + file + " includes itself through -options_file (" + path + file + ")";
     }
+    if (const auto r = reads.find(canon); r != reads.end()) {
+      *n = r->second;
+      return "";
+    }
     if (depth >= 16) return "options file " + file + ": -options_file nested more than 16 deep";
     std::ifstream in(file);
     if (!in) return "options file " + file + " (-options_file): cannot be read";
     chain.push_back(canon);
     shown.push_back(file);
     if (std::find(optionsFilesRead.begin(), optionsFilesRead.end(), file) == optionsFilesRead.end()) optionsFilesRead.push_back(file);
+    *n = 1;
     for (std::string line; std::getline(in, line);) {
       const size_t hash = line.find('#');
       if (hash != std::string::npos) line.resize(hash);
@@ -215,18 +225,31 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
       for (std::string t; ls >> t;) tok.push_back(t);
       for (size_t k = 0; k + 1 < tok.size(); ++k)
         if (tok[k] == "-options_file") {
-          const std::string e = visit(tok[k + 1], depth + 1);
+          double            m = 0;
+          const std::string e = visit(tok[k + 1], depth + 1, &m);
           if (!e.empty()) return e;
+          *n += m;
+          if (*n > maxReads) {
+            char msg[64];
+            std::snprintf(msg, sizeof msg, "%.4g", *n);
+            return "options file " + file + " makes PETSc read options files " + msg + " times or more through -options_file (more than " + std::to_string((int)maxReads) + "; " + tok[k + 1] +
+                   " and the files it includes are read once for every -options_file line naming it): include each file once";
+          }
         }
     }
     chain.pop_back();
     shown.pop_back();
+    reads[canon] = *n;
     return "";
   };
+  double total = 0;
   for (size_t i = 0; i + 1 < words.size(); ++i)
     if (words[i] == "-options_file") {
-      const std::string e = visit(words[i + 1], 0);
+      double            n = 0;
+      const std::string e = visit(words[i + 1], 0, &n);
       if (!e.empty()) return e;
+      total += n;
+      if (total > maxReads) return "the command line's -options_file files make PETSc read options files more than " + std::to_string((int)maxReads) + " times (" + words[i + 1] + " among them): include each file once";
     }
   return "";
 }
