@@ -134,6 +134,10 @@ rbc_bad_stage(bodies_twice "-bodies: the body 'ring' appears twice" fom -options
 # forever)
 rbc_bad_stage(geo_includes_itself "mesh '[^']*selfinc[.]geo' includes itself through Include or Merge [(]selfinc[.]geo -> selfinc_b[.]geo -> selfinc[.]geo[)]" fom -options_file runs/ring_on_block.opts -mesh_file @SELFINC_GEO@)
 rbc_bad_stage(geo_parser_gave_up "gmsh failed on '[^']*twice[.]geo' [(](it hung after its parser gave up, and was ended|killed by signal 6|exit code [1-9][0-9]*)[^)]*[)]: Error *: GEO point with tag 1 already exists" fom -options_file runs/ring_on_block.opts -mesh_file @TWICE_GEO@)
+# a user's mesh PETSc's reader mishandles (here a node block of an undefined entity: a segmentation fault), refused by
+# the structure check on rank 0 before the reader (the other faults: tests/test_gmsh_check.cpp)
+rbc_bad_stage(mesh_undefined_entity "[$]Nodes, line [0-9]+: node block 1 names entity 77 of dimension 0, which [$]Entities does not define" fom -options_file runs/ring_on_block.opts -mesh_file @BADENTITY_MSH@)
+rbc_bad_stage_np2(mesh_undefined_entity "node block 1 names entity 77 of dimension 0, which [$]Entities does not define" fom -options_file runs/ring_on_block.opts -mesh_file @BADENTITY_MSH@)
 rbc_bad_stage(generated_mesh_refused "PETSc's reader refused the mesh gmsh made of .*freecurve[.]geo" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@)
 rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this failure within 3 s" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@ -rbc_error_wait 3)
 # offline values that ran without a word: a negative number of groups (ran as 0), a greedy budget below its initial set

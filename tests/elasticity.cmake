@@ -57,3 +57,8 @@ rbc_test_exe(test_element_assembly)
 rbc_add_mpi_test(NAME element_assembly_half_disks RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/half_disks.opts -fem_degree 2 -test_mu 0.7,0.06,1.3,0.12 LABELS elasticity)
 rbc_add_mpi_test(NAME element_assembly_ring_loads RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/ring_on_block.opts -body_force 0.3,-1 -traction ring_top -traction_ring_top_t 0.5,-2 -dirichlet block_bottom,slave -dirichlet_slave_u 0.01,0.02 -test_mu 0.95,1.15 LABELS elasticity)
 rbc_add_mpi_test(NAME element_assembly_block3d RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -scene block3d -mesh_file meshes/block3d.geo -bodies block -body_E 100 -body_nu 0.3 -dirichlet bottom,sides -dirichlet_bottom_u 0,0,0 -dirichlet_sides_u 0.01,0,0.02 -dirichlet_sides_comps 0,2 -traction top -traction_top_t 0.1,0,-1 -body_force 0,0,-2 -contact 0 -fem_degree 2 LABELS elasticity)
+# the structure check of a user's gmsh file before PETSc's reader (src/mesh/gmsh_check.hpp): a sound mesh in formats
+# 4.1 and 2.2, and each fault of the fuzzing audit of 2026-12-02 (no PETSc, one process)
+rbc_test_exe(test_gmsh_check)
+add_test(NAME gmsh_check COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/gmsh_check.sh $<TARGET_FILE:test_gmsh_check> ${PROJECT_SOURCE_DIR})
+set_tests_properties(gmsh_check PROPERTIES TIMEOUT 60 LABELS bad_input)

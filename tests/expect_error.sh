@@ -15,7 +15,9 @@
 # @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf;
 # @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface; @MIXED3D_GEO@ by a 3D mesh of tetrahedra and hexahedra;
 # @SELFINC_GEO@ by a .geo including, through a second file, itself three times; @TWICE_GEO@ by a .geo that includes
-# ring_on_block.geo twice (gmsh's parser gives up inside the Include, and gmsh 4.8 then hangs or aborts).
+# ring_on_block.geo twice (gmsh's parser gives up inside the Include, and gmsh 4.8 then hangs or aborts); @BADENTITY_MSH@
+# by ring_on_block's mesh whose first node block names entity 77, which the file does not define (a segmentation fault
+# in PETSc's reader before the structure check, src/mesh/gmsh_check.hpp).
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -129,6 +131,18 @@ GEO
     cp "$(dirname "$0")/../meshes/ring_on_block.geo" "$tmpdir/ring_on_block.geo"
     printf 'Include "ring_on_block.geo";\nInclude "ring_on_block.geo";\n' > "$tmpdir/twice.geo"
     args+=("$tmpdir/twice.geo")
+  elif [ "$a" = "@BADENTITY_MSH@" ]; then
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/ring_on_block.geo" -format msh41 -v 0 -o "$tmpdir/ring.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    /usr/bin/python3 - "$tmpdir/ring.msh" "$tmpdir/badentity.msh" <<'PY' || { echo "expect_error: the mesh edit failed"; exit 2; }
+import sys
+L = open(sys.argv[1]).read().split("\n")
+i = L.index("$Nodes") + 2  # the first block's header: dim, entity, parametric, count
+h = L[i].split()
+h[1] = "77"
+L[i] = " ".join(h)
+open(sys.argv[2], "w").write("\n".join(L))
+PY
+    args+=("$tmpdir/badentity.msh")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")

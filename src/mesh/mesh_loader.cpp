@@ -3,6 +3,7 @@
 #include "rbcontact/mesh.hpp"
 #include "rbcontact/partition.hpp"
 #include "rbcontact/report.hpp"
+#include "gmsh_check.hpp"
 #include <petscsf.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -450,7 +451,7 @@ static std::string Gmsh22TagClash(const std::string &msh, const std::string &opt
         for (int i = 0; i < n; ++i) {
           int         d, t;
           std::string name;
-          f >> d >> t;
+          if (!(f >> d >> t)) break; // (a count beyond the file: 2e9 failed reads before, 30 s and more)
           std::getline(f, name);
           const size_t a = name.find('"'), b = name.rfind('"');
           groups[{d, t}] = (a != std::string::npos && b > a) ? name.substr(a + 1, b - a - 1) : name;
@@ -489,87 +490,6 @@ static std::string Gmsh22TagClash(const std::string &msh, const std::string &opt
     }
   }
   return why;
-}
-
-// Before the reader, for a user's ASCII .msh (4.1 or 2.2): an element pointing at a node tag the file does not define.
-// PETSc 3.18's reader indexes with it unchecked (a segmentation fault, or a mesh it then called inverted). "" when every
-// reference is defined, or when the file says nothing that can be read here (binary: left to the reader).
-static std::string UndefinedNodeRefs(const std::string &msh)
-{
-  std::ifstream      f(msh);
-  std::string        line;
-  double             version = 0;
-  std::vector<char>  defined; // by node tag
-  auto define = [&](long long t) {
-    if (t < 0 || t > 100000000) return false;
-    if ((size_t)t >= defined.size()) defined.resize((size_t)t + 1, 0);
-    defined[(size_t)t] = 1;
-    return true;
-  };
-  auto known = [&](long long t) { return t >= 0 && (size_t)t < defined.size() && defined[(size_t)t]; };
-  auto bad   = [&](long long e, long long t) { return "element " + std::to_string(e) + " uses node " + std::to_string(t) + ", which the file does not define (a corrupt or hand-edited mesh)"; };
-  // msh 4.1: a section's header (blocks, count, smallest and largest tag), then each block's four numbers (the last
-  // one its count) and its body, read by body(count)
-  auto blocks41 = [&](const std::function<bool(long long)> &body) {
-    long long nb, cnt, lo, hi, h[4];
-    if (!(f >> nb >> cnt >> lo >> hi)) return false;
-    for (long long b = 0; b < nb; ++b)
-      if (!(f >> h[0] >> h[1] >> h[2] >> h[3]) || !body(h[3])) return false;
-    return true;
-  };
-  std::string err;
-  // an element line: its tag (2.2: then its type and tags), then its nodes, every one defined
-  auto elementLine = [&](const std::string &l, bool v22) {
-    std::istringstream in(l);
-    long long          id = 0, type, ntags = 0, t;
-    in >> id;
-    if (v22) in >> type >> ntags;
-    for (long long j = 0; j < ntags; ++j) in >> t;
-    while (err.empty() && in >> t)
-      if (!known(t)) err = bad(id, t);
-  };
-  while (std::getline(f, line)) {
-    if (line.rfind("$MeshFormat", 0) == 0) {
-      int binary = 0;
-      if (!(f >> version >> binary) || binary != 0) return "";
-    } else if (line.rfind("$Nodes", 0) == 0) {
-      if (version >= 4) {
-        const bool ok = blocks41([&](long long n) {
-          for (long long k = 0; k < n; ++k) {
-            long long t;
-            if (!(f >> t) || !define(t)) return false;
-          }
-          std::getline(f, line);
-          for (long long k = 0; k < n; ++k) std::getline(f, line); // coordinates
-          return true;
-        });
-        if (!ok) return "";
-      } else {
-        long long n;
-        if (!(f >> n)) return "";
-        std::getline(f, line);
-        for (long long k = 0; k < n && std::getline(f, line); ++k) {
-          std::istringstream in(line);
-          long long          t;
-          if (!(in >> t) || !define(t)) return "";
-        }
-      }
-    } else if (line.rfind("$Elements", 0) == 0) {
-      long long n = 0;
-      if (version >= 4) {
-        blocks41([&](long long cnt) {
-          std::getline(f, line);
-          for (long long k = 0; k < cnt && err.empty() && std::getline(f, line); ++k) elementLine(line, false);
-          return err.empty();
-        });
-      } else if (f >> n) {
-        std::getline(f, line);
-        for (long long k = 0; k < n && err.empty() && std::getline(f, line); ++k) elementLine(line, true);
-      }
-      return err;
-    }
-  }
-  return "";
 }
 
 // Before the reader: the bodies of -bodies with no physical group of the mesh's dimension in the $PhysicalNames of
@@ -623,14 +543,17 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     // Rank 0 reads the text before PETSc's reader: the format 2.2 tag clash; a body of -bodies whose cells are in no
     // physical group (gmsh then saves only its boundary curves, which PETSc's reader refuses on rank 0 while the other
     // ranks wait in its collectives: a hang on 2 ranks for a generated mesh, which is not parsed on rank 0 first); in
-    // a user's file, an element pointing at an undefined node.
+    // a user's file, everything the reader would mishandle (GmshStructureProblem: an element pointing at an undefined
+    // node, counts that disagree with the data, undefined entities, ...).
     std::string why;
     PetscMPIInt r0;
     PetscCallMPI(MPI_Comm_rank(comm, &r0));
     if (r0 == 0) {
-      why                 = Gmsh22TagClash(msh, "-mesh_file " + scene.mesh.file, generated);
-      std::string missing = why.empty() ? BodiesWithoutGroup(msh, scene) : "";
-      if (why.empty() && missing.empty() && !generated) missing = UndefinedNodeRefs(msh);
+      // a user's file: its structure first (counts, tags and references PETSc's reader trusts: gmsh_check.hpp), so that
+      // the checks below read a sound file
+      std::string missing = generated ? "" : GmshStructureProblem(msh);
+      why                 = missing.empty() ? Gmsh22TagClash(msh, "-mesh_file " + scene.mesh.file, generated) : "";
+      if (why.empty() && missing.empty()) missing = BodiesWithoutGroup(msh, scene);
       if (!missing.empty()) why = "Mesh '" + msh + "' (from -mesh_file " + scene.mesh.file + "): " + missing;
     }
     PetscCall(BcastString(comm, &why));
