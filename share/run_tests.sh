@@ -14,7 +14,8 @@ BUILD="${RBC_BUILD_DIR:-build}"
 if [ "${CI:-}" = "true" ] || [ ! -t 1 ]; then
   # No terminal: no colours, no prompts, no progress bars.
   export CLICOLOR=0 CLICOLOR_FORCE=0 NO_COLOR=1 GCC_COLORS= TERM=dumb DEBIAN_FRONTEND=noninteractive
-  export CMAKE_COLOR_DIAGNOSTICS=OFF
+  # (not CMAKE_COLOR_DIAGNOSTICS=OFF: it adds -fno-diagnostics-color to every compile line, so the build quickstart.sh
+  # made was compiled again in full; found in a fresh-machine run, 2026-12-02)
   COLOR_OPT=(-DCMAKE_COLOR_MAKEFILE=OFF)
 else
   COLOR_OPT=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # share/setup.sh: installs what rbcontact needs on a Debian bookworm machine (PETSc/SLEPc 3.18,
 # METIS, HDF5 (OpenMPI), OpenMPI, gmsh, CMake, compilers, and the Python plotting packages),
-# pybind11 (pybind11-dev: the Python module, docs/python.md), and
+# pybind11 (pybind11-dev: the Python module, docs/python.md), git (the commit in every report's provenance: a minbase
+# Debian has none, and reports then said "unknown"), and
 # OpenBLAS (libopenblas0-pthread: Debian's alternatives then give it to PETSc, MUMPS and LAPACK in place
 # of the reference BLAS; the dense compliance and MUMPS's fronts run 5-10x faster, docs/fom_speed.md).
 # Idempotent: checks each package with dpkg-query and runs `apt-get update` + `apt-get install`
@@ -12,7 +13,7 @@ set -euo pipefail
 PACKAGES=(
   petsc-dev slepc-dev libmetis-dev libhdf5-openmpi-dev openmpi-bin gmsh libgmsh-dev
   cmake pkg-config g++ make python3-matplotlib python3-h5py python3-numpy
-  libopenblas0-pthread pybind11-dev
+  libopenblas0-pthread pybind11-dev git
 )
 
 die() { echo "setup.sh: error: $*" >&2; exit 1; }
