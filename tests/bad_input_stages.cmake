@@ -14,7 +14,7 @@ rbc_bad_stage(offline_stop "-offline_stop eim: unknown step" offline -options_fi
 rbc_bad_stage(ecsw_fit "Unknown option action2 for -ecsw_fit. Available options: terms action" offline -options_file runs/ring_on_block.opts -ecsw_fit action2 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_group_points "-ecsw_group_points 50 must be 0 .one group. or >= 100" offline -options_file runs/ring_on_block.opts -ecsw_group_points 50 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(ecsw_eliminate_from "-ecsw_eliminate_from 1[.]5 must lie in [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -ecsw_eliminate_from 1.5 -rom /tmp/rbc_never.h5)
-rbc_bad_stage(ecsw_group_max_points "empirical cubature: group 0 of 3 reaches .* > its tolerance .* with 5 points .-ecsw_max_points 5; larger -ecsw_group_points" offline -options_file runs/ring_on_block.opts -ecsw_group_points 100 -ecsw_max_points 5 -snapshots_restart false -snapshots /tmp/rbc_group_max_points.snapshots.h5 -rom /tmp/rbc_group_max_points.h5)
+rbc_bad_stage(ecsw_group_max_points "empirical cubature: group 0 of 3 reaches .* > its tolerance .* with 5 points .-ecsw_max_points 5; larger -ecsw_group_points" offline -options_file runs/ring_on_block.opts -ecsw_group_points 100 -ecsw_max_points 5 -snapshots_restart false -snapshots @TMP@/group_max_points.snapshots.h5 -rom @TMP@/group_max_points.h5)
 rbc_bad_stage(supremizers_infsup "-pod_supremizers_infsup 1.5 out of range [(]0, 1[]]" offline -options_file runs/ring_on_block.opts -pod_supremizers_infsup 1.5 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_tol "-greedy_tol 0 must be > 0" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_tol 0 -rom /tmp/rbc_never.h5)
 rbc_bad_stage(greedy_max_solves "-greedy_max_solves 0 must be >= 1" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 0 -rom /tmp/rbc_never.h5)
@@ -138,8 +138,14 @@ rbc_bad_stage(geo_parser_gave_up "gmsh failed on '[^']*twice[.]geo' [(](it hung 
 # the structure check on rank 0 before the reader (the other faults: tests/test_gmsh_check.cpp)
 rbc_bad_stage(mesh_undefined_entity "[$]Nodes, line [0-9]+: node block 1 names entity 77 of dimension 0, which [$]Entities does not define" fom -options_file runs/ring_on_block.opts -mesh_file @BADENTITY_MSH@)
 rbc_bad_stage_np2(mesh_undefined_entity "node block 1 names entity 77 of dimension 0, which [$]Entities does not define" fom -options_file runs/ring_on_block.opts -mesh_file @BADENTITY_MSH@)
+# the same in binary 4.1 (a $Nodes header one node short: PETSc's reader aborted, then hung), which the check reads too
+rbc_bad_stage(mesh_binary41_short_count "[$]Nodes, byte [0-9]+: node block [0-9]+ holds [0-9]+ nodes, more than the [0-9]+ the header's count of [0-9]+ leaves" fom -options_file runs/ring_on_block.opts -mesh_file @BIN41_SHORT_MSH@)
+rbc_bad_stage_np2(mesh_binary41_short_count "[$]Nodes, byte [0-9]+: node block [0-9]+ holds [0-9]+ nodes, more than" fom -options_file runs/ring_on_block.opts -mesh_file @BIN41_SHORT_MSH@)
 rbc_bad_stage(generated_mesh_refused "PETSc's reader refused the mesh gmsh made of .*freecurve[.]geo" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@)
 rbc_bad_stage_np2(generated_mesh_refused "the other ranks did not reach this failure within 3 s" fom -options_file runs/ring_on_block.opts -mesh_file @FREECURVE_GEO@ -rbc_error_wait 3)
+# a -train_file of more samples than any training set holds (1e7: an 80 MB file took 3.6 GB and a minute to read, then
+# its FOMs would have run; 5 s and 0.7 GB to refuse)
+rbc_bad_stage(train_file_too_many "Parameter sample file '[^']*big_samples[.]txt' line 10000001: more than 10000000 samples" offline -options_file runs/ring_on_block.opts -train_type file -train_file @BIG_SAMPLES_TXT@ -rom /tmp/rbc_never.h5)
 # offline values that ran without a word: a negative number of groups (ran as 0), a greedy budget below its initial set
 rbc_bad_stage(snapshots_subcomm_negative "-snapshots_subcomm -2 must be >= 0" offline -options_file runs/ring_on_block.opts -offline_stop snapshots -snapshots /tmp/rbc_never.h5 -snapshots_subcomm -2)
 rbc_bad_stage(greedy_max_solves_initial "-greedy_max_solves 1 is below the 2 points of the initial set" offline -options_file runs/ring_on_block.opts -train_type greedy -greedy_max_solves 1 -rom /tmp/rbc_never.h5)

@@ -36,12 +36,12 @@ rbc_bad_input(E_negative "-body_E: Young's modulus -5[.]? of body 'block' must b
 rbc_bad_input(nu_half "-body_nu: Poisson ratio 0[.]5 of body 'block' must lie in [(]-1, 0[.]5[)]" -body_nu 0.3,0.5)
 rbc_bad_input(partitioner "Unknown value 'bogus' for option -mesh_partitioner" -mesh_partitioner bogus)
 rbc_bad_input(fem_degree "-fem_degree 3 is not supported [(]1 or 2[)]" -fem_degree 3)
-rbc_bad_input(garbage_msh "Cannot read mesh '[^']*garbage_mesh[.]msh' [(]from -mesh_file [^)]*garbage_mesh[.]msh[)]: not a valid gmsh file" -mesh_file @GARBAGE_MSH@)
+rbc_bad_input(garbage_msh "Mesh '[^']*garbage_mesh[.]msh' [(]from -mesh_file [^)]*garbage_mesh[.]msh[)]: [$]MeshFormat, line 2: the format version is 'this': rbcontact reads gmsh files of format 4.1" -mesh_file @GARBAGE_MSH@)
 rbc_bad_input(garbage_geo "gmsh failed on '[^']*garbage_geometry[.]geo' [(]exit code [1-9][0-9]*[)]: Error.*syntax error" -mesh_file @GARBAGE_GEO@)
 # The malformed mesh on 2 ranks (PETSc's reader parses on rank 0 only; the other rank used to
 # hang in a collective): expect_error.sh writes the file once and launches mpiexec -n 2 itself.
 add_test(NAME bad_input_garbage_msh_np2
-  COMMAND ${RBC_EXPECT_ERROR} "Cannot read mesh '[^']*garbage_mesh[.]msh'" ${RBC_MPIEXEC} -n 2 ${RBC_FOM_RING} -mesh_file @GARBAGE_MSH@
+  COMMAND ${RBC_EXPECT_ERROR} "Mesh '[^']*garbage_mesh[.]msh' [(]from -mesh_file [^)]*[)]: [$]MeshFormat, line 2: the format version is 'this'" ${RBC_MPIEXEC} -n 2 ${RBC_FOM_RING} -mesh_file @GARBAGE_MSH@
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(bad_input_garbage_msh_np2 PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 60 PROCESSORS 2 LABELS elasticity)
 # An unknown name on 2 ranks: every rank's message lists the mesh's names (their union over the ranks: a rank lacking a
@@ -58,7 +58,8 @@ rbc_add_mpi_test(NAME element_assembly_half_disks RANKS 1 2 COMMAND $<TARGET_FIL
 rbc_add_mpi_test(NAME element_assembly_ring_loads RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -options_file runs/ring_on_block.opts -body_force 0.3,-1 -traction ring_top -traction_ring_top_t 0.5,-2 -dirichlet block_bottom,slave -dirichlet_slave_u 0.01,0.02 -test_mu 0.95,1.15 LABELS elasticity)
 rbc_add_mpi_test(NAME element_assembly_block3d RANKS 1 2 COMMAND $<TARGET_FILE:test_element_assembly> -scene block3d -mesh_file meshes/block3d.geo -bodies block -body_E 100 -body_nu 0.3 -dirichlet bottom,sides -dirichlet_bottom_u 0,0,0 -dirichlet_sides_u 0.01,0,0.02 -dirichlet_sides_comps 0,2 -traction top -traction_top_t 0.1,0,-1 -body_force 0,0,-2 -contact 0 -fem_degree 2 LABELS elasticity)
 # the structure check of a user's gmsh file before PETSc's reader (src/mesh/gmsh_check.hpp): a sound mesh in formats
-# 4.1 and 2.2, and each fault of the fuzzing audit of 2026-12-02 (no PETSc, one process)
+# 4.1 (ASCII and binary) and 2.2, each fault of the fuzzing audit of 2026-12-02 (no PETSc, one process); then the FOM
+# of ring_on_block from its binary 4.1 mesh on 1 and 2 ranks against the ASCII one's
 rbc_test_exe(test_gmsh_check)
-add_test(NAME gmsh_check COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/gmsh_check.sh $<TARGET_FILE:test_gmsh_check> ${PROJECT_SOURCE_DIR})
-set_tests_properties(gmsh_check PROPERTIES TIMEOUT 60 LABELS bad_input)
+add_test(NAME gmsh_check COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/gmsh_check.sh $<TARGET_FILE:test_gmsh_check> ${PROJECT_SOURCE_DIR} $<TARGET_FILE:rbcontact_exe> ${RBC_MPIEXEC})
+set_tests_properties(gmsh_check PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 120 PROCESSORS 2 LABELS bad_input)

@@ -17,7 +17,10 @@
 # @SELFINC_GEO@ by a .geo including, through a second file, itself three times; @TWICE_GEO@ by a .geo that includes
 # ring_on_block.geo twice (gmsh's parser gives up inside the Include, and gmsh 4.8 then hangs or aborts); @BADENTITY_MSH@
 # by ring_on_block's mesh whose first node block names entity 77, which the file does not define (a segmentation fault
-# in PETSc's reader before the structure check, src/mesh/gmsh_check.hpp).
+# in PETSc's reader before the structure check, src/mesh/gmsh_check.hpp); @BIN41_SHORT_MSH@ by that mesh in binary 4.1
+# whose $Nodes header counts one node fewer than its blocks hold (PETSc's reader: an abort, then a hang);
+# @BIG_SAMPLES_TXT@ by a -train_file of 10000001 one-parameter samples (one more than every training set's cap); @TMP@
+# inside any other argument by the temporary directory (outputs a refused run may leave: removed at exit).
 set -u
 if [ $# -lt 2 ]; then
   echo "usage: $0 REGEX cmd [args...]" >&2
@@ -143,11 +146,26 @@ L[i] = " ".join(h)
 open(sys.argv[2], "w").write("\n".join(L))
 PY
     args+=("$tmpdir/badentity.msh")
+  elif [ "$a" = "@BIN41_SHORT_MSH@" ]; then
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/ring_on_block.geo" -format msh41 -bin -v 0 -o "$tmpdir/ring.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    /usr/bin/python3 - "$tmpdir/ring.msh" "$tmpdir/bin41_short.msh" <<'PY' || { echo "expect_error: the mesh edit failed"; exit 2; }
+import struct, sys
+b = bytearray(open(sys.argv[1], "rb").read())
+assert b.startswith(b"$MeshFormat\n4.1 1 8\n")
+i = b.index(b"\n$Nodes\n") + 8  # numEntityBlocks, numNodes, minNodeTag, maxNodeTag (size_t, little-endian)
+n = struct.unpack_from("<Q", b, i + 8)[0]
+struct.pack_into("<Q", b, i + 8, n - 1)
+open(sys.argv[2], "wb").write(b)
+PY
+    args+=("$tmpdir/bin41_short.msh")
+  elif [ "$a" = "@BIG_SAMPLES_TXT@" ]; then
+    /usr/bin/python3 -c "open('$tmpdir/big_samples.txt', 'w').write('1\\n' * 10000001)" || { echo "expect_error: cannot write the sample file"; exit 2; }
+    args+=("$tmpdir/big_samples.txt")
   elif [ "$a" = "@GARBAGE_GEO@" ]; then
     printf 'Point(1) = {0, 0, 0, 0.1};\nthis is not gmsh syntax (\n' > "$tmpdir/garbage_geometry.geo"
     args+=("$tmpdir/garbage_geometry.geo")
   else
-    args+=("$a")
+    args+=("${a//@TMP@/$tmpdir}")  # @TMP@ inside an argument: this run's temporary directory (removed at exit)
   fi
 done
 

@@ -1254,6 +1254,24 @@ def guards(args):
     with h5py.File(d + "/box.h5", "a") as f:
         f["params/box"][...] = np.array(f["params/box"])[:, ::-1]
     expect_error(args, ["-rom", d + "/box.h5"], ["box.h5", "/params/box row 0", "corrupt"], "a ROM file whose box has min > max")
+    # a corrupted dataspace (found by fuzzing, 2026-12-02): /online/contact/theta's stored dims and max dims (four
+    # little-endian 64-bit words in its object header) rewritten to 2^32 rows. Before the guard in DatasetDims the
+    # reader allocated 172 GB and died with "out of memory ... a size option too large?"; a 115 kB file declaring 4.2 GB
+    # got them allocated and zeroed. Refused now from the declared size against the stored one, in well under 1 GB.
+    import resource
+    import struct
+    with h5py.File(rom, "r") as f:
+        shape = f["online/contact/theta"].shape
+    data = open(rom, "rb").read()
+    pat = struct.pack("<4Q", shape[0], shape[1], shape[0], shape[1])
+    check(data.count(pat) == 1, "the dims of /online/contact/theta occur once in the ROM file (the patch below is unambiguous)")
+    i = data.find(pat)
+    with open(d + "/dims.h5", "wb") as f:
+        f.write(data[:i] + struct.pack("<4Q", 1 << 32, shape[1], 1 << 32, shape[1]) + data[i + len(pat):])
+    expect_error(args, ["-rom", d + "/dims.h5", "-mu", "1.02"], ["dims.h5", "/online/contact/theta", "declares shape 4294967296 x %d" % shape[1], "corrupt or truncated"],
+                 "a ROM file whose /online/contact/theta declares 2^32 rows")
+    rss_mb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
+    check(rss_mb < 1024, "no child process of this test used 1 GB or more (largest %.0f MB)" % rss_mb)
     # /online/affine: a huge finite value (1e200 x f) and a record reading tensor entry 1e8 of body 0 (segfaults, found by a
     # second audit)
     for name, ds, change, words in (("f_big", "online/affine/f", lambda a: a * 1e200, ["/online/affine/f", "a corrupt file"]),

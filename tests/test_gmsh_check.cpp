@@ -3,11 +3,15 @@
 // audit of 2026-12-02 found (docs/bad_input.md: a physical name with a ':' before its quotes or of 300 characters,
 // counts that disagree with the blocks, an undefined entity or a dimension beyond 3, an element type of another
 // dimension, sparse node tags, a 2.2 element with 1200 or 2e12 tags, a count of 2e9 names), and a truncated file, a
-// repeated node tag, an undefined node and a $Periodic section, gives its message; binary and format 4.0 files are
-// left to the reader (""). No PETSc: the check runs on rank 0 before the reader.
+// repeated node tag, an undefined node and a $Periodic section, gives its message. The same for binary 4.1 (sound in
+// both byte orders and data sizes; a short count, an undefined node, a cut file, a bad marker), and everything the
+// reader was not written for is refused: format 4.0 or 2.6, an odd data size or file type, NUL bytes, an unterminated
+// $Comments block, a word of 5000 characters, not a gmsh file, an empty file. Binary 2.2 is left to the tag check
+// beside this one (""). No PETSc: the check runs on rank 0 before the reader.
 #include "../src/mesh/gmsh_check.hpp"
 #include <unistd.h>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 
@@ -56,6 +60,49 @@ static std::string Replace(std::string s, const std::string &from, const std::st
   if (at == std::string::npos) return "(the test's edit '" + from + "' found nothing)";
   return s.replace(at, from.size(), to);
 }
+
+// The two-triangle mesh of kMesh41 in binary format 4.1, as gmsh writes it: ASCII section names, the values of a
+// section raw after its name's newline (int: 4 bytes, size_t: dsize, double: 8), in little- or big-endian byte order.
+// edit changes it before it is written: nodes, the header's node count; node9, the last triangle's last node.
+struct Bin41 {
+  int  dsize = 8;
+  bool big = false, node9 = false;
+  long nodes = 4;
+  std::string b;
+  void Raw(unsigned long long v, int n)
+  {
+    for (int i = 0; i < n; ++i) b += (char)((v >> (8 * (big ? n - 1 - i : i))) & 0xff);
+  }
+  void I(long long v) { Raw((unsigned long long)v & 0xffffffffull, 4); }
+  void S(unsigned long long v) { Raw(v, dsize); }
+  void D(double v)
+  {
+    unsigned long long u;
+    std::memcpy(&u, &v, 8);
+    Raw(u, 8);
+  }
+  std::string Text()
+  {
+    b = "$MeshFormat\n4.1 1 " + std::to_string(dsize) + "\n";
+    I(1);
+    b += "\n$EndMeshFormat\n$PhysicalNames\n2\n1 11 \"bottom\"\n2 1 \"body\"\n$EndPhysicalNames\n$Entities\n";
+    S(4), S(1), S(1), S(0);
+    const double pt[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int i = 0; i < 4; ++i) I(i + 1), D(pt[i][0]), D(pt[i][1]), D(0), S(0);
+    I(1), D(0), D(0), D(0), D(1), D(0), D(0), S(1), I(11), S(2), I(1), I(-2); // curve 1: bottom
+    I(1), D(0), D(0), D(0), D(1), D(1), D(0), S(1), I(1), S(1), I(1);         // surface 1: body
+    b += "\n$EndEntities\n$Nodes\n";
+    S(2), S(nodes), S(1), S(4);
+    I(0), I(1), I(0), S(1), S(1), D(0), D(0), D(0);
+    I(2), I(1), I(0), S(3), S(2), S(3), S(4), D(1), D(0), D(0), D(1), D(1), D(0), D(0), D(1), D(0);
+    b += "\n$EndNodes\n$Elements\n";
+    S(2), S(3), S(1), S(3);
+    I(1), I(1), I(1), S(1), S(1), S(1), S(2);
+    I(2), I(1), I(2), S(2), S(2), S(1), S(2), S(3), S(3), S(1), S(3), S(node9 ? 9 : 4);
+    b += "\n$EndElements\n";
+    return b;
+  }
+};
 
 static void Expect(const std::string &what, const std::string &text, const std::string &words)
 {
@@ -106,9 +153,35 @@ int main(int argc, char **argv)
   Expect("inf coordinates are left to the geometry check", Replace(kMesh22, "2 1 0 0\n", "2 inf 0 0\n"), "");
   Expect("a $Periodic section", kMesh41 + "$Periodic\n0\n$EndPeriodic\n", "a $Periodic section (gmsh Periodic constraints)");
   Expect("parametric nodes", Replace(kMesh41, "0 1 0 1\n1\n", "0 1 1 1\n1\n"), "has parametric coordinates");
-  Expect("binary 4.1: left to the reader", Replace(kMesh41, "4.1 0 8", "4.1 1 8"), "");
-  Expect("format 4.0: left to the reader", Replace(kMesh41, "4.1 0 8", "4 0 8"), "");
-  Expect("not a gmsh file: left to the reader", "hello\n", "");
+  // binary 4.1 (PETSc: a short node count, an abort then a hang; an undefined node, a segmentation fault)
+  {
+    Bin41 sound, big, d4, short_count, undefined;
+    big.big = true, d4.dsize = 4, short_count.nodes = 3, undefined.node9 = true;
+    Expect("binary 4.1, sound", sound.Text(), "");
+    Expect("binary 4.1, big-endian", big.Text(), "");
+    Expect("binary 4.1, data size 4", d4.Text(), "");
+    Expect("binary 4.1: the header says 3 nodes, the blocks hold 4", short_count.Text(), "$Nodes, byte ");
+    Expect("binary 4.1: ... and names the fault", short_count.Text(), "node block 2 holds 3 nodes, more than the 2 the header's count of 3 leaves");
+    Expect("binary 4.1: an element on an undefined node", undefined.Text(), "element 3 uses node 9, which the file does not define");
+    const std::string t = sound.Text();
+    Expect("binary 4.1 cut inside $Elements", t.substr(0, t.find("$EndElements") - 20), "$Elements, byte");
+    Expect("binary 4.1 with a marker that is not 1", Replace(t, std::string("\n\x01\0\0\0\n", 6), std::string("\n\x02\0\0\0\n", 6)), "the header's endianness marker is not the int 1 in either byte order");
+    Expect("binary 4.1 with a space after a section's name", Replace(t, "$Nodes\n", "$Nodes \n"), "no newline before the number of node blocks");
+    Expect("ASCII 4.1 read as binary (the header says 1)", Replace(kMesh41, "4.1 0 8", "4.1 1 8"), "the header's endianness marker is not the int 1");
+  }
+  // everything else is refused: PETSc's reader was not written for it (each a crash or a hang in the fuzzing audit)
+  Expect("binary 2.2: refused by the tag check beside this one", Replace(kMesh22, "2.2 0 8", "2.2 1 8"), "");
+  Expect("format 4.0", Replace(kMesh41, "4.1 0 8", "4.0 0 8"), "$MeshFormat, line 2: the format version is '4.0': rbcontact reads gmsh files of format 4.1 (gmsh's default) or 2.2");
+  Expect("format 2.6", Replace(kMesh22, "2.2 0 8", "2.6 0 8"), "the format version is '2.6'");
+  Expect("a data size of 0+8", Replace(kMesh41, "4.1 0 8", "4.1 0 0+8"), "the data size is '0+8', not 8 or 4");
+  Expect("a file type of 2", Replace(kMesh41, "4.1 0 8", "4.1 2 8"), "the file type is '2', not 0 (ASCII) or 1 (binary)");
+  Expect("a NUL byte before $MeshFormat", std::string("\0", 1) + kMesh41, "line 1: a control byte (0x00) in the text");
+  Expect("a NUL byte in the version line", Replace(kMesh41, "4.1 0 8", std::string("4.1\0 0 8", 7)), "$MeshFormat, line 2: a control byte (0x00)");
+  Expect("a NUL byte in a physical name", Replace(kMesh41, "\"body\"", std::string("\"bo\0dy\"", 7)), "$PhysicalNames, line 7: a control byte (0x00)");
+  Expect("an unterminated $Comments block", "$Comments\nhello\n", "the file ends where $EndComments should follow");
+  Expect("a word of 5000 characters", Replace(kMesh41, "$Nodes\n", "$Comments\n" + std::string(5000, 'w') + "\n$EndComments\n$Nodes\n"), "after $EndEntities, line 19: a word of 5000 characters where $EndComments should be");
+  Expect("not a gmsh file", "hello\n", "line 1: 'hello' where the first section, $MeshFormat, should be: not a gmsh file");
+  Expect("an empty file", "", "the file is empty");
   std::printf("%d failure(s)\n", failures);
   return failures ? 1 : 0;
 }

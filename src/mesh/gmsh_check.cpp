@@ -1,11 +1,13 @@
-// src/mesh/gmsh_check.cpp: GmshStructureProblem (gmsh_check.hpp), the structure check of a user's ASCII gmsh file
-// (formats 4.1 and 2.2) before PETSc 3.18's reader (src/dm/impls/plex/plexgmsh.c), which trusts the file. Linear in
-// the file's size; memory: the file's text and one byte per node tag of the span the header declares.
+// src/mesh/gmsh_check.cpp: GmshStructureProblem (gmsh_check.hpp), the structure check of a user's gmsh file (formats
+// 4.1 ASCII and binary, 2.2 ASCII) before PETSc 3.18's reader (src/dm/impls/plex/plexgmsh.c), which trusts the file.
+// Linear in the file's size; memory: the file's text and one byte per node tag of the span the header declares.
 #include "gmsh_check.hpp"
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -23,7 +25,7 @@ namespace {
 struct Fault : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-struct NotChecked {}; // a kind of file this check leaves to the reader
+struct NotChecked {}; // binary 2.2, which the tag check beside this one refuses (mesh_loader.cpp)
 
 // Nodes of a gmsh element type that PETSc 3.18 reads (its GmshCellTable), its dimension; 0 for another type.
 int TypeNodes(long long type, int *dim)
@@ -60,8 +62,11 @@ int TypeNodes(long long type, int *dim)
   return 0;
 }
 
-// The file's whitespace-separated tokens, as PETSc's ASCII viewer reads them, with the line of each for the messages.
+// The file's whitespace-separated tokens, as PETSc's ASCII viewer reads them, with the line of each for the messages;
+// in a binary file (format 4.1), a section's values are raw bytes instead (int: 4, size_t: the header's data size,
+// double: 8; in the file's byte order, which its header's marker int says), between ASCII section names.
 const long long kIntMaxT = 2147483647;
+const size_t    kWordMax = 1000; // PETSc 3.18's reader reads a word into a 4096-byte buffer, unchecked; gmsh's are short
 
 class Tokens {
 public:
@@ -78,28 +83,43 @@ public:
     const size_t b = p_;
     while (p_ < t_.size() && !std::isspace((unsigned char)t_[p_])) ++p_;
     last_ = b;
+    raw_  = false;
+    for (size_t i = b; i < p_; ++i)
+      if (IsControl(t_[i])) Fail(ControlByte(t_[i]));
+    if (p_ - b > kWordMax) Fail("a word of " + std::to_string(p_ - b) + " characters where " + what + " should be (PETSc 3.18's reader reads words into a 4096-byte buffer, unchecked)");
     return std::string_view(t_).substr(b, p_ - b);
   }
-  // An integer token in [lo, hi] (the reader's int or size_t, cast to a 32-bit PetscInt).
-  long long Int(const char *what, long long lo, long long hi)
+  // Binary values from here on: int of 4 bytes, size_t of dsize (4 or 8); the byte order from the header's marker int
+  // (1), which follows the header's line.
+  void Binary(int dsize)
   {
-    const std::string tok(Next(what));
-    char             *end = nullptr;
-    errno                 = 0;
-    const long long v     = std::strtoll(tok.c_str(), &end, 10);
-    if (tok.empty() || *end || errno) Fail(std::string(what) + " is '" + Short(tok) + "', not an integer");
-    if (v < lo || v > hi) Fail(std::string(what) + " is " + tok + ", outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return v;
+    dsize_ = dsize;
+    if (Raw(4, "the header's endianness marker (the int 1)") != 1) {
+      big_ = true;
+      p_ -= 4;
+      if (Raw(4, "the header's endianness marker (the int 1)") != 1) Fail("the header's endianness marker is not the int 1 in either byte order (not a binary gmsh file, or a damaged one)");
+    }
   }
+  bool IsBinary() const { return dsize_ > 0 && !text_; }
+  // A section of ASCII values in a binary file ($PhysicalNames), or the end of it.
+  void TextSection(bool on) { text_ = on; }
+  // An integer in [lo, hi]: a token, or in a binary file an int (4 bytes, signed) or, with size, a size_t (unsigned of
+  // the data size); cast to a 32-bit PetscInt by the reader.
+  long long Int(const char *what, long long lo, long long hi) { return Value(what, lo, hi, false); }
+  long long Size(const char *what, long long lo, long long hi) { return Value(what, lo, hi, true); }
   // A header's count: at most what the rest of the file can hold (room: an upper bound from its size).
   long long Count(const char *what, long long room)
   {
-    const long long v = Int(what, 0, kIntMaxT);
+    const long long v = Size(what, 0, kIntMaxT);
     if (v > room) Fail(std::string(what) + " is " + std::to_string(v) + ", more than the rest of the file can hold (" + std::to_string(room) + " at most)");
     return v;
   }
   void Real(const char *what) // any number, inf and nan included (the geometry check after the reader names those)
   {
+    if (IsBinary()) {
+      Raw(8, what);
+      return;
+    }
     const std::string tok(Next(what));
     char             *end = nullptr;
     (void)std::strtod(tok.c_str(), &end);
@@ -125,7 +145,9 @@ public:
   {
     const size_t e = t_.find('\n', p_);
     std::string  r = t_.substr(p_, (e == std::string::npos ? t_.size() : e) - p_);
-    p_             = e == std::string::npos ? t_.size() : e;
+    for (char c : r)
+      if (IsControl(c) && c != '\t' && c != '\r') Fail(ControlByte(c));
+    p_ = e == std::string::npos ? t_.size() : e;
     return r;
   }
   // Characters left (a bound on the counts a header may declare).
@@ -134,8 +156,9 @@ public:
   void   Rewind(size_t at) { p_ = at; }
   [[noreturn]] void Fail(const std::string &why) const
   {
-    const size_t at   = last_ < t_.size() ? last_ : t_.size();
-    size_t       line = 1;
+    const size_t at = last_ < t_.size() ? last_ : t_.size();
+    if (dsize_ > 0) throw Fault(section_ + (section_.empty() ? "" : ", ") + "byte " + std::to_string(at) + ": " + why);
+    size_t line = 1;
     for (size_t i = 0; i < at; ++i) line += t_[i] == '\n';
     throw Fault(section_ + (section_.empty() ? "" : ", ") + "line " + std::to_string(line) + ": " + why);
   }
@@ -143,12 +166,66 @@ public:
 
 private:
   static std::string Short(const std::string &s) { return s.size() > 40 ? s.substr(0, 40) + "..." : s; }
-  void               Skip()
+  // a byte no gmsh text holds (PETSc's reader: a NUL cut its words, then a segmentation fault or a hang)
+  static bool        IsControl(char c) { return ((unsigned char)c < 0x20 && !std::isspace((unsigned char)c)) || c == 0x7f; }
+  static std::string ControlByte(char c)
+  {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02x", (unsigned)(unsigned char)c);
+    return std::string("a control byte (") + hex + ") in the text (a damaged file, or a binary one whose header says ASCII)";
+  }
+  void Skip()
   {
     while (p_ < t_.size() && std::isspace((unsigned char)t_[p_])) ++p_;
   }
+  long long Value(const char *what, long long lo, long long hi, bool size)
+  {
+    long long   v;
+    std::string shown;
+    if (IsBinary()) {
+      const unsigned long long u = Raw(size ? dsize_ : 4, what);
+      if (size && u > (unsigned long long)hi) Fail(std::string(what) + " is " + std::to_string(u) + ", outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      v     = size ? (long long)u : (long long)(int32_t)(uint32_t)u;
+      shown = std::to_string(v);
+    } else {
+      const std::string tok(Next(what));
+      char             *end = nullptr;
+      errno                 = 0;
+      v                     = std::strtoll(tok.c_str(), &end, 10);
+      if (tok.empty() || *end || errno) Fail(std::string(what) + " is '" + Short(tok) + "', not an integer");
+      shown = tok;
+    }
+    if (v < lo || v > hi) Fail(std::string(what) + " is " + shown + ", outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return v;
+  }
+  // n raw bytes as an unsigned value in the file's byte order. The first value after a section's name starts after
+  // the one newline that ends the name's line, as gmsh writes it.
+  unsigned long long Raw(int n, const char *what)
+  {
+    if (!raw_) {
+      if (p_ >= t_.size() || t_[p_] != '\n') {
+        last_ = p_;
+        Fail(std::string("no newline before ") + what + " (binary data follows its section's name and one newline)");
+      }
+      ++p_;
+      raw_ = true;
+    }
+    last_ = p_;
+    if (t_.size() - p_ < (size_t)n) Fail(std::string("the file ends where ") + what + " should follow");
+    unsigned long long v = 0;
+    for (int i = 0; i < n; ++i) {
+      const unsigned long long b = (unsigned char)t_[p_ + (size_t)i];
+      v |= b << (8 * (big_ ? n - 1 - i : i));
+    }
+    p_ += (size_t)n;
+    return v;
+  }
   std::string t_;
   size_t      p_ = 0, last_ = 0;
+  int         dsize_ = 0;     // > 0: a binary file
+  bool        big_   = false; // its values are big-endian
+  bool        raw_   = false; // the last thing read was raw bytes (else a token: a newline precedes the next raw value)
+  bool        text_  = false; // an ASCII section of a binary file
 };
 
 const long long kIntMax = kIntMaxT; // the reader's int and 32-bit PetscInt
@@ -225,17 +302,17 @@ void Nodes41(Tokens &tk, const std::set<long long> entities[4], NodeTags *tags)
   tk.section_           = "$Nodes";
   const long long nb    = tk.Count("the number of node blocks", (long long)tk.Left() / 8);
   const long long nn    = tk.Count("the number of nodes", (long long)tk.Left() / 8);
-  const long long lo    = tk.Int("the smallest node tag", 0, kIntMax);
-  const long long hi    = tk.Int("the largest node tag", 0, kIntMax);
+  const long long lo    = tk.Size("the smallest node tag", 0, kIntMax);
+  const long long hi    = tk.Size("the largest node tag", 0, kIntMax);
   long long       total = 0;
   tags->Span(tk, lo, hi, nn);
   for (long long b = 0; b < nb; ++b) {
     const long long dim = tk.Int("a node block's entity dimension", 0, 3), eid = tk.Int("a node block's entity tag", -kIntMax, kIntMax);
     if (!entities[dim].count(eid)) tk.Fail("node block " + std::to_string(b + 1) + " names entity " + std::to_string(eid) + " of dimension " + std::to_string(dim) + ", which $Entities does not define");
     if (tk.Int("a node block's parametric flag", 0, 1)) tk.Fail("node block " + std::to_string(b + 1) + " has parametric coordinates, which PETSc 3.18's reader does not read (save the mesh without Mesh.SaveParametric)");
-    const long long n = tk.Int("a node block's node count", 0, kIntMax);
+    const long long n = tk.Size("a node block's node count", 0, kIntMax);
     if (n > nn - total) tk.Fail("node block " + std::to_string(b + 1) + " holds " + std::to_string(n) + " nodes, more than the " + std::to_string(nn - total) + " the header's count of " + std::to_string(nn) + " leaves");
-    for (long long k = 0; k < n; ++k) tags->Define(tk, tk.Int("a node tag", 1, kIntMax));
+    for (long long k = 0; k < n; ++k) tags->Define(tk, tk.Size("a node tag", 1, kIntMax));
     for (long long k = 0; k < 3 * n; ++k) tk.Real("a node coordinate");
     total += n;
   }
@@ -254,8 +331,8 @@ std::string Elements41(Tokens &tk, const std::set<long long> entities[4], const 
   tk.section_        = "$Elements";
   const long long nb = tk.Count("the number of element blocks", (long long)tk.Left() / 8);
   const long long ne = tk.Count("the number of elements", (long long)tk.Left() / 4);
-  tk.Int("the smallest element tag", 0, kIntMax);
-  tk.Int("the largest element tag", 0, kIntMax);
+  tk.Size("the smallest element tag", 0, kIntMax);
+  tk.Size("the largest element tag", 0, kIntMax);
   long long total = 0;
   for (long long b = 0; b < nb; ++b) {
     const long long dim = tk.Int("an element block's entity dimension", 0, 3), eid = tk.Int("an element block's entity tag", -kIntMax, kIntMax);
@@ -265,12 +342,12 @@ std::string Elements41(Tokens &tk, const std::set<long long> entities[4], const 
     const int       nn   = TypeNodes(type, &tdim);
     if (!nn) tk.Fail("element type " + std::to_string(type) + " is not one PETSc 3.18's reader reads");
     if (tdim != dim) tk.Fail("element block " + std::to_string(b + 1) + " of dimension " + std::to_string(dim) + " holds elements of type " + std::to_string(type) + ", of dimension " + std::to_string(tdim));
-    const long long n = tk.Int("an element block's element count", 0, kIntMax);
+    const long long n = tk.Size("an element block's element count", 0, kIntMax);
     if (n > ne - total) tk.Fail("element block " + std::to_string(b + 1) + " holds " + std::to_string(n) + " elements, more than the " + std::to_string(ne - total) + " the header's count of " + std::to_string(ne) + " leaves");
     for (long long k = 0; k < n; ++k) {
-      const long long id = tk.Int("an element tag", 0, kIntMax);
+      const long long id = tk.Size("an element tag", 0, kIntMax);
       for (int j = 0; j < nn; ++j) {
-        const long long node = tk.Int("an element's node tag", 0, kIntMax);
+        const long long node = tk.Size("an element's node tag", 0, kIntMax);
         if (!tags.Known(node)) return UndefinedNode(id, node);
       }
     }
@@ -341,33 +418,47 @@ std::string GmshStructureProblem(const std::string &path)
   }
   Tokens tk(std::move(text));
   try {
-    if (tk.Section() != "$MeshFormat") return ""; // not a gmsh file: PETSc's reader says so
-    tk.section_             = "$MeshFormat";
+    const std::string first = tk.Section();
+    if (first.empty()) return "the file is empty (or holds only white space)";
+    if (first != "$MeshFormat") tk.Fail("'" + first.substr(0, 40) + "' where the first section, $MeshFormat, should be: not a gmsh file");
+    tk.section_ = "$MeshFormat";
     const std::string ver(tk.Next("the format version"));
     const std::string type(tk.Next("the file type"));
-    tk.Next("the data size");
-    const bool v41 = ver == "4.1", v22 = ver == "2.2";
-    if ((!v41 && !v22) || type != "0") throw NotChecked(); // binary, 4.0, another version: left to the reader
+    const std::string dsize(tk.Next("the data size"));
+    const bool        v41 = ver == "4.1", v22 = ver == "2.2";
+    if (!v41 && !v22)
+      tk.Fail("the format version is '" + ver.substr(0, 40) + "': rbcontact reads gmsh files of format 4.1 (gmsh's default) or 2.2 (PETSc 3.18's reader mishandles the others, and an unchecked file can crash it); re-save it with gmsh -format msh41");
+    if (type != "0" && type != "1") tk.Fail("the file type is '" + type.substr(0, 40) + "', not 0 (ASCII) or 1 (binary)");
+    if (dsize != "8" && !(v41 && dsize == "4")) tk.Fail("the data size is '" + dsize.substr(0, 40) + "', not " + (v41 ? "8 or 4" : "8"));
+    if (type == "1") {
+      if (v22) throw NotChecked(); // binary 2.2: refused by the tag check beside this one (mesh_loader.cpp)
+      tk.Binary(dsize == "8" ? 8 : 4);
+    }
     tk.Expect("$EndMeshFormat");
     std::set<long long> entities[4];
     NodeTags            tags;
-    std::string         s = tk.Section();
+    tk.section_   = "after $EndMeshFormat";
+    std::string s = tk.Section();
     if (s == "$PhysicalNames") {
+      tk.TextSection(true); // (ASCII in a binary file too)
       PhysicalNames(tk);
-      s = tk.Section();
+      tk.TextSection(false);
+      tk.section_ = "after $EndPhysicalNames";
+      s           = tk.Section();
     }
     if (v41) {
-      tk.section_ = "after $EndPhysicalNames";
+      tk.section_ = "before $Entities";
       if (s != "$Entities") tk.Fail("'" + s + "' where $Entities should be (PETSc 3.18's reader needs it in format 4.1)");
       Entities41(tk, entities);
-      s = tk.Section();
+      tk.section_ = "after $EndEntities";
+      s           = tk.Section();
     }
     tk.section_ = "before $Nodes";
     if (s != "$Nodes") tk.Fail("'" + s + "' where $Nodes should be");
     if (v41) Nodes41(tk, entities, &tags);
     else Nodes22(tk, &tags);
-    s           = tk.Section();
     tk.section_ = "after $EndNodes";
+    s           = tk.Section();
     if (s != "$Elements") tk.Fail("'" + s + "' where $Elements should be");
     const std::string undefined = v41 ? Elements41(tk, entities, tags) : Elements22(tk, tags);
     if (!undefined.empty()) return undefined;

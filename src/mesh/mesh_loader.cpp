@@ -544,7 +544,8 @@ PetscErrorCode MeshLoad(MPI_Comm comm, const SceneSpec &scene, DM *dm)
     // physical group (gmsh then saves only its boundary curves, which PETSc's reader refuses on rank 0 while the other
     // ranks wait in its collectives: a hang on 2 ranks for a generated mesh, which is not parsed on rank 0 first); in
     // a user's file, everything the reader would mishandle (GmshStructureProblem: an element pointing at an undefined
-    // node, counts that disagree with the data, undefined entities, ...).
+    // node, counts that disagree with the data, undefined entities, a NUL byte, a format other than 4.1 ASCII or binary
+    // and 2.2 ASCII, ...): the reader sees no user's file the check has not read.
     std::string why;
     PetscMPIInt r0;
     PetscCallMPI(MPI_Comm_rank(comm, &r0));

@@ -75,6 +75,9 @@ std::string Names(const std::vector<ParamSpec> &params)
   return s.empty() ? "none" : s;
 }
 
+// The most samples a training set holds (a tensor grid, random or LHS set, or a sample file).
+const size_t kMaxSamples = 10000000;
+
 // Reads a sample file; returns an error message (empty: success).
 std::string ReadSampleFile(const std::string &path, const std::string &option, const std::vector<ParamSpec> &params, std::vector<std::vector<PetscReal>> *pts)
 {
@@ -125,6 +128,8 @@ std::string ReadSampleFile(const std::string &path, const std::string &option, c
         // the shortest digits that tell the value from the box's ends (the box was printed with 17 digits)
         return "Parameter sample file '" + path + "' line " + std::to_string(lineno) + ": " + OutOfBoxMessage(params[j], x[j]);
       }
+    if (pts->size() == kMaxSamples) // (an 80 MB file took 3.6 GB and a minute before this cap)
+      return "Parameter sample file '" + path + "' line " + std::to_string(lineno) + ": more than " + std::to_string(kMaxSamples) + " samples (the cap of every training set)";
     pts->push_back(x);
   }
   if (f.bad()) return "Error reading the parameter sample file '" + path + "'";
