@@ -6,7 +6,9 @@
 #include <hdf5.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -223,10 +225,26 @@ inline bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hs
   // A corrupted dataspace declares more values than the file stores: refused here, before a reader allocates them (a
   // fuzzed ROM file of 115 kB declared 4294966024 values: 4.2 GB allocated and zeroed, then H5Dread failed). Checked
   // for contiguous datasets (every one CreateDataset makes, h5py's default), whose storage is all there once written;
-  // an unwritten one (no storage) passes if it fits in the file. Chunked (compressed) datasets are not checked.
+  // an unwritten one (no storage) passes if it fits in the file. A chunked dataset (h5py with compression or maxshape;
+  // rbcontact writes none) must hold every chunk its shape needs: an unwritten chunk reads as the fill value, so a
+  // declared shape of 2^32 rows over one stored chunk was a ROM file of 157 kB that asked for 447 GB (refused since
+  // 2026-12-03; compression itself is fine: the chunks are counted, not their bytes).
   H5Id t(H5Dget_type(d), H5Tclose);
   H5Id pl(H5Dget_create_plist(d), H5Pclose);
-  if (t.ok() && pl.ok() && H5Pget_layout(pl.get()) == H5D_CONTIGUOUS) {
+  const H5D_layout_t layout = pl.ok() ? H5Pget_layout(pl.get()) : H5D_LAYOUT_ERROR;
+  if (layout == H5D_CHUNKED && rank > 0) {
+    std::vector<hsize_t> chunk((size_t)rank, 0);
+    hsize_t              stored = 0;
+    if (H5Pget_chunk(pl.get(), rank, chunk.data()) != rank || H5Dget_num_chunks(d, sp.get(), &stored) < 0) return c.Fail("cannot get the chunks of dataset " + name);
+    long double need = 1;
+    for (int i = 0; i < rank; ++i) need *= chunk[i] > 0 ? std::ceil((long double)(*dims)[i] / (long double)chunk[i]) : 0.0L;
+    if ((long double)stored < need) {
+      std::ostringstream m;
+      m << "dataset " << name << " declares shape " << ShapeString(*dims) << " in chunks of " << ShapeString(chunk) << " but stores " << (unsigned long long)stored << " of its " << (unsigned long long)std::min(need, 1.8e19L) << " chunks: a corrupt or truncated file";
+      return c.Fail(m.str(), false);
+    }
+  }
+  if (t.ok() && layout == H5D_CONTIGUOUS) {
     long double bytes = (long double)H5Tget_size(t.get());
     for (hsize_t x : *dims) bytes *= (long double)x;
     const hsize_t stored = H5Dget_storage_size(d);

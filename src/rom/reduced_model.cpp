@@ -937,8 +937,12 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     // -rom_threads: the regions below split over the points (or the patch's rows) on nth threads
     const int nth = (int)threads;
     if (nth > 1 && !pool_.pool) { // the first threaded solve: say so when the threads must share cores
+      // (once per job, by the first rank of PETSC_COMM_WORLD: mpirun binds every rank alike, and the solves are not
+      // collective, so the ranks cannot agree on one message)
       const PetscInt nc = ThreadCpus();
-      if (nc > 0 && nc < nth) PetscCallAbort(PETSC_COMM_SELF, PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "WARNING: -rom_threads %d, but this process may run on %d CPU(s) only, so the threads share them and the solve may run slower than on one thread (mpirun binds each rank to a core by default: run with mpirun --bind-to none, or --map-by slot:PE=%d)\n", nth, (int)nc, nth));
+      PetscMPIInt    wr = 0;
+      if (MPI_Comm_rank(PETSC_COMM_WORLD, &wr) != MPI_SUCCESS) wr = 0;
+      if (wr == 0 && nc > 0 && nc < nth) PetscCallAbort(PETSC_COMM_SELF, PetscFPrintf(PETSC_COMM_SELF, PETSC_STDERR, "WARNING: -rom_threads %d, but this process may run on %d CPU(s) only, so the threads share them and the solve may run slower than on one thread (mpirun binds each rank to a core by default: run with mpirun --bind-to none, or --map-by slot:PE=%d)\n", nth, (int)nc, nth));
     }
     ForkJoin *pool = nth > 1 ? &pool_.Get(nth) : nullptr;
     // (ContactTerms returns a count, not an error code: the events' calls abort on an error)
