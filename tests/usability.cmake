@@ -2,7 +2,7 @@
 # report and HDF5 file, the report of a failed run, -help, the boundary options renamed out of PETSc's
 # -bc_ namespace, the README's iterative solver on a contact scene (tests/usability_checks.py), the
 # installation (tests/install_check.sh), the "your own scene" tutorial with the installed package
-# (tests/tutorial_check.sh, docs/tutorial.md).
+# (tests/tutorial_check.sh, docs/tutorial.md), Makefile.petsc (tests/makefile_petsc_check.sh).
 find_program(RBC_PYTHON3_U NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_UC ${RBC_PYTHON3_U} ${CMAKE_CURRENT_SOURCE_DIR}/usability_checks.py)
 foreach(np 1 2)
@@ -22,3 +22,6 @@ set_tests_properties(usability_install PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" T
 # empty directory with the installed binary (1 rank, about 15 s)
 add_test(NAME usability_tutorial COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tutorial_check.sh ${CMAKE_BINARY_DIR})
 set_tests_properties(usability_tutorial PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)
+# Makefile.petsc (the build for users with their own PETSc/SLEPc): its info, three objects, its errors (about 10 s)
+add_test(NAME usability_makefile_petsc COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/makefile_petsc_check.sh ${PROJECT_SOURCE_DIR})
+set_tests_properties(usability_makefile_petsc PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)
