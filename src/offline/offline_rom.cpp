@@ -23,7 +23,9 @@
 
 namespace rbc {
 
-static PetscLogEvent OFF_EIM = 0, OFF_Affine = 0;
+// OFF_Hyper: the hyper-reduction of the contact terms (the contact states, the cubature fit and/or the EIM, the patch
+// self-check; it was named RBCEIM until 2026-12-03 though it also timed the cubature)
+static PetscLogEvent OFF_Hyper = 0, OFF_Affine = 0;
 
 // Position of p in list, appended if absent.
 static PetscInt Intern(std::vector<PetscInt> *list, PetscInt p)
@@ -267,7 +269,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   ReducedModel   rm;
 
   PetscFunctionBeginUser;
-  if (!OFF_EIM) PetscCall(PetscLogEventRegister("RBCEIM", DM_CLASSID, &OFF_EIM));
+  if (!OFF_Hyper) PetscCall(PetscLogEventRegister("RBCHyperReduction", DM_CLASSID, &OFF_Hyper));
   PetscCallMPI(MPI_Comm_rank(world, &wrank));
   const PetscInt N = Npod + nsup, R = dual.W.cols, m = (PetscInt)snaps.size();
   PetscCall(PetscTime(&t0));
@@ -276,7 +278,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
   std::shared_ptr<ContactPatch> full;
   std::vector<PetscReal>        P;
   PetscCall(BuildExactReducedModel(world, fom, cmap, order, V, modes, Npod, nsup, dual, &rm, &full, &P, &nsub));
-  PetscCall(PetscLogEventBegin(OFF_EIM, 0, 0, 0, 0));
+  PetscCall(PetscLogEventBegin(OFF_Hyper, 0, 0, 0, 0));
   const PetscInt Q = full->NumPoints();
   rm.warmStart      = PETSC_FALSE;
   rm.loop.monitor   = PETSC_FALSE;
@@ -630,7 +632,7 @@ PetscErrorCode OfflineReducedModel(MPI_Comm world, ElasticFOM &fom, ContactMap &
     }
     PetscCheck(patchDiff <= 1e-12 && outside == 0, world, PETSC_ERR_PLIB, "offline: the local contact data differs from the full contact map by %g (%" PetscInt_FMT " projections outside): increase -eim_patch_rings", (double)patchDiff, outside);
   }
-  PetscCall(PetscLogEventEnd(OFF_EIM, 0, 0, 0, 0));
+  PetscCall(PetscLogEventEnd(OFF_Hyper, 0, 0, 0, 0));
   PetscCall(PetscTime(&t2));
   // outputs of interest on the slave surface (max pressure, contact half-width; surface_outputs.hpp): the dual
   // basis on the slave vertices and the slave facets; their weights checked against the FOM's at the default
