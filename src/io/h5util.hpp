@@ -113,6 +113,33 @@ inline bool FileExists(const std::string &path)
   return stat(path.c_str(), &st) == 0;
 }
 
+// Whether the link `name` exists below `loc`, every group on its path checked (H5Lexists fails on a missing group).
+inline bool LinkExists(Ctx &c, hid_t loc, const std::string &name, bool *exists)
+{
+  *exists = true;
+  for (size_t k = name.find('/', 1); *exists; k = name.find('/', k + 1)) {
+    const std::string prefix = name.substr(0, k);
+    const htri_t      e      = H5Lexists(loc, prefix.c_str(), H5P_DEFAULT);
+    if (e < 0) return c.Fail("cannot read the link " + prefix + ": a corrupt file");
+    *exists = e > 0;
+    if (k == std::string::npos) break;
+  }
+  return true;
+}
+
+// Opens dataset `name`; a failure says whether it is missing or there but unreadable (a corrupt header: with the
+// checksummed metadata of CreateFile, a damaged object header fails here, and "missing" would mislead).
+inline bool OpenDataset(Ctx &c, hid_t loc, const std::string &name, H5Id *d)
+{
+  *d = H5Id(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+  if (d->ok()) return true;
+  const std::string detail = H5Detail();
+  bool              exists = false;
+  if (!LinkExists(c, loc, name, &exists)) return false;
+  if (!exists) return c.Fail("missing dataset " + name, false);
+  return c.Fail("dataset " + name + " is there but cannot be opened: a corrupt file" + (detail.empty() ? std::string() : " (HDF5: " + detail + ")"), false);
+}
+
 inline bool MakeStringType(Ctx &c, size_t len, H5Id *t)
 {
   *t = H5Id(H5Tcopy(H5T_C_S1), H5Tclose);
@@ -273,8 +300,8 @@ inline bool WriteWhole(Ctx &c, hid_t file, const std::string &name, hid_t ftype,
 
 inline bool ReadWhole(Ctx &c, hid_t file, const std::string &name, const std::vector<hsize_t> &expect, std::vector<double> *v)
 {
-  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!d.ok()) return c.Fail("missing dataset " + name);
+  H5Id d;
+  if (!OpenDataset(c, file, name, &d)) return false;
   std::vector<hsize_t> dims;
   if (!DatasetDims(c, d.get(), name, &dims)) return false;
   if (dims != expect) return c.Fail("dataset " + name + " has shape " + ShapeString(dims) + ", expected " + ShapeString(expect) + " (corrupt file?)", false);
@@ -288,8 +315,8 @@ inline bool ReadWhole(Ctx &c, hid_t file, const std::string &name, const std::ve
 // Reads or writes row `row` (ncols values) of a 1D (ncols = 1) or 2D dataset.
 inline bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsize_t row, hsize_t ncols, void *buf, bool write)
 {
-  H5Id d(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!d.ok()) return c.Fail("missing dataset " + name);
+  H5Id d;
+  if (!OpenDataset(c, file, name, &d)) return false;
   H5Id fs(H5Dget_space(d.get()), H5Sclose);
   if (!fs.ok()) return c.Fail("cannot get the dataspace of dataset " + name);
   const int rank = H5Sget_simple_extent_ndims(fs.get());
@@ -309,6 +336,19 @@ inline bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsiz
   const herr_t st = write ? H5Dwrite(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf) : H5Dread(d.get(), mtype, ms.get(), fs.get(), H5P_DEFAULT, buf);
   if (st < 0) return c.Fail(std::string("cannot ") + (write ? "write" : "read") + " row " + std::to_string((unsigned long long)row) + " of dataset " + name);
   return true;
+}
+
+// Creates (truncates) an HDF5 file in the 1.8 file format (H5Pset_libver_bounds V18..V18): superblock v2, object
+// headers v2, whose metadata (headers, attributes, dataspaces, links) HDF5 checksums, so a corrupted header is an error
+// on opening rather than a wrong shape, a crash or a wrong value (docs/bad_input.md). Not the 1.10 format: its
+// superblock v3 marks a file open for writing, and a snapshot file left by a killed job would need h5clear
+// (docs/snapshot_file.md). Readable by HDF5 >= 1.8 (h5py, ParaView). Every file rbcontact writes itself (ROM, basis,
+// snapshot files) is created here; files opened for writing later keep the format they have.
+inline hid_t CreateFile(const std::string &path)
+{
+  H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!fapl.ok() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) return H5I_INVALID_HID;
+  return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
 }
 
 // H5Fflush, then fsync of the file descriptor (data reaches the disk, not only the OS cache).

@@ -51,7 +51,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
     const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
     bool              ok  = true;
     {
-      H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+      H5Id f(CreateFile(tmp), H5Fclose);
       if (!f.ok()) ok = c.Fail("cannot create the file (directory missing or not writable?)");
       if (ok) ok = WriteStringAttr(c, f.get(), "format", kRomFormat);
       if (ok) {
@@ -98,10 +98,9 @@ PetscErrorCode RomReadDataset(const std::string &path, const std::string &name, 
   PetscFunctionBeginUser;
   bool ok = OpenRom(c, path, &f);
   if (ok) {
-    H5Id d(H5Dopen2(f.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
+    H5Id                 d;
     std::vector<hsize_t> hd;
-    if (!d.ok()) ok = c.Fail("missing dataset " + name, false);
-    if (ok) ok = DatasetDims(c, d.get(), name, &hd);
+    ok = OpenDataset(c, f.get(), name, &d) && DatasetDims(c, d.get(), name, &hd);
     if (ok) ok = ReadWhole(c, f.get(), name, hd, data);
     dims->assign(hd.begin(), hd.end());
   }
@@ -146,14 +145,7 @@ PetscErrorCode RomReadOptional(const std::string &file, const std::string &name,
     Ctx     c{"ROM file '" + file + "'", std::string()};
     H5Id    f;
     bool    ok = OpenRom(c, file, &f);
-    exists     = ok;
-    for (size_t k = name.find('/', 1); ok && exists; k = name.find('/', k + 1)) {
-      const std::string prefix = name.substr(0, k);
-      const htri_t      e      = H5Lexists(f.get(), prefix.c_str(), H5P_DEFAULT);
-      if (e < 0) ok = c.Fail("cannot query " + prefix);
-      exists = e > 0;
-      if (k == std::string::npos) break;
-    }
+    ok         = ok && LinkExists(c, f.get(), name, &exists);
     PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s", c.err.c_str());
   }
   *found = exists;

@@ -177,8 +177,8 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
   h->meshChecksum = mc;
   if (!ReadStringAttr(c, f, "code_version", &h->codeVersion) || !ReadStringAttr(c, f, "options", &h->optionsText)) return false;
   if (h->optionsText == "@/options") {
-    H5Id d(H5Dopen2(f, "/options", H5P_DEFAULT), H5Dclose);
-    if (!d.ok()) return c.Fail("missing dataset /options");
+    H5Id d;
+    if (!OpenDataset(c, f, "/options", &d)) return false;
     H5Id t(H5Dget_type(d.get()), H5Tclose);
     if (!t.ok()) return c.Fail("cannot get the type of dataset /options");
     std::vector<char> buf(H5Tget_size(t.get()) + 1, 0);
@@ -195,8 +195,8 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
 
   // /params/names
   {
-    H5Id d(H5Dopen2(f, "/params/names", H5P_DEFAULT), H5Dclose);
-    if (!d.ok()) return c.Fail("missing dataset /params/names");
+    H5Id d;
+    if (!OpenDataset(c, f, "/params/names", &d)) return false;
     std::vector<hsize_t> dims;
     if (!DatasetDims(c, d.get(), "/params/names", &dims)) return false;
     if (dims != std::vector<hsize_t>{np}) return c.Fail("dataset /params/names has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)np), false);
@@ -219,8 +219,8 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
 
 bool ReadDone(Ctx &c, hid_t f, hsize_t ntrain, std::vector<signed char> *done)
 {
-  H5Id d(H5Dopen2(f, "/snapshots/done", H5P_DEFAULT), H5Dclose);
-  if (!d.ok()) return c.Fail("missing dataset /snapshots/done");
+  H5Id d;
+  if (!OpenDataset(c, f, "/snapshots/done", &d)) return false;
   std::vector<hsize_t> dims;
   if (!DatasetDims(c, d.get(), "/snapshots/done", &dims)) return false;
   if (dims != std::vector<hsize_t>{ntrain}) return c.Fail("dataset /snapshots/done has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)ntrain), false);
@@ -352,7 +352,7 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
   if (!CheckNotLocked(c, target)) return false;
   {
-    H5Id f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+    H5Id f(CreateFile(tmp), H5Fclose);
     bool ok = f.ok() || ct.Fail("cannot create the file (directory missing or not writable?)");
     ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && FlushSync(ct, f.get()) && CloseFile(ct, &f);
     if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + target + "': " + std::strerror(errno), false);
