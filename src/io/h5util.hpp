@@ -17,8 +17,18 @@
 namespace rbc {
 namespace h5 {
 
+// Set once HDF5 has failed on a file and the failure is in one of our messages (Ctx::Fail): HDF5 1.10.8 leaks
+// free-list blocks on a failed metadata load (a checksum error) and, at MPI_Finalize, would print "HDF5: infinite
+// loop closing library" and a line of interface codes below our message; it prints that only while automatic
+// error printing is on (H5_term_library), so from then on H5Quiet leaves it off.
+inline bool &KeepQuiet()
+{
+  static bool keep = false;
+  return keep;
+}
+
 // Silences HDF5's automatic error-stack printing while alive (we report errors ourselves), then
-// restores the previous handler.
+// restores the previous handler (unless KeepQuiet()).
 class H5Quiet {
 public:
   H5Quiet()
@@ -26,7 +36,10 @@ public:
     H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   }
-  ~H5Quiet() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+  ~H5Quiet()
+  {
+    if (!KeepQuiet()) H5Eset_auto2(H5E_DEFAULT, func_, data_);
+  }
   H5Quiet(const H5Quiet &)            = delete;
   H5Quiet &operator=(const H5Quiet &) = delete;
 
@@ -101,6 +114,7 @@ struct Ctx {
       if (hdf5) {
         const std::string d = H5Detail();
         if (!d.empty()) err += " (HDF5: " + d + ")";
+        KeepQuiet() = KeepQuiet() || !d.empty();
       }
     }
     return false;
@@ -137,6 +151,7 @@ inline bool OpenDataset(Ctx &c, hid_t loc, const std::string &name, H5Id *d)
   bool              exists = false;
   if (!LinkExists(c, loc, name, &exists)) return false;
   if (!exists) return c.Fail("missing dataset " + name, false);
+  KeepQuiet() = KeepQuiet() || !detail.empty();
   return c.Fail("dataset " + name + " is there but cannot be opened: a corrupt file" + (detail.empty() ? std::string() : " (HDF5: " + detail + ")"), false);
 }
 
