@@ -23,6 +23,8 @@
   initial_guess  -snapshots_initial_guess nearest (half_disks on the dense dual path, with and without sensitivities;
               sphere_block3d on the saddle path with GAMG): the snapshots of the zero start to the Kacanov tolerance, in
               fewer Kacanov iterations, on 1 rank and on 2 (two groups, each from its own); a bad value refused.
+  disk_full   a full disk (a small tmpfs; skipped, exit 77, where it cannot be mounted): the ROM pair's and the snapshot
+              file's writes refused with "No space left on device" naming the file, the previous pair kept, nothing left.
 """
 import argparse
 import atexit
@@ -278,6 +280,26 @@ def mismatch(args):
               and not os.path.exists(d + "/never.h5"), "%s in a done row of /snapshots/%s: refused naming the file, the row and the dataset, no ROM" % (val, ds))
     p = bases_from_tampered("prov_kkt_nan", "kkt", 1, np.nan)
     check(p.returncode == 0, "a NaN KKT residual (not given) is accepted")
+    # the options text in the dataset /options (written when it is too long for an attribute): read as one fixed-length
+    # string; a dataset of 64 of them was read 64 x its size into a buffer of one (a heap overflow, review of 2026-12-04)
+    with h5py.File(d + "/s.h5", "r") as f:
+        text = f.attrs["options"]
+        text = text.decode() if isinstance(text, bytes) else str(text)
+    for name, data in (("opt_one", np.array(text.encode(), dtype="S%d" % (len(text) + 1))),
+                       ("opt_many", np.array([text.encode()] * 64, dtype="S%d" % (len(text) + 1))),
+                       ("opt_vlen", np.array([text], dtype=h5py.string_dtype()))):
+        shutil.copy(d + "/s.h5", d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "r+") as f:
+            f.attrs["options"] = np.bytes_(b"@/options")
+            f["options"] = data
+        p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
+                            "-offline_stop", "bases", "-snapshots", d + "/%s.h5" % name, "-snapshots_restart", "-rom", d + "/never.h5"],
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        if name == "opt_one":
+            check(p.returncode == 0, "the options text in a dataset /options (one fixed-length string): read, the bases built")
+        else:
+            check(p.returncode != 0 and "%s.h5" % name in p.stdout and "dataset /options is not one fixed-length string" in p.stdout and "SEGV" not in p.stdout,
+                  "a dataset /options of %s: refused naming the file and the dataset (exit %d)" % ("64 strings" if name == "opt_many" else "a variable-length string", p.returncode))
 
 
 def early_options(args):
@@ -696,9 +718,84 @@ def initial_guess(args):
           "-snapshots_initial_guess previous is refused, naming the option, before any snapshot file")
 
 
+def disk_full(args):
+    """A full disk (a 4 MB tmpfs mounted for the test; skipped, exit 77, where it cannot be mounted): the ROM pair's and
+    the snapshot file's writes fail with a message naming the file and "No space left on device"; the previous ROM and
+    basis file stay as they were (also when the basis file was already replaced: put back) with no temporary or
+    .previous file left (a failure before the replacement left both .previous links: rename() of two links of one file
+    does nothing); no segmentation fault at the exit (HDF5's shutdown crashed on a file it had failed to flush); a
+    snapshot file without room is said before the first solve. 1 and 2 ranks."""
+    d = workdir("rbc_off_full_")
+    m = d + "/small"
+    os.makedirs(m)
+    if os.geteuid() != 0 or subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", m], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL).returncode != 0:
+        print("  SKIP  a small file system cannot be mounted here (mount -t tmpfs needs root): not run")
+        sys.exit(77)
+    atexit.register(subprocess.run, ["umount", "-l", m])  # (atexit runs it before the removal of d, registered first)
+    ring = "runs/ring_on_block.opts"
+
+    def offline(np_, extra):
+        return subprocess.run(["mpirun", "-n", str(np_), args.exe, "offline", "-options_file", ring] + extra, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+    def sha(path):
+        import hashlib
+        with open(path, "rb") as f:
+            return hashlib.sha256(f.read()).hexdigest()
+
+    def fill_to(free):
+        """A file of zeros leaving `free` bytes of the tmpfs free (its blocks: 4 kB)."""
+        if os.path.exists(m + "/fill"):
+            os.remove(m + "/fill")
+        st = os.statvfs(m)
+        n = st.f_bavail * st.f_frsize - free
+        with open(m + "/fill", "wb") as f:
+            f.write(b"\0" * max(n, 0))
+            f.flush()
+            os.fsync(f.fileno())
+
+    # the snapshots outside the small file system (the bases and ROM from them: fast); the sizes of the new pair
+    for n in (3, 4):
+        p = offline(1, ["-train_size", str(n), "-snapshots", "%s/s%d.h5" % (d, n), "-rom", "%s/ref%d.h5" % (d, n)])
+        check(p.returncode == 0, "the reference run with %d training radii" % n)
+    B, R = os.path.getsize(d + "/ref4.basis.h5"), os.path.getsize(d + "/ref4.h5")
+    p = offline(1, ["-train_size", "3", "-snapshots", d + "/s3.h5", "-snapshots_restart", "-rom", m + "/rom.h5"])
+    before = {q: sha(q) for q in (m + "/rom.h5", m + "/rom.basis.h5")}
+    new = ["-train_size", "4", "-snapshots", d + "/s4.h5", "-snapshots_restart", "-rom", m + "/rom.h5", "-report", d + "/r.json"]
+    for np_ in (1, 2):
+        for what, free, fname in (("while writing the basis file", B // 2, "rom.basis.h5"), ("while writing the ROM file, the basis file replaced", B + R // 2, "rom.h5")):
+            fill_to(free)
+            p = offline(np_, new)
+            after = {q: sha(q) for q in before}
+            left = sorted(f for f in os.listdir(m) if ".tmp" in f or ".previous" in f)
+            err = [l for l in p.stdout.splitlines() if "rbcontact error" in l][:1]
+            check(0 < p.returncode < 128 and "No space left on device" in p.stdout and ("ROM file '%s/%s'" % (m, fname)) in p.stdout and after == before and not left,
+                  "disk full %s, %d rank(s): exit %d (an error, not a signal), the message names %s and the full disk; the previous pair unchanged (%s), nothing left (%s)"
+                  % (what, np_, p.returncode, fname, after == before, left))
+            if err and len(err[0]) > 400:
+                check(False, "the message is short (%d characters): %s" % (len(err[0]), err[0][:400]))
+            os.remove(m + "/fill")
+            q = subprocess.run(["mpirun", "-n", "1", args.exe, "online", "-rom", m + "/rom.h5", "-mu", "1.02"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            check(q.returncode == 0, "... the previous pair still answers online")
+    # the snapshot file: written whole at its creation (its rows' space included), so a disk without room for it is said
+    # before the first FOM solve, and no file is left; with room, the same command runs
+    S = os.path.getsize(d + "/s4.h5")
+    for np_ in (1, 2):
+        snap = "%s/snap_np%d.h5" % (m, np_)
+        fill_to(S // 2)
+        p = offline(np_, ["-train_size", "4", "-snapshots", snap, "-offline_stop", "snapshots", "-snapshots_subcomm", "1", "-snapshots_monitor"])
+        left = sorted(f for f in os.listdir(m) if ".tmp" in f or f == os.path.basename(snap))
+        check(0 < p.returncode < 128 and "No space left on device" in p.stdout and ("Snapshot file '%s'" % snap) in p.stdout and "  snapshot " not in p.stdout and not left,
+              "disk full for the snapshot file (%d of %d bytes free), %d rank(s): exit %d, the message names the file and the full disk, before any "
+              "solve; nothing left (%s)" % (S // 2, S, np_, p.returncode, left))
+        os.remove(m + "/fill")
+        p = offline(np_, ["-train_size", "4", "-snapshots", snap, "-offline_stop", "snapshots", "-snapshots_subcomm", "1", "-report", d + "/res.json"])
+        check(p.returncode == 0 and report(d + "/res.json")["fom_solves"] == 4, "... with room, the same command solves the 4 snapshots")
+        os.remove(snap)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "early_options", "bases_warnings", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess"])
+    ap.add_argument("check", choices=["ring", "half_disks", "resume", "concurrent", "mismatch", "early_options", "bases_warnings", "bases", "dualbasis_import", "greedy", "snapshots_from", "sensitivities", "initial_guess", "disk_full"])
     ap.add_argument("--exe", required=True)
     args = ap.parse_args()
     globals()[args.check](args)

@@ -1304,6 +1304,12 @@ def guards(args):
         p = run(args, np_, "online", ["-rom", d + "/dims_native.h5", "-mu", "1.02"], expect_ok=False)
         check(p.returncode != 0 and p.stdout.count("checksum") >= 1 and "infinite loop" not in p.stdout and "HDF5-DIAG" not in p.stdout,
               "the checksum error on %d rank(s): our message, no HDF5 complaint at exit (%s)" % (np_, "infinite loop" if "infinite loop" in p.stdout else "none"))
+    # a group where a dataset belongs: said so, not "a corrupt file" (nor "missing")
+    shutil.copy(rom, d + "/grp.h5")
+    with h5py.File(d + "/grp.h5", "r+") as f:
+        del f["online/contact/theta"]
+        f.create_group("online/contact/theta")
+    expect_error(args, ["-rom", d + "/grp.h5", "-mu", "1.02"], ["grp.h5", "/online/contact/theta is a group, not a dataset"], "a ROM file with a group in place of /online/contact/theta")
     run(args, 1, "online", ["-rom", d + "/earliest.h5", "-mu", "1.02", "-report", d + "/earliest.json"])
     run(args, 1, "online", ["-rom", rom, "-mu", "1.02", "-report", d + "/native.json"])
     fa, fb = report(d + "/native.json")["outputs"]["contact_force"], report(d + "/earliest.json")["outputs"]["contact_force"]

@@ -22,6 +22,6 @@ set_tests_properties(usability_install PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" T
 # empty directory with the installed binary (1 rank, about 15 s)
 add_test(NAME usability_tutorial COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tutorial_check.sh ${CMAKE_BINARY_DIR})
 set_tests_properties(usability_tutorial PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)
-# Makefile.petsc (the build for users with their own PETSc/SLEPc): its info, three objects, its errors (about 10 s)
+# Makefile.petsc (the build for users with their own PETSc/SLEPc): its info, three objects, its errors (about 8 s)
 add_test(NAME usability_makefile_petsc COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/makefile_petsc_check.sh ${PROJECT_SOURCE_DIR})
 set_tests_properties(usability_makefile_petsc PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 LABELS usability)

@@ -4,11 +4,14 @@
 // Internal (not installed): include only from src/io/*.cpp.
 #pragma once
 #include <hdf5.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -86,10 +89,22 @@ private:
   herr_t (*close_)(hid_t) = nullptr;
 };
 
+// An error description of HDF5's file drivers ("file write failed: time = <date>\n, filename = ..., errno = 28, error
+// message = 'No space left on device', buf = 0x..., ...", two lines and a dozen fields) cut to what it says: "file write
+// failed: No space left on device (errno 28)". Other descriptions are kept as they are.
+inline std::string ShortDescription(const std::string &d)
+{
+  const size_t t = d.find(": time = "), e = d.find("errno = "), m = d.find("error message = '");
+  if (t == std::string::npos || e == std::string::npos || m == std::string::npos) return d;
+  const size_t q = d.find('\'', m + 17);
+  if (q == std::string::npos) return d;
+  return d.substr(0, t) + ": " + d.substr(m + 17, q - m - 17) + " (errno " + std::to_string(std::atoi(d.c_str() + e + 8)) + ")";
+}
+
 inline herr_t WalkErrors(unsigned n, const H5E_error2_t *e, void *ctx)
 {
   auto *v = static_cast<std::vector<std::string> *>(ctx);
-  if (e && e->desc && *e->desc) v->push_back(e->desc);
+  if (e && e->desc && *e->desc) v->push_back(ShortDescription(e->desc));
   return 0;
 }
 
@@ -151,6 +166,12 @@ inline bool OpenDataset(Ctx &c, hid_t loc, const std::string &name, H5Id *d)
   bool              exists = false;
   if (!LinkExists(c, loc, name, &exists)) return false;
   if (!exists) return c.Fail("missing dataset " + name, false);
+  { // a group or a named datatype at that path opens as an object: not a corrupt file
+    H5Id o(H5Oopen(loc, name.c_str(), H5P_DEFAULT), H5Oclose);
+    const H5I_type_t t = o.ok() ? H5Iget_type(o.get()) : H5I_BADID;
+    H5Eclear2(H5E_DEFAULT);
+    if (t == H5I_GROUP || t == H5I_DATATYPE) return c.Fail(name + " is " + (t == H5I_GROUP ? "a group" : "a named datatype") + ", not a dataset", false);
+  }
   KeepQuiet() = KeepQuiet() || !detail.empty();
   return c.Fail("dataset " + name + " is there but cannot be opened: a corrupt file" + (detail.empty() ? std::string() : " (HDF5: " + detail + ")"), false);
 }
@@ -353,17 +374,117 @@ inline bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsiz
   return true;
 }
 
-// Creates (truncates) an HDF5 file in the 1.8 file format (H5Pset_libver_bounds V18..V18): superblock v2, object
-// headers v2, whose metadata (headers, attributes, dataspaces, links) HDF5 checksums, so a corrupted header is an error
-// on opening rather than a wrong shape, a crash or a wrong value (docs/bad_input.md). Not the 1.10 format: its
-// superblock v3 marks a file open for writing, and a snapshot file left by a killed job would need h5clear
-// (docs/snapshot_file.md). Readable by HDF5 >= 1.8 (h5py, ParaView). Every file rbcontact writes itself (ROM, basis,
-// snapshot files) is created here; files opened for writing later keep the format they have.
-inline hid_t CreateFile(const std::string &path)
+// Creates an HDF5 file in memory (the core driver, no backing store) in the 1.8 file format (H5Pset_libver_bounds
+// V18..V18): superblock v2, object headers v2, whose metadata (headers, attributes, dataspaces, links) HDF5 checksums,
+// so a corrupted header is an error on opening rather than a wrong shape, a crash or a wrong value
+// (docs/bad_input.md). Not the 1.10 format: its superblock v3 marks a file open for writing, and a snapshot file left
+// by a killed job would need h5clear (docs/snapshot_file.md). Readable by HDF5 >= 1.8 (h5py, ParaView). Every file
+// rbcontact writes whole (ROM, basis files, a new snapshot file) is built here and written by SaveImage; files opened
+// for writing later keep the format they have. In memory because HDF5 (1.10.8) cannot close a file on disk whose
+// metadata it failed to write (a full disk): the identifier stayed, and HDF5's shutdown at MPI_Finalize crashed on it
+// (segmentation fault after our message; docs/bad_input.md "A full disk"). `name` only labels it.
+inline hid_t CreateFile(const std::string &name)
 {
-  H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (!fapl.ok() || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) return H5I_INVALID_HID;
-  return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+  hid_t f = H5I_INVALID_HID, why = H5I_INVALID_HID;
+  {
+    H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+    if (!fapl.ok() || H5Pset_fapl_core(fapl.get(), (size_t)1 << 20, 0) < 0 || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) return H5I_INVALID_HID;
+    f = H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+    if (f < 0) why = H5Eget_current_stack(); // the H5Pclose of fapl, a successful call, would clear the stack that says why
+  }
+  if (why >= 0) H5Eset_current_stack(why); // (and closes the copy): the caller's Ctx::Fail reads it
+  return f;
+}
+
+// HDF5's metadata checksum (Bob Jenkins' lookup3 hashlittle, public domain, as H5_checksum_lookup3 in H5checksum.c):
+// bytes read one by one, so the same on any byte order.
+inline uint32_t Lookup3(const unsigned char *k, size_t length, uint32_t initval)
+{
+  auto     rot = [](uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
+  uint32_t a, b, c;
+  a = b = c = 0xdeadbeefu + (uint32_t)length + initval;
+  while (length > 12) {
+    a += k[0] + ((uint32_t)k[1] << 8) + ((uint32_t)k[2] << 16) + ((uint32_t)k[3] << 24);
+    b += k[4] + ((uint32_t)k[5] << 8) + ((uint32_t)k[6] << 16) + ((uint32_t)k[7] << 24);
+    c += k[8] + ((uint32_t)k[9] << 8) + ((uint32_t)k[10] << 16) + ((uint32_t)k[11] << 24);
+    a -= c; a ^= rot(c, 4);  c += b;
+    b -= a; b ^= rot(a, 6);  a += c;
+    c -= b; c ^= rot(b, 8);  b += a;
+    a -= c; a ^= rot(c, 16); c += b;
+    b -= a; b ^= rot(a, 19); a += c;
+    c -= b; c ^= rot(b, 4);  b += a;
+    length -= 12;
+    k += 12;
+  }
+  switch (length) { // (every case falls through)
+  case 12: c += (uint32_t)k[11] << 24; // fall through
+  case 11: c += (uint32_t)k[10] << 16; // fall through
+  case 10: c += (uint32_t)k[9] << 8;   // fall through
+  case 9: c += k[8];                   // fall through
+  case 8: b += (uint32_t)k[7] << 24;   // fall through
+  case 7: b += (uint32_t)k[6] << 16;   // fall through
+  case 6: b += (uint32_t)k[5] << 8;    // fall through
+  case 5: b += k[4];                   // fall through
+  case 4: a += (uint32_t)k[3] << 24;   // fall through
+  case 3: a += (uint32_t)k[2] << 16;   // fall through
+  case 2: a += (uint32_t)k[1] << 8;    // fall through
+  case 1: a += k[0]; break;
+  case 0: return c;
+  }
+  c ^= b; c -= rot(b, 14);
+  a ^= c; a -= rot(c, 11);
+  b ^= a; b -= rot(a, 25);
+  c ^= b; c -= rot(b, 16);
+  a ^= c; a -= rot(c, 4);
+  b ^= a; b -= rot(a, 14);
+  c ^= b; c -= rot(b, 24);
+  return c;
+}
+
+// The superblock checksum of a file image from H5Fget_file_image: HDF5 1.10.8 returns a version-2 superblock whose
+// checksum is stale (measured: the image and the file the same driver writes at close differ in those 4 bytes
+// only, and HDF5 refuses to open the image: "incorrect metadata checksum"). Recomputed over the superblock (signature,
+// version, sizes, flags, 4 addresses), as HDF5 writes it; false if the image does not start with a v2/v3 superblock.
+inline bool FixSuperblockChecksum(std::vector<char> *img)
+{
+  static const unsigned char sig[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+  if (img->size() < 12 || std::memcmp(img->data(), sig, 8) != 0) return false;
+  const unsigned char *u = reinterpret_cast<const unsigned char *>(img->data());
+  if (u[8] != 2 && u[8] != 3) return false;
+  const size_t n = 12 + 4 * (size_t)u[9]; // 4 addresses of sizeof_offsets bytes
+  if (img->size() < n + 4) return false;
+  const uint32_t sum = Lookup3(u, n, 0);
+  for (int i = 0; i < 4; ++i) (*img)[n + i] = (char)((sum >> (8 * i)) & 0xff);
+  return true;
+}
+
+// Writes the image of a file made by CreateFile to path (created or truncated) with write(2), then fsync: a failure
+// (ENOSPC, EIO) is said with its errno and leaves HDF5's file intact, to be closed as usual.
+inline bool SaveImage(Ctx &c, hid_t f, const std::string &path)
+{
+  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) return c.Fail("cannot flush the file's image in memory");
+  const ssize_t n = H5Fget_file_image(f, nullptr, 0);
+  if (n < 0) return c.Fail("cannot get the file's image");
+  std::vector<char> buf((size_t)n);
+  if (H5Fget_file_image(f, buf.data(), buf.size()) != n) return c.Fail("cannot get the file's image");
+  if (!FixSuperblockChecksum(&buf)) return c.Fail("the file's image does not start with a version-2 superblock", false);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return c.Fail(std::string("cannot create the file: ") + std::strerror(errno), false);
+  int    err = 0;
+  size_t off = 0;
+  while (off < buf.size()) {
+    const ssize_t w = ::write(fd, buf.data() + off, buf.size() - off);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      err = w < 0 ? errno : EIO;
+      break;
+    }
+    off += (size_t)w;
+  }
+  if (!err && ::fsync(fd) != 0) err = errno;
+  if (::close(fd) != 0 && !err) err = errno;
+  if (err) return c.Fail("cannot write the file (" + std::to_string((unsigned long long)buf.size()) + " bytes): " + std::strerror(err), false);
+  return true;
 }
 
 // H5Fflush, then fsync of the file descriptor (data reaches the disk, not only the OS cache).

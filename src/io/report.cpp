@@ -183,16 +183,20 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
     const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
-    std::ofstream     f(tmp);
-    if (!f) ok = 0;
+    errno = 0;
+    std::ofstream f(tmp);
+    if (!f) ok = -(errno ? errno : EIO);
     else {
       f << text;
       f.close();
-      if (!f || std::rename(tmp.c_str(), target.c_str()) != 0) { ok = 0; std::remove(tmp.c_str()); }
+      if (!f || std::rename(tmp.c_str(), target.c_str()) != 0) {
+        ok = -(errno ? errno : EIO); // (a full disk: ENOSPC, from the write or the close)
+        std::remove(tmp.c_str());
+      }
     }
   }
   PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
-  PetscCheck(ok, comm, PETSC_ERR_FILE_OPEN, "Cannot write file '%s' (directory missing or not writable?)", path.c_str());
+  PetscCheck(ok > 0, comm, PETSC_ERR_FILE_OPEN, "Cannot write file '%s': %s", path.c_str(), std::strerror(-ok));
   PetscFunctionReturn(0);
 }
 

@@ -181,6 +181,15 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
     if (!OpenDataset(c, f, "/options", &d)) return false;
     H5Id t(H5Dget_type(d.get()), H5Tclose);
     if (!t.ok()) return c.Fail("cannot get the type of dataset /options");
+    // one fixed-length string, as written: a dataspace of n values would be read n x its size into the buffer (a heap
+    // overflow), a variable-length one as a pointer, and a declared size beyond the file's is not stored in it
+    std::vector<hsize_t> od;
+    if (!DatasetDims(c, d.get(), "/options", &od)) return false;
+    hsize_t n = 1;
+    for (hsize_t x : od) n *= x;
+    hsize_t fileSize = 0;
+    if (n != 1 || H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) != 0 || H5Fget_filesize(f, &fileSize) < 0 || H5Tget_size(t.get()) > fileSize)
+      return c.Fail("dataset /options is not one fixed-length string of the file's (shape " + ShapeString(od) + "): a corrupt file", false);
     std::vector<char> buf(H5Tget_size(t.get()) + 1, 0);
     if (H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0) return c.Fail("cannot read dataset /options");
     h->optionsText = buf.data();
@@ -237,12 +246,12 @@ bool ReadDone(Ctx &c, hid_t f, hsize_t ntrain, std::vector<signed char> *done)
 bool ReadPending(Ctx &c, hid_t f, hsize_t ntrain, std::vector<PetscInt> *pending)
 {
   pending->clear();
-  const htri_t e = H5Lexists(f, kPendingSet, H5P_DEFAULT);
-  if (e < 0) return c.Fail(std::string("cannot query dataset ") + kPendingSet);
-  if (!e) return true;
-  H5Id d(H5Dopen2(f, kPendingSet, H5P_DEFAULT), H5Dclose);
+  bool exists = false;
+  if (!LinkExists(c, f, kPendingSet, &exists)) return false;
+  if (!exists) return true;
+  H5Id                 d;
   std::vector<hsize_t> dims;
-  if (!d.ok() || !DatasetDims(c, d.get(), kPendingSet, &dims)) return c.Fail(std::string("cannot open dataset ") + kPendingSet);
+  if (!OpenDataset(c, f, kPendingSet, &d) || !DatasetDims(c, d.get(), kPendingSet, &dims)) return false;
   if (dims != std::vector<hsize_t>{ntrain}) return c.Fail(std::string("dataset ") + kPendingSet + " has shape " + ShapeString(dims) + ", expected " + std::to_string((unsigned long long)ntrain), false);
   std::vector<signed char> flag(ntrain, 0);
   if (ntrain > 0 && H5Dread(d.get(), H5T_NATIVE_SCHAR, H5S_ALL, H5S_ALL, H5P_DEFAULT, flag.data()) < 0) return c.Fail(std::string("cannot read dataset ") + kPendingSet);
@@ -255,7 +264,9 @@ bool WritePending(Ctx &c, hid_t f, hsize_t ntrain, const std::vector<PetscInt> &
 {
   std::vector<signed char> flag(ntrain, 0);
   for (PetscInt i : pending) flag[(size_t)i] = 1;
-  if (H5Lexists(f, kPendingSet, H5P_DEFAULT) <= 0) { // an older file: created (metadata) and flushed before any pick is marked
+  bool exists = false;
+  if (!LinkExists(c, f, kPendingSet, &exists)) return false;
+  if (!exists) { // an older file: created (metadata) and flushed before any pick is marked
     const signed char zero = 0;
     if (!CreateDataset(c, f, kPendingSet, H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr) || !FlushSync(c, f)) return false;
   }
@@ -320,6 +331,7 @@ bool CheckNotLocked(Ctx &c, const std::string &path)
   if (H5Id(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose).ok()) return true;
   H5Id ro(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   const bool readable = ro.ok() && H5Pset_file_locking(ro.get(), 0, 1) >= 0 && H5Id(H5Fopen(path.c_str(), H5F_ACC_RDONLY, ro.get()), H5Fclose).ok();
+  KeepQuiet() = KeepQuiet() || !readable; // (a failed open of a corrupt file: HDF5's complaint at exit, h5util.hpp)
   if (!readable || access(path.c_str(), W_OK) != 0) return true; // not an HDF5 file we could open, or read-only: replaced as asked
   return c.Fail("exists and another job is writing it (HDF5's file lock): not replaced under that job; wait for it to end, or give another file", false);
 }
@@ -353,8 +365,8 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
   if (!CheckNotLocked(c, target)) return false;
   {
     H5Id f(CreateFile(tmp), H5Fclose);
-    bool ok = f.ok() || ct.Fail("cannot create the file (directory missing or not writable?)");
-    ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && FlushSync(ct, f.get()) && CloseFile(ct, &f);
+    bool ok = f.ok() || ct.Fail("cannot create the file");
+    ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && SaveImage(ct, f.get(), tmp) && CloseFile(ct, &f);
     if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + target + "': " + std::strerror(errno), false);
     if (!ok) {
       f.Reset();
@@ -418,9 +430,9 @@ bool WriteOnRoot(Ctx &c, hid_t f, const std::string &path, const SnapshotHeader 
   bool created = false;
   for (const auto &kv : s.extra) {
     const std::string name = "/snapshots/extra/" + kv.first;
-    const htri_t      e    = H5Lexists(f, name.c_str(), H5P_DEFAULT);
-    if (e < 0) return c.Fail("cannot query dataset " + name);
-    if (e == 0) {
+    bool              e    = false;
+    if (!LinkExists(c, f, name, &e)) return false;
+    if (!e) {
       if (!CreateDataset(c, f, name, H5T_IEEE_F64LE, {(hsize_t)ntrain, (hsize_t)kv.second.size()}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
       created = true;
     }
@@ -576,7 +588,8 @@ PetscErrorCode SnapshotFile::RowsWithoutExtra(const std::string &name, std::vect
     H5Quiet           q;
     Ctx               c    = FileCtx(path_);
     const std::string dn   = "/snapshots/extra/" + name;
-    const bool        has  = H5Lexists((hid_t)file_, "/snapshots/extra", H5P_DEFAULT) > 0 && H5Lexists((hid_t)file_, dn.c_str(), H5P_DEFAULT) > 0;
+    bool              has  = false; // (an unreadable link is an error, not a missing extra: every row would lack it)
+    if (!LinkExists(c, (hid_t)file_, dn, &has)) err = c.err;
     std::vector<hsize_t> dims;
     if (has) {
       H5Id d(H5Dopen2((hid_t)file_, dn.c_str(), H5P_DEFAULT), H5Dclose);
@@ -928,8 +941,9 @@ bool ImportH5(Ctx &c, const std::string &file, const std::string &dset, bool tra
   if (is <= 0) return c.Fail("is not an HDF5 file", is < 0);
   H5Id f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!f.ok()) return c.Fail("cannot be opened");
-  const htri_t e = H5Lexists(f.get(), dset.c_str(), H5P_DEFAULT);
-  if (e <= 0) return c.Fail("has no dataset " + dset, false);
+  bool e = false;
+  if (!LinkExists(c, f.get(), dset, &e)) return false;
+  if (!e) return c.Fail("has no dataset " + dset, false);
   H5Id d(H5Dopen2(f.get(), dset.c_str(), H5P_DEFAULT), H5Dclose);
   if (!d.ok()) return c.Fail("cannot open dataset " + dset + " (a group?)");
   H5Id t(H5Dget_type(d.get()), H5Tclose);

@@ -2,6 +2,7 @@
 // reference configuration) and the nonnegative dual basis of the multiplier snapshots; ROM file.
 #include "rbcontact/offline_bases.hpp"
 #include <algorithm>
+#include <sys/stat.h>
 #include "rbcontact/dual_basis.hpp"
 #include "rbcontact/pod.hpp"
 #include "rbcontact/rom_file.hpp"
@@ -628,7 +629,14 @@ PreviousFiles::PreviousFiles(MPI_Comm comm, const std::vector<std::string> &path
 
 void PreviousFiles::Restore()
 {
-  for (const auto &k : kept_) (void)std::rename(k.second.c_str(), k.first.c_str()); // atomic: the previous file is back
+  // atomic: the previous file is back. Where the file was not replaced yet (the failure came first: a full disk while
+  // writing it), the link and the file are one inode and rename() does nothing (POSIX): the link is removed instead
+  // (it was left beside the file)
+  for (const auto &k : kept_) {
+    struct stat a, b;
+    if (::stat(k.first.c_str(), &a) == 0 && ::stat(k.second.c_str(), &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) (void)::unlink(k.second.c_str());
+    else (void)std::rename(k.second.c_str(), k.first.c_str());
+  }
   kept_.clear();
 }
 

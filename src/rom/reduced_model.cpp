@@ -936,9 +936,11 @@ PetscInt ReducedModel::ContactTerms(const std::vector<PetscReal> &mu, const Pets
     }
     // -rom_threads: the regions below split over the points (or the patch's rows) on nth threads
     const int nth = (int)threads;
-    if (nth > 1 && !pool_.pool) { // the first threaded solve: say so when the threads must share cores
-      // (once per job, by the first rank of PETSC_COMM_WORLD: mpirun binds every rank alike, and the solves are not
-      // collective, so the ranks cannot agree on one message)
+    static std::atomic<int> checkedFor{1}; // the largest thread count checked in this process (every model, its copies, validate's threads)
+    int                     seen = checkedFor.load(std::memory_order_relaxed);
+    if (nth > seen && checkedFor.compare_exchange_strong(seen, nth)) { // the first solve on this many threads: say so when they must share cores
+      // (once per job and thread count, by the first rank of PETSC_COMM_WORLD: mpirun binds every rank alike, and the
+      // solves are not collective, so the ranks cannot agree on one message)
       const PetscInt nc = ThreadCpus();
       PetscMPIInt    wr = 0;
       if (MPI_Comm_rank(PETSC_COMM_WORLD, &wr) != MPI_SUCCESS) wr = 0;
