@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """hdf5_corruption.py: measurement (not a test) of what the ROM file reader does with damaged HDF5 metadata, in
-the file format rbcontact writes (HDF5 1.8: checksummed object headers, src/io/h5util.hpp CreateFile) and in HDF5's
+the file format rbcontact writes (HDF5 1.8: checksummed object headers, src/io/h5util.hpp MemoryFile) and in HDF5's
 earliest format (h5py's default and older rbcontact files; the same ROM file rewritten by h5py).
 
 For each format: --n random single-byte changes of the file's metadata (every byte outside the datasets' raw data),

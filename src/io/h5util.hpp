@@ -157,7 +157,7 @@ inline bool LinkExists(Ctx &c, hid_t loc, const std::string &name, bool *exists)
 }
 
 // Opens dataset `name`; a failure says whether it is missing or there but unreadable (a corrupt header: with the
-// checksummed metadata of CreateFile, a damaged object header fails here, and "missing" would mislead).
+// checksummed metadata of MemoryFile, a damaged object header fails here, and "missing" would mislead).
 inline bool OpenDataset(Ctx &c, hid_t loc, const std::string &name, H5Id *d)
 {
   *d = H5Id(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
@@ -374,118 +374,115 @@ inline bool RowIO(Ctx &c, hid_t file, const std::string &name, hid_t mtype, hsiz
   return true;
 }
 
-// Creates an HDF5 file in memory (the core driver, no backing store) in the 1.8 file format (H5Pset_libver_bounds
-// V18..V18): superblock v2, object headers v2, whose metadata (headers, attributes, dataspaces, links) HDF5 checksums,
-// so a corrupted header is an error on opening rather than a wrong shape, a crash or a wrong value
-// (docs/bad_input.md). Not the 1.10 format: its superblock v3 marks a file open for writing, and a snapshot file left
-// by a killed job would need h5clear (docs/snapshot_file.md). Readable by HDF5 >= 1.8 (h5py, ParaView). Every file
-// rbcontact writes whole (ROM, basis files, a new snapshot file) is built here and written by SaveImage; files opened
-// for writing later keep the format they have. In memory because HDF5 (1.10.8) cannot close a file on disk whose
-// metadata it failed to write (a full disk): the identifier stayed, and HDF5's shutdown at MPI_Finalize crashed on it
-// (segmentation fault after our message; docs/bad_input.md "A full disk"). `name` only labels it.
-inline hid_t CreateFile(const std::string &name)
-{
-  hid_t f = H5I_INVALID_HID, why = H5I_INVALID_HID;
+// A file rbcontact writes whole (ROM, basis files, a new snapshot file), built in memory by HDF5 (the core driver, no
+// backing store) in the 1.8 file format (H5Pset_libver_bounds V18..V18): superblock v2, object headers v2, whose
+// metadata (headers, attributes, dataspaces, links) HDF5 checksums, so a corrupted header is an error on opening
+// rather than a wrong shape, a crash or a wrong value (docs/bad_input.md). Not the 1.10 format: its superblock v3 marks
+// a file open for writing, and a snapshot file left by a killed job would need h5clear (docs/snapshot_file.md).
+// Readable by HDF5 >= 1.8 (h5py, ParaView). Files opened for writing later keep the format they have.
+// In memory because HDF5 (1.10.8) cannot close a file on disk whose metadata it failed to write (a full disk): the
+// identifier stayed, and HDF5's shutdown at MPI_Finalize crashed on it (a segmentation fault after our message;
+// docs/bad_input.md "A full disk"). Save closes the file, which hands HDF5's final image to this object (the file
+// image callbacks: no copy), and writes it with write(2) + fsync, so the disk's errors are ours, with their errno.
+// Declare it before the H5Id of its file (the close hands the image over; the destructor frees it).
+class MemoryFile {
+public:
+  MemoryFile() = default;
+  MemoryFile(const MemoryFile &)            = delete;
+  MemoryFile &operator=(const MemoryFile &) = delete;
+  ~MemoryFile() { std::free(image_); }
+
+  // The file, H5I_INVALID_HID on a failure whose reason stays on HDF5's error stack. (HDF5 first tries to open `name`:
+  // a stale file there, e.g. a temporary file of a killed job with the same pid, is read into memory and dropped, and
+  // Save's O_TRUNC replaces it.)
+  hid_t Create(const std::string &name)
   {
-    H5Id fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-    if (!fapl.ok() || H5Pset_fapl_core(fapl.get(), (size_t)1 << 20, 0) < 0 || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0) return H5I_INVALID_HID;
-    f = H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
-    if (f < 0) why = H5Eget_current_stack(); // the H5Pclose of fapl, a successful call, would clear the stack that says why
-  }
-  if (why >= 0) H5Eset_current_stack(why); // (and closes the copy): the caller's Ctx::Fail reads it
-  return f;
-}
-
-// HDF5's metadata checksum (Bob Jenkins' lookup3 hashlittle, public domain, as H5_checksum_lookup3 in H5checksum.c):
-// bytes read one by one, so the same on any byte order.
-inline uint32_t Lookup3(const unsigned char *k, size_t length, uint32_t initval)
-{
-  auto     rot = [](uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
-  uint32_t a, b, c;
-  a = b = c = 0xdeadbeefu + (uint32_t)length + initval;
-  while (length > 12) {
-    a += k[0] + ((uint32_t)k[1] << 8) + ((uint32_t)k[2] << 16) + ((uint32_t)k[3] << 24);
-    b += k[4] + ((uint32_t)k[5] << 8) + ((uint32_t)k[6] << 16) + ((uint32_t)k[7] << 24);
-    c += k[8] + ((uint32_t)k[9] << 8) + ((uint32_t)k[10] << 16) + ((uint32_t)k[11] << 24);
-    a -= c; a ^= rot(c, 4);  c += b;
-    b -= a; b ^= rot(a, 6);  a += c;
-    c -= b; c ^= rot(b, 8);  b += a;
-    a -= c; a ^= rot(c, 16); c += b;
-    b -= a; b ^= rot(a, 19); a += c;
-    c -= b; c ^= rot(b, 4);  b += a;
-    length -= 12;
-    k += 12;
-  }
-  switch (length) { // (every case falls through)
-  case 12: c += (uint32_t)k[11] << 24; // fall through
-  case 11: c += (uint32_t)k[10] << 16; // fall through
-  case 10: c += (uint32_t)k[9] << 8;   // fall through
-  case 9: c += k[8];                   // fall through
-  case 8: b += (uint32_t)k[7] << 24;   // fall through
-  case 7: b += (uint32_t)k[6] << 16;   // fall through
-  case 6: b += (uint32_t)k[5] << 8;    // fall through
-  case 5: b += k[4];                   // fall through
-  case 4: a += (uint32_t)k[3] << 24;   // fall through
-  case 3: a += (uint32_t)k[2] << 16;   // fall through
-  case 2: a += (uint32_t)k[1] << 8;    // fall through
-  case 1: a += k[0]; break;
-  case 0: return c;
-  }
-  c ^= b; c -= rot(b, 14);
-  a ^= c; a -= rot(c, 11);
-  b ^= a; b -= rot(a, 25);
-  c ^= b; c -= rot(b, 16);
-  a ^= c; a -= rot(c, 4);
-  b ^= a; b -= rot(a, 14);
-  c ^= b; c -= rot(b, 24);
-  return c;
-}
-
-// The superblock checksum of a file image from H5Fget_file_image: HDF5 1.10.8 returns a version-2 superblock whose
-// checksum is stale (measured: the image and the file the same driver writes at close differ in those 4 bytes
-// only, and HDF5 refuses to open the image: "incorrect metadata checksum"). Recomputed over the superblock (signature,
-// version, sizes, flags, 4 addresses), as HDF5 writes it; false if the image does not start with a v2/v3 superblock.
-inline bool FixSuperblockChecksum(std::vector<char> *img)
-{
-  static const unsigned char sig[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
-  if (img->size() < 12 || std::memcmp(img->data(), sig, 8) != 0) return false;
-  const unsigned char *u = reinterpret_cast<const unsigned char *>(img->data());
-  if (u[8] != 2 && u[8] != 3) return false;
-  const size_t n = 12 + 4 * (size_t)u[9]; // 4 addresses of sizeof_offsets bytes
-  if (img->size() < n + 4) return false;
-  const uint32_t sum = Lookup3(u, n, 0);
-  for (int i = 0; i < 4; ++i) (*img)[n + i] = (char)((sum >> (8 * i)) & 0xff);
-  return true;
-}
-
-// Writes the image of a file made by CreateFile to path (created or truncated) with write(2), then fsync: a failure
-// (ENOSPC, EIO) is said with its errno and leaves HDF5's file intact, to be closed as usual.
-inline bool SaveImage(Ctx &c, hid_t f, const std::string &path)
-{
-  if (H5Fflush(f, H5F_SCOPE_GLOBAL) < 0) return c.Fail("cannot flush the file's image in memory");
-  const ssize_t n = H5Fget_file_image(f, nullptr, 0);
-  if (n < 0) return c.Fail("cannot get the file's image");
-  std::vector<char> buf((size_t)n);
-  if (H5Fget_file_image(f, buf.data(), buf.size()) != n) return c.Fail("cannot get the file's image");
-  if (!FixSuperblockChecksum(&buf)) return c.Fail("the file's image does not start with a version-2 superblock", false);
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) return c.Fail(std::string("cannot create the file: ") + std::strerror(errno), false);
-  int    err = 0;
-  size_t off = 0;
-  while (off < buf.size()) {
-    const ssize_t w = ::write(fd, buf.data() + off, buf.size() - off);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) {
-      err = w < 0 ? errno : EIO;
-      break;
+    hid_t f = H5I_INVALID_HID, why = H5I_INVALID_HID;
+    {
+      H5FD_file_image_callbacks_t cb = {Malloc, Memcpy, Realloc, Free, UdataCopy, UdataFree, this};
+      H5Id                        fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+      // (a strong close: H5Fclose closes every object of the file and the driver, so the image is handed over at that
+      // call, never later into a destroyed MemoryFile)
+      if (!fapl.ok() || H5Pset_fapl_core(fapl.get(), (size_t)1 << 20, 0) < 0 || H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18) < 0 ||
+          H5Pset_fclose_degree(fapl.get(), H5F_CLOSE_STRONG) < 0 || H5Pset_file_image_callbacks(fapl.get(), &cb) < 0)
+        return H5I_INVALID_HID;
+      f = H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get());
+      if (f < 0) why = H5Eget_current_stack(); // the H5Pclose of fapl, a successful call, would clear the stack that says why
     }
-    off += (size_t)w;
+    if (why >= 0) H5Eset_current_stack(why); // (and closes the copy): the caller's Ctx::Fail reads it
+    return f;
   }
-  if (!err && ::fsync(fd) != 0) err = errno;
-  if (::close(fd) != 0 && !err) err = errno;
-  if (err) return c.Fail("cannot write the file (" + std::to_string((unsigned long long)buf.size()) + " bytes): " + std::strerror(err), false);
-  return true;
-}
+
+  // Closes *file and writes its image to path (created or truncated), then fsync.
+  bool Save(Ctx &c, H5Id *file, const std::string &path)
+  {
+    const hid_t id = file->Release();
+    if (H5Fclose(id) < 0 || !image_) return c.Fail("cannot close the file's image in memory");
+    // the file's length is the end of file its superblock records: the driver's memory (in steps of 1 MB) may end
+    // before it (space allocated and never written: a snapshot file's rows), which is written as zeros
+    const unsigned char *u  = static_cast<const unsigned char *>(image_);
+    const size_t         so = size_ >= 12 ? u[9] : 0;
+    unsigned long long   eof = 0;
+    if (size_ < 12 + 3 * so || std::memcmp(u, "\211HDF\r\n\032\n", 8) != 0 || (u[8] != 2 && u[8] != 3) || so < 4 || so > 8)
+      return c.Fail("the file's image does not start with a version-2 superblock", false);
+    for (size_t k = 0; k < so; ++k) eof |= (unsigned long long)u[12 + 2 * so + k] << (8 * k);
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) return c.Fail(std::string("cannot create the file: ") + std::strerror(errno), false);
+    // (zeros written, not a hole: the space is the disk's now, so a full disk is said here, not at a later row)
+    const std::vector<unsigned char> zeros(eof > size_ ? std::min<unsigned long long>(eof - size_, 1 << 20) : 0, 0);
+    int                              err = 0;
+    unsigned long long               off = 0;
+    while (off < eof) {
+      const bool    mem = off < size_;
+      const size_t  len = mem ? (size_t)(std::min<unsigned long long>(eof, size_) - off) : (size_t)std::min<unsigned long long>(eof - off, zeros.size());
+      const ssize_t w   = ::write(fd, mem ? u + off : zeros.data(), len);
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) {
+        err = w < 0 ? errno : EIO;
+        break;
+      }
+      off += (unsigned long long)w;
+    }
+    if (!err && ::fsync(fd) != 0) err = errno;
+    if (::close(fd) != 0 && !err) err = errno;
+    if (err) return c.Fail("cannot write the file (" + std::to_string(eof) + " bytes): " + std::strerror(err), false);
+    return true;
+  }
+
+private:
+  // (the size of the driver's buffer: its allocations for the file, not the copies of property lists)
+  static void Track(void *q, size_t n, H5FD_file_image_op_t op, void *self)
+  {
+    if (q && (op == H5FD_FILE_IMAGE_OP_FILE_OPEN || op == H5FD_FILE_IMAGE_OP_FILE_RESIZE)) static_cast<MemoryFile *>(self)->size_ = n;
+  }
+  static void *Malloc(size_t n, H5FD_file_image_op_t op, void *self)
+  {
+    void *q = std::malloc(n);
+    Track(q, n, op, self);
+    return q;
+  }
+  static void *Memcpy(void *d, const void *s, size_t n, H5FD_file_image_op_t, void *) { return std::memcpy(d, s, n); }
+  static void *Realloc(void *p, size_t n, H5FD_file_image_op_t op, void *self)
+  {
+    void *q = std::realloc(p, n);
+    Track(q, n, op, self);
+    return q;
+  }
+  static herr_t Free(void *p, H5FD_file_image_op_t op, void *self)
+  {
+    auto *m = static_cast<MemoryFile *>(self);
+    if (op == H5FD_FILE_IMAGE_OP_FILE_CLOSE && p) { // the file's final image: kept for Save
+      std::free(m->image_);
+      m->image_ = p;
+    } else std::free(p);
+    return 0;
+  }
+  static void  *UdataCopy(void *self) { return self; } // (the property lists share this object)
+  static herr_t UdataFree(void *) { return 0; }
+
+  void  *image_ = nullptr;
+  size_t size_  = 0;
+};
 
 // H5Fflush, then fsync of the file descriptor (data reaches the disk, not only the OS cache).
 inline bool FlushSync(Ctx &c, hid_t file)

@@ -51,7 +51,8 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
     const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
     bool              ok  = true;
     {
-      H5Id f(CreateFile(tmp), H5Fclose);
+      MemoryFile mem;
+      H5Id       f(mem.Create(tmp), H5Fclose);
       if (!f.ok()) ok = c.Fail("cannot create the file");
       if (ok) ok = WriteStringAttr(c, f.get(), "format", kRomFormat);
       if (ok) {
@@ -65,7 +66,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
         std::vector<hsize_t> dims(it.dims.begin(), it.dims.end());
         ok = WriteWhole(c, f.get(), it.path, H5T_IEEE_F64LE, dims, H5T_NATIVE_DOUBLE, it.data.data());
       }
-      if (ok) ok = SaveImage(c, f.get(), tmp);
+      if (ok) ok = mem.Save(c, &f, tmp);
     }
     if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = c.Fail("cannot rename the temporary file into place", false);
     if (!ok) {

@@ -364,9 +364,10 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
   if (!CheckNotLocked(c, target)) return false;
   {
-    H5Id f(CreateFile(tmp), H5Fclose);
-    bool ok = f.ok() || ct.Fail("cannot create the file");
-    ok      = ok && WriteHeaderAndLayout(ct, f.get(), h) && SaveImage(ct, f.get(), tmp) && CloseFile(ct, &f);
+    MemoryFile mem;
+    H5Id       f(mem.Create(tmp), H5Fclose);
+    bool       ok = f.ok() || ct.Fail("cannot create the file");
+    ok            = ok && WriteHeaderAndLayout(ct, f.get(), h) && mem.Save(ct, &f, tmp);
     if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + target + "': " + std::strerror(errno), false);
     if (!ok) {
       f.Reset();
