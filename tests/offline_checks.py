@@ -280,6 +280,19 @@ def mismatch(args):
               and not os.path.exists(d + "/never.h5"), "%s in a done row of /snapshots/%s: refused naming the file, the row and the dataset, no ROM" % (val, ds))
     p = bases_from_tampered("prov_kkt_nan", "kkt", 1, np.nan)
     check(p.returncode == 0, "a NaN KKT residual (not given) is accepted")
+    # a header declaring 1e12 training points of no parameter (review of 2026-12-04): every dataset it names is empty,
+    # so the stored-size guard passed, and 1e12 empty points were allocated (std::bad_alloc, blamed on "a size option")
+    shutil.copy(d + "/s.h5", d + "/huge.h5")
+    with h5py.File(d + "/huge.h5", "r+") as f:
+        f.attrs["ntrain"], f.attrs["nparams"] = np.int64(10 ** 12), np.int64(0)
+        for ds, shape in (("params/names", (0,)), ("params/min", (0,)), ("params/max", (0,)), ("train/points", (10 ** 12, 0))):
+            dt = f[ds].dtype
+            del f[ds]
+            f.create_dataset(ds, shape=shape, dtype=dt)
+    p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3",
+                        "-offline_stop", "bases", "-snapshots", d + "/huge.h5", "-snapshots_restart", "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "huge.h5" in p.stdout and "attributes ntrain 1000000000000" in p.stdout and "out of memory" not in p.stdout,
+          "a snapshot file declaring 1e12 training points of no parameter: refused naming the file and the attribute (exit %d)" % p.returncode)
     # the options text in the dataset /options (written when it is too long for an attribute): read as one fixed-length
     # string; a dataset of 64 of them was read 64 x its size into a buffer of one (a heap overflow, review of 2026-12-04)
     with h5py.File(d + "/s.h5", "r") as f:
@@ -446,6 +459,16 @@ def dualbasis_import(args):
         f["lambda"] = bad
     p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/neg.h5:/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "negative" in p.stdout, "negative multipliers are refused with a clear error")
+    # a NaN or an inf among the imported values (review of 2026-12-04: a NaN went into the dual basis, an inf hid every
+    # negative entry)
+    for v in (np.nan, np.inf):
+        bad = L.copy()
+        bad[5, 4] = v
+        with h5py.File(d + "/nf.h5", "w") as f:
+            f["lambda"] = bad
+        p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/nf.h5:/lambda", "-dual_out", d + "/wnf.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and "non-finite value" in p.stdout and "nf.h5" in p.stdout and "snapshot 4, entry 5" in p.stdout and not os.path.exists(d + "/wnf.h5"),
+              "an imported %s is refused naming the file, the snapshot and the entry, no basis written" % v)
     p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/nosuch"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "nosuch" in p.stdout, "a missing dataset is an error naming it")
     # a tolerance the basis misses is said (exit 0 and no word before, audit 2026-11-29): the report's dual.tol_reached

@@ -1304,6 +1304,32 @@ def guards(args):
         p = run(args, np_, "online", ["-rom", d + "/dims_native.h5", "-mu", "1.02"], expect_ok=False)
         check(p.returncode != 0 and p.stdout.count("checksum") >= 1 and "infinite loop" not in p.stdout and "HDF5-DIAG" not in p.stdout,
               "the checksum error on %d rank(s): our message, no HDF5 complaint at exit (%s)" % (np_, "infinite loop" if "infinite loop" in p.stdout else "none"))
+    # /online/contact/meta's counts (review of 2026-12-04): 3 x 1431655766 nodes wrapped to 2 in 32 bits, so a theta and
+    # a uD of 2 values passed and the facets read past them; a count of 2^59 facets wrapped to 0 entries
+    for name, change, words in (("meta_wrap", {0: 3, 1: 1, 2: 1431655766}, ["/online/contact/theta has 2 entries (4294967298 expected)"]),
+                                ("meta_big", {5: 2.0 ** 59}, ["/online/contact/meta entry 5", "not a count"])):
+        shutil.copy(rom, d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "r+") as f:
+            m = np.array(f["online/contact/meta"])
+            for k, v in change.items():
+                m[k] = v
+            f["online/contact/meta"][...] = m
+            if name == "meta_wrap":
+                for ds in ("online/contact/theta", "online/contact/uD"):
+                    del f[ds]
+                    f[ds] = np.zeros(2)
+        expect_error(args, ["-rom", d + "/%s.h5" % name, "-mu", "1.02"], ["%s.h5" % name] + words, "a ROM file with /online/contact/meta tampered (%s)" % name)
+    # a string attribute holding an array (review of 2026-12-04): read into a buffer of one string (4096 fixed-length
+    # ones: the binary of 1142153 hung; 3 variable-length ones: 24 bytes over an 8-byte pointer on the stack)
+    for name, val in (("attr_fixed", np.array([b"rbcontact-rom"] * 4096, dtype="S14")), ("attr_vlen", None)):
+        shutil.copy(rom, d + "/%s.h5" % name)
+        with h5py.File(d + "/%s.h5" % name, "r+") as f:
+            if val is None:
+                f.attrs["format"] = ["a", "b", "c"]
+            else:
+                f.attrs.create("format", val)
+        expect_error(args, ["-rom", d + "/%s.h5" % name, "-mu", "1.02"], ["%s.h5" % name, "attribute 'format' is not one string stored in the file"],
+                     "a ROM file whose format attribute is an array of %s strings" % ("4096 fixed-length" if val is not None else "3 variable-length"))
     # a group where a dataset belongs: said so, not "a corrupt file" (nor "missing")
     shutil.copy(rom, d + "/grp.h5")
     with h5py.File(d + "/grp.h5", "r+") as f:

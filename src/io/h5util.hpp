@@ -232,6 +232,13 @@ inline bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
   H5Id t(H5Aget_type(a.get()), H5Tclose);
   if (!t.ok()) return c.Fail(std::string("cannot get the type of attribute '") + name + "'");
   if (H5Tget_class(t.get()) != H5T_STRING) return c.Fail(std::string("attribute '") + name + "' is not a string", false);
+  { // one string, stored in the file: an array of n was read n x its size into a buffer of one (a heap or stack overflow)
+    H5Id          sp(H5Aget_space(a.get()), H5Sclose), file(H5Iget_file_id(obj), H5Fclose);
+    hsize_t       fsize = 0;
+    const hssize_t n    = sp.ok() ? H5Sget_simple_extent_npoints(sp.get()) : -1;
+    if (n != 1 || !file.ok() || H5Fget_filesize(file.get(), &fsize) < 0 || H5Tget_size(t.get()) > fsize)
+      return c.Fail(std::string("attribute '") + name + "' is not one string stored in the file (" + std::to_string((long long)n) + " values): a corrupt file", false);
+  }
   const htri_t vlen = H5Tis_variable_str(t.get());
   if (vlen < 0) return c.Fail(std::string("cannot inspect attribute '") + name + "'");
   if (vlen) {

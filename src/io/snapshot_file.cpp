@@ -198,6 +198,11 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
     if (!ReadAttr(c, f, i64names[k], H5T_NATIVE_LLONG, &i64[k])) return false;
     if (i64[k] < 0) return c.Fail(std::string("attribute '") + i64names[k] + "' is negative (corrupt file?)", false);
   }
+  // (bounds before anything is allocated from them: a training set holds at most 1e7 points, as -train_size and
+  // -train_file; dofs and multipliers are PetscInts. A zero-width /train/points passed the stored-size guard with
+  // 1e12 rows: review of 2026-12-04)
+  if (i64[0] > 10000000 || i64[2] > 2147483647LL || i64[3] > 2147483647LL)
+    return c.Fail("attributes ntrain " + std::to_string(i64[0]) + ", ndofs " + std::to_string(i64[2]) + ", nmult " + std::to_string(i64[3]) + ": beyond any training set or mesh (corrupt file?)", false);
   const hsize_t ntrain = (hsize_t)i64[0], np = (hsize_t)i64[1];
   h->ndofs = (PetscInt)i64[2];
   h->nmult = (PetscInt)i64[3];

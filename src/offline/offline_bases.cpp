@@ -676,6 +676,8 @@ PetscErrorCode DualSnapshotMatrix(MPI_Comm comm, const std::string &s, DenseMatr
   L.Resize((PetscInt)cols[0].size(), (PetscInt)cols.size());
   for (PetscInt j = 0; j < L.cols; ++j)
     for (PetscInt i = 0; i < L.rows; ++i) {
+      // (a NaN passed the max/min below and went into the dual basis; an inf hid every negative entry)
+      PetscCheck(std::isfinite(cols[j][i]), comm, PETSC_ERR_USER_INPUT, "dualbasis: '%s' holds a non-finite value (%g) in snapshot %" PetscInt_FMT ", entry %" PetscInt_FMT, s.c_str(), (double)cols[j][i], j, i);
       L(i, j) = cols[j][i];
       vmax    = std::max(vmax, std::abs(L(i, j)));
       vmin    = std::min(vmin, L(i, j));

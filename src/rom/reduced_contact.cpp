@@ -494,6 +494,10 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
   geomSet_.fill(0);
   PetscCall(RomReadDataset(file, group + "/meta", &dims, &meta));
   PetscCheck(meta.size() == 8, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta has %zu entries (8 expected)", file.c_str(), group.c_str(), meta.size());
+  // every count a whole number in [0, 2^31 - 1] (a larger one wrapped in the products below: 3 x 1431655766 nodes
+  // passed as 2 values of uD, and the facets then read past it; review of 2026-12-04), the products in 64 bits
+  for (int k : {0, 1, 2, 3, 5, 6, 7})
+    PetscCheck(meta[k] >= 0 && meta[k] <= 2147483647.0 && meta[k] == std::floor(meta[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta entry %d is %g, not a count: a corrupt file", file.c_str(), group.c_str(), k, meta[k]);
   dim          = (PetscInt)meta[0];
   N            = (PetscInt)meta[1];
   nnode        = (PetscInt)meta[2];
@@ -501,21 +505,21 @@ PetscErrorCode ContactPatch::Deserialize(const std::string &file, const std::str
   smoothNormal = meta[4] != 0;
   const size_t ns = (size_t)meta[5], nm = (size_t)meta[6], np = (size_t)meta[7];
   PetscCheck(dim == 2 || dim == 3, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/meta: dimension %" PetscInt_FMT, file.c_str(), group.c_str(), dim);
-  auto need = [&](const std::string &name, size_t n) -> PetscErrorCode {
+  auto need = [&](const std::string &name, unsigned long long n) -> PetscErrorCode {
     PetscFunctionBeginUser;
     PetscCall(RomReadDataset(file, group + "/" + name, &dims, &data));
-    PetscCheck(data.size() == n, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s has %zu entries (%zu expected)", file.c_str(), group.c_str(), name.c_str(), data.size(), n);
+    PetscCheck(data.size() == n, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: %s/%s has %zu entries (%llu expected)", file.c_str(), group.c_str(), name.c_str(), data.size(), n);
     PetscCall(RomCheckValues("ROM file " + file, group + "/" + name, data));
     PetscFunctionReturn(0);
   };
-  PetscCall(need("theta", nnode * dim * std::max<PetscInt>(N, 1)));
+  PetscCall(need("theta", (unsigned long long)nnode * (unsigned long long)dim * (unsigned long long)std::max<PetscInt>(N, 1)));
   theta.assign(data.begin(), data.end());
   if (!N) theta.clear();
-  PetscCall(need("uD", nnode * dim));
+  PetscCall(need("uD", (unsigned long long)nnode * (unsigned long long)dim));
   uD.assign(data.begin(), data.end());
   for (PetscInt side = 0; side < 2; ++side) {
     const size_t n = side ? nm : ns;
-    PetscCall(need(side ? "master" : "slave", n * 32));
+    PetscCall(need(side ? "master" : "slave", (unsigned long long)n * 32));
     auto &fs = side ? master : slave;
     fs.assign(n, SurfaceFacet());
     if (side) searchable.assign(n, 1);
