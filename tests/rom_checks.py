@@ -1319,6 +1319,14 @@ def guards(args):
                     del f[ds]
                     f[ds] = np.zeros(2)
         expect_error(args, ["-rom", d + "/%s.h5" % name, "-mu", "1.02"], ["%s.h5" % name] + words, "a ROM file with /online/contact/meta tampered (%s)" % name)
+    # a body's modulus parameter beyond the parameters (review of 2026-12-04: it fell back to the constant modulus)
+    shutil.copy(rom, d + "/pe.h5")
+    with h5py.File(d + "/pe.h5", "r+") as f:
+        b = np.array(f["online/bodies"])
+        b[0, 2] = 7
+        f["online/bodies"][...] = b
+    expect_error(args, ["-rom", d + "/pe.h5", "-mu", "1.02"], ["pe.h5", "/online/bodies row 0: the parameter of E is 7", "neither -1 nor an index"],
+                 "a ROM file whose body 0 takes E from parameter 7 of 1")
     # a string attribute holding an array (review of 2026-12-04): read into a buffer of one string (4096 fixed-length
     # ones: the binary of 1142153 hung; 3 variable-length ones: 24 bytes over an 8-byte pointer on the stack)
     for name, val in (("attr_fixed", np.array([b"rbcontact-rom"] * 4096, dtype="S14")), ("attr_vlen", None)):

@@ -179,6 +179,12 @@ PetscErrorCode ReducedParametrization::Read(const std::string &file)
   PetscCheck(bod.size() % 4 == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/bodies is malformed", file.c_str());
   bodies.assign(bod.size() / 4, BodySpec());
   for (size_t b = 0; b < bodies.size(); ++b) {
+    // the parameters E and nu follow: -1 (a constant) or an index of mu (an index out of range fell back to the constant
+    // without a word; review of 2026-12-04)
+    for (int k : {2, 3}) {
+      const double q = bod[4 * b + k];
+      PetscCheck(q == std::floor(q) && q >= -1 && q < (double)params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/bodies row %zu: the parameter of %s is %g, neither -1 nor an index in [0, %zu): a corrupt file", file.c_str(), b, k == 2 ? "E" : "nu", q, params.size());
+    }
     bodies[b].E       = bod[4 * b];
     bodies[b].nu      = bod[4 * b + 1];
     bodies[b].paramE  = (PetscInt)bod[4 * b + 2];
