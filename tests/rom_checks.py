@@ -1327,6 +1327,13 @@ def guards(args):
         f["online/bodies"][...] = b
     expect_error(args, ["-rom", d + "/pe.h5", "-mu", "1.02"], ["pe.h5", "/online/bodies row 0: the parameter of E is 7", "neither -1 nor an index"],
                  "a ROM file whose body 0 takes E from parameter 7 of 1")
+    # the warm starts' parameters as a vector, not n x (the parameters) (review of 2026-12-04: the shape was not checked)
+    shutil.copy(rom, d + "/wm.h5")
+    with h5py.File(d + "/wm.h5", "r+") as f:
+        a = np.array(f["online/warm/mu"])
+        del f["online/warm/mu"]
+        f["online/warm/mu"] = a.reshape(-1)
+    expect_error(args, ["-rom", d + "/wm.h5", "-mu", "1.02"], ["wm.h5", "/online/warm/mu has 1 dimensions", "expected n x 1"], "a ROM file whose /online/warm/mu is a vector")
     # a string attribute holding an array (review of 2026-12-04): read into a buffer of one string (4096 fixed-length
     # ones: the binary of 1142153 hung; 3 variable-length ones: 24 bytes over an 8-byte pointer on the stack)
     for name, val in (("attr_fixed", np.array([b"rbcontact-rom"] * 4096, dtype="S14")), ("attr_vlen", None)):

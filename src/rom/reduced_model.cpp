@@ -413,9 +413,11 @@ PetscErrorCode ReducedModel::Read(const std::string &path)
   warmL.clear();
   {
     bool found;
-    PetscCall(RomReadOptional(path, "/online/warm/mu", &warmMu, &found));
+    std::vector<unsigned long long> wd;
+    PetscCall(RomReadOptional(path, "/online/warm/mu", &warmMu, &found, &wd));
     if (!found) warmMu.clear();
-    else {
+    else { // one row of the parameters per warm start (its shape was not checked: review of 2026-12-04)
+      PetscCheck(wd.size() == 2 && wd[1] == (unsigned long long)par.params.size(), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "ROM file %s: /online/warm/mu has %zu dimensions (the last %llu), expected n x %zu (the parameters): a corrupt file", path.c_str(), wd.size(), wd.empty() ? 0ULL : wd.back(), par.params.size());
       const size_t nw = warmMu.size() / std::max<size_t>(1, par.params.size());
       PetscCall(ReadShaped(path, "/online/warm/v", {nw, N}, &warmV));
       PetscCall(ReadShaped(path, "/online/warm/lambda", {nw, R}, &warmL));
