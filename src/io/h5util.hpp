@@ -224,6 +224,15 @@ inline bool ReadAttr(Ctx &c, hid_t obj, const char *name, hid_t mtype, void *buf
   return true;
 }
 
+// The size in bytes of the file holding obj (a file, dataset or attribute's object); 0 when HDF5 cannot tell.
+inline hsize_t FileSizeOf(hid_t obj)
+{
+  hsize_t size = 0;
+  H5Id    f(H5Iget_file_id(obj), H5Fclose);
+  if (!f.ok() || H5Fget_filesize(f.get(), &size) < 0) size = 0;
+  return size;
+}
+
 // Reads a string attribute (fixed-length or variable-length).
 inline bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
 {
@@ -233,10 +242,9 @@ inline bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
   if (!t.ok()) return c.Fail(std::string("cannot get the type of attribute '") + name + "'");
   if (H5Tget_class(t.get()) != H5T_STRING) return c.Fail(std::string("attribute '") + name + "' is not a string", false);
   { // one string, stored in the file: an array of n was read n x its size into a buffer of one (a heap or stack overflow)
-    H5Id          sp(H5Aget_space(a.get()), H5Sclose), file(H5Iget_file_id(obj), H5Fclose);
-    hsize_t       fsize = 0;
-    const hssize_t n    = sp.ok() ? H5Sget_simple_extent_npoints(sp.get()) : -1;
-    if (n != 1 || !file.ok() || H5Fget_filesize(file.get(), &fsize) < 0 || H5Tget_size(t.get()) > fsize)
+    H5Id           sp(H5Aget_space(a.get()), H5Sclose);
+    const hssize_t n = sp.ok() ? H5Sget_simple_extent_npoints(sp.get()) : -1;
+    if (n != 1 || H5Tget_size(t.get()) > FileSizeOf(obj))
       return c.Fail(std::string("attribute '") + name + "' is not one string stored in the file (" + std::to_string((long long)n) + " values): a corrupt file", false);
   }
   const htri_t vlen = H5Tis_variable_str(t.get());
@@ -318,9 +326,7 @@ inline bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hs
     long double bytes = (long double)H5Tget_size(t.get());
     for (hsize_t x : *dims) bytes *= (long double)x;
     const hsize_t stored = H5Dget_storage_size(d);
-    hsize_t       fsize  = 0;
-    H5Id          f(H5Iget_file_id(d), H5Fclose);
-    if (f.ok() && H5Fget_filesize(f.get(), &fsize) < 0) fsize = 0;
+    const hsize_t fsize  = FileSizeOf(d);
     if (bytes > (long double)stored && (stored > 0 || bytes > (long double)fsize)) {
       std::ostringstream m;
       m << "dataset " << name << " declares shape " << ShapeString(*dims) << " (" << (double)bytes << " bytes), more than the file stores for it (" << (unsigned long long)stored << " bytes; the file has " << (unsigned long long)fsize << "): a corrupt or truncated file";

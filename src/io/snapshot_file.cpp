@@ -187,8 +187,7 @@ bool ReadHeaderH5(Ctx &c, hid_t f, SnapshotHeader *h)
     if (!DatasetDims(c, d.get(), "/options", &od)) return false;
     hsize_t n = 1;
     for (hsize_t x : od) n *= x;
-    hsize_t fileSize = 0;
-    if (n != 1 || H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) != 0 || H5Fget_filesize(f, &fileSize) < 0 || H5Tget_size(t.get()) > fileSize)
+    if (n != 1 || H5Tget_class(t.get()) != H5T_STRING || H5Tis_variable_str(t.get()) != 0 || H5Tget_size(t.get()) > FileSizeOf(f))
       return c.Fail("dataset /options is not one fixed-length string of the file's (shape " + ShapeString(od) + "): a corrupt file", false);
     std::vector<char> buf(H5Tget_size(t.get()) + 1, 0);
     if (H5Dread(d.get(), t.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()) < 0) return c.Fail("cannot read dataset /options");
