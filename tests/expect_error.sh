@@ -11,7 +11,7 @@
 # of a fresh temp file holding a malformed gmsh .msh / .geo file, removed afterwards; @PIN_MSH22@ by
 # meshes/pin_in_hole.geo meshed in gmsh format 2.2 (an entity tag equal to another group's physical tag); @NOBLOCK_GEO@
 # by meshes/ring_on_block.geo without the block's Physical Surface; @ORDER2_GEO@ by the same with Mesh.ElementOrder = 2;
-# @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
+# @PIN_MSH22BIN@ by @PIN_MSH22@ in binary; @PART_MSH22@ by ring_on_block's mesh in format 2.2 partitioned in 2; @DUPPHYS_MSH@ by ring_on_block's mesh with "ring_top" under two physical tags;
 # @MISSING_NODE_MSH@ / @INF_NODE_MSH@ by that mesh with a triangle pointing at an undefined node / a node at x = inf;
 # @FREECURVE_GEO@ by ring_on_block.geo with a physical curve in no surface; @MIXED3D_GEO@ by a 3D mesh of tetrahedra and hexahedra;
 # @SELFINC_GEO@ by a .geo including, through a second file, itself three times; @TWICE_GEO@ by a .geo that includes
@@ -48,6 +48,11 @@ for a in "$@"; do
     # meshes/ring_on_block.geo meshed with second-order (curved) elements
     { cat "$(dirname "$0")/../meshes/ring_on_block.geo"; echo 'Mesh.ElementOrder = 2;'; } > "$tmpdir/order2.geo"
     args+=("$tmpdir/order2.geo")
+  elif [ "$a" = "@PART_MSH22@" ]; then
+    # meshes/ring_on_block.geo in gmsh format 2.2, partitioned in 2: the partition count (1) and tags (1, 2) after the
+    # entity tag equal the surfaces' physical tags (ring 1, block 2)
+    "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/ring_on_block.geo" -format msh22 -part 2 -v 0 -o "$tmpdir/ring.part.22.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }
+    args+=("$tmpdir/ring.part.22.msh")
   elif [ "$a" = "@PIN_MSH22BIN@" ]; then
     # meshes/pin_in_hole.geo in binary gmsh format 2.2 (the tag clash of @PIN_MSH22@, unreadable as text)
     "${RBC_GMSH:-gmsh}" -2 "$(dirname "$0")/../meshes/pin_in_hole.geo" -format msh22 -bin -v 0 -o "$tmpdir/pin_in_hole.22bin.msh" > /dev/null 2>&1 || { echo "expect_error: gmsh failed"; exit 2; }

@@ -293,6 +293,24 @@ def mismatch(args):
                         "-offline_stop", "bases", "-snapshots", d + "/huge.h5", "-snapshots_restart", "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "huge.h5" in p.stdout and "attributes ntrain 1000000000000" in p.stdout and "out of memory" not in p.stdout,
           "a snapshot file declaring 1e12 training points of no parameter: refused naming the file and the attribute (exit %d)" % p.returncode)
+    # datasets of zero rows store nothing, so the stored-size guard passed any other extent (audit of 2026-12-04): an
+    # extra of 0 x 2^50 (-snapshots_sensitivities asked for a row of 2^50 values: std::bad_alloc, exit 134) and a header
+    # ndofs of 2^31 - 1 over an empty /snapshots/u (rows sized from the header before the dataset was seen)
+    shutil.copy(d + "/s.h5", d + "/zero_extra.h5")
+    with h5py.File(d + "/zero_extra.h5", "r+") as f:
+        f.create_dataset("snapshots/extra/sensitivity_u", shape=(0, 2 ** 50), dtype="f8")
+    p = subprocess.run(["mpirun", "-n", "1", args.exe, "offline", "-options_file", "runs/ring_on_block.opts", "-train_type", "grid", "-train_size", "3", "-snapshots_sensitivities",
+                        "-offline_stop", "bases", "-snapshots", d + "/zero_extra.h5", "-snapshots_restart", "-rom", d + "/never.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "zero_extra.h5" in p.stdout and "/snapshots/extra/sensitivity_u has shape 0 x 1125899906842624, expected ntrain (3)" in p.stdout and "bad_alloc" not in p.stdout,
+          "an extra dataset of 0 x 2^50: refused naming the file and the dataset (exit %d)" % p.returncode)
+    shutil.copy(d + "/s.h5", d + "/zero_u.h5")
+    with h5py.File(d + "/zero_u.h5", "r+") as f:
+        f.attrs["ndofs"] = np.int64(2 ** 31 - 1)
+        del f["snapshots/u"]
+        f.create_dataset("snapshots/u", shape=(0, 2 ** 31 - 1), dtype="f8")
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/zero_u.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "zero_u.h5" in p.stdout and "/snapshots/u has shape 0 x 2147483647, expected 3 x 2147483647" in p.stdout,
+          "an empty /snapshots/u under a header ndofs of 2^31 - 1: refused naming the file and the dataset's shape (exit %d)" % p.returncode)
     # the options text in the dataset /options (written when it is too long for an attribute): read as one fixed-length
     # string; a dataset of 64 of them was read 64 x its size into a buffer of one (a heap overflow, review of 2026-12-04)
     with h5py.File(d + "/s.h5", "r") as f:
@@ -469,6 +487,22 @@ def dualbasis_import(args):
         p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/nf.h5:/lambda", "-dual_out", d + "/wnf.h5"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         check(p.returncode != 0 and "non-finite value" in p.stdout and "nf.h5" in p.stdout and "snapshot 4, entry 5" in p.stdout and not os.path.exists(d + "/wnf.h5"),
               "an imported %s is refused naming the file, the snapshot and the entry, no basis written" % v)
+    # a dataset of zero rows and 2^40 columns stores nothing (audit of 2026-12-04: 2^40 empty snapshot columns were
+    # allocated, std::bad_alloc)
+    with h5py.File(d + "/empty.h5", "w") as f:
+        f.create_dataset("lambda", shape=(0, 2 ** 40), dtype="f8")
+    p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/empty.h5:/lambda"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    check(p.returncode != 0 and "empty.h5" in p.stdout and "has shape 0 x 1099511627776: it holds no snapshots" in p.stdout, "a dataset of 0 x 2^40: refused naming it (exit %d)" % p.returncode)
+    # a virtual dataset (it reads other files; unmapped, its fill value for any shape) and external raw storage: refused
+    with h5py.File(d + "/virt.h5", "w") as f:
+        layout = h5py.VirtualLayout(shape=L.shape, dtype="f8")
+        layout[:, :] = h5py.VirtualSource(d + "/ext.h5", "lambda", shape=L.shape)
+        f.create_virtual_dataset("lambda", layout)
+        L.astype("f8").tofile(d + "/raw.bin")
+        f.create_dataset("ext", shape=L.shape, dtype="f8", external=[(d + "/raw.bin", 0, L.nbytes)])
+    for ds, words in (("lambda", "is a virtual dataset"), ("ext", "has external storage")):
+        p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/virt.h5:/" + ds], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(p.returncode != 0 and "virt.h5" in p.stdout and words in p.stdout, "a dataset that %s: refused naming it (exit %d)" % (words, p.returncode))
     p = subprocess.run([args.exe, "dualbasis", "-snapshots", d + "/ext.h5:/nosuch"], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     check(p.returncode != 0 and "nosuch" in p.stdout, "a missing dataset is an error naming it")
     # a tolerance the basis misses is said (exit 0 and no word before, audit 2026-11-29): the report's dual.tol_reached

@@ -51,9 +51,9 @@ def check(cond, msg):
         FAILED.append(msg)
 
 
-def run(args, np_, stage, extra, expect_ok=True):
+def run(args, np_, stage, extra, expect_ok=True, env=None):
     c = ["mpirun", "-n", str(np_), args.exe, stage] + extra
-    p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    p = subprocess.run(c, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     if expect_ok and p.returncode != 0:
         print(p.stdout[-4000:])
         sys.exit("command failed (exit %d): %s" % (p.returncode, " ".join(c)))
@@ -1459,6 +1459,20 @@ def guards(args):
             r = report(d + "/old.json")
             check(p.returncode != 0 and all(w in p.stdout for w in words) and "SEGV" not in p.stdout and r["converged"] is False and words[0] in r["error"],
                   "-options_file %s, %d rank(s): refused, the report says so" % (os.path.basename(opts), np_))
+    # the options PETSc reads besides the command line: a ~/.petscrc, or an -options_file in PETSC_OPTIONS, that includes
+    # itself (not checked before 2026-12-04: PETSc recursed until a segmentation fault, exit 139, no message)
+    home = d + "/home"
+    os.makedirs(home)
+    with open(home + "/.petscrc", "w") as f:
+        f.write("-options_file %s/self.opts\n" % d)
+    for extra_env, where in (({"HOME": home}, "a file PETSc reads at every start; -skip_petscrc skips it"),
+                             ({"PETSC_OPTIONS": "-options_file %s/self.opts" % d}, "named in the environment's PETSC_OPTIONS")):
+        for np_ in (1, 2):
+            p = run(args, np_, "online", base, expect_ok=False, env=dict(os.environ, **extra_env))
+            check(p.returncode != 0 and "includes itself" in p.stdout and where in p.stdout and "SEGV" not in p.stdout,
+                  "%s holding a self-including -options_file, %d rank(s): refused naming it (exit %d)" % (list(extra_env)[0], np_, p.returncode))
+    p = run(args, 1, "online", base + ["-skip_petscrc"], expect_ok=False, env=dict(os.environ, HOME=home))
+    check(p.returncode == 0, "-skip_petscrc: that ~/.petscrc is not read (exit %d)" % p.returncode)
     shutil.rmtree(d, ignore_errors=True)
 
 

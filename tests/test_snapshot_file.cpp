@@ -266,6 +266,17 @@ static PetscErrorCode TestImport(const std::string &dir)
     PetscCall(MatDestroy(&A));
     PetscCall(MatDestroy(&B));
     std::ofstream(garbage) << "this is not a matrix\n";
+    // Corrupt headers (audit of 2026-12-04): an AIJ file of 4 kB declaring 1000 x (2^31 - 1) with no nonzeros (its
+    // dense import asked for 17 TB), and a dense one declaring (2^31 - 1)^2 (M * N * 8 overflowed 64 bits and passed).
+    auto header = [](std::ofstream &o, std::vector<long long> words) {
+      for (long long w : words)
+        for (int b = (int)sizeof(PetscInt) - 1; b >= 0; --b) o.put((char)((unsigned long long)w >> (8 * b) & 0xff));
+    };
+    std::ofstream wide(dir + "/wide.bin", std::ios::binary), huge(dir + "/huge.bin", std::ios::binary);
+    header(wide, {MAT_FILE_CLASSID, 1000, 2147483647LL, 0});
+    header(wide, std::vector<long long>(1000, 0));
+    header(huge, {MAT_FILE_CLASSID, 2147483647LL, 2147483647LL, -1});
+    header(huge, std::vector<long long>(64, 0));
   }
   PetscCallMPI(MPI_Barrier(PETSC_COMM_WORLD));
 
@@ -295,6 +306,10 @@ static PetscErrorCode TestImport(const std::string &dir)
   CheckError(code, "import of an HDF5 file without a dataset name", {h5, ":/path/to/dataset"});
   code = ImportSnapshotMatrix(PETSC_COMM_WORLD, garbage, &cols);
   CheckError(code, "import of a garbage file", {garbage, "PETSc binary Mat"});
+  code = ImportSnapshotMatrix(PETSC_COMM_WORLD, dir + "/wide.bin", &cols);
+  CheckError(code, "import of an AIJ file whose dense copy exceeds the memory", {dir + "/wide.bin", "1000 x 2147483647", "more than this machine's memory"});
+  code = ImportSnapshotMatrix(PETSC_COMM_WORLD, dir + "/huge.bin", &cols);
+  CheckError(code, "import of a dense file whose size overflows 64 bits", {dir + "/huge.bin", "2147483647 x 2147483647", "truncated or corrupt"});
   code = ImportSnapshotMatrix(PETSC_COMM_WORLD, dir + "/missing.h5:/S", &cols);
   CheckError(code, "import of a missing file", {dir + "/missing.h5", "does not exist"});
   PetscCall(PetscPopErrorHandler());

@@ -310,6 +310,10 @@ inline bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hs
   H5Id t(H5Dget_type(d), H5Tclose);
   H5Id pl(H5Dget_create_plist(d), H5Pclose);
   const H5D_layout_t layout = pl.ok() ? H5Pget_layout(pl.get()) : H5D_LAYOUT_ERROR;
+  // A virtual dataset reads other files (or, unmapped, its fill value for any declared shape) and external storage
+  // reads raw files beside it: neither is what rbcontact or h5py writes by default, and neither can be checked here.
+  if (layout == H5D_VIRTUAL) return c.Fail("dataset " + name + " is a virtual dataset (its values live in other files): rbcontact reads datasets stored in the file itself; copy it into a plain dataset", false);
+  if (pl.ok() && H5Pget_external_count(pl.get()) > 0) return c.Fail("dataset " + name + " has external storage (its values live in raw files beside it): rbcontact reads datasets stored in the file itself; copy it into a plain dataset", false);
   if (layout == H5D_CHUNKED && rank > 0) {
     std::vector<hsize_t> chunk((size_t)rank, 0);
     hsize_t              stored = 0;
@@ -336,6 +340,16 @@ inline bool DatasetDims(Ctx &c, hid_t d, const std::string &name, std::vector<hs
   return true;
 }
 
+// Dataset `name` has shape `expect` (checked by DatasetDims against what the file stores).
+inline bool HasShape(Ctx &c, hid_t file, const std::string &name, const std::vector<hsize_t> &expect)
+{
+  H5Id d;
+  std::vector<hsize_t> dims;
+  if (!OpenDataset(c, file, name, &d) || !DatasetDims(c, d.get(), name, &dims)) return false;
+  if (dims != expect) return c.Fail("dataset " + name + " has shape " + ShapeString(dims) + ", expected " + ShapeString(expect) + " (corrupt file?)", false);
+  return true;
+}
+
 // Whole-dataset write / read with a shape check.
 inline bool WriteWhole(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *buf)
 {
@@ -349,13 +363,11 @@ inline bool WriteWhole(Ctx &c, hid_t file, const std::string &name, hid_t ftype,
 
 inline bool ReadWhole(Ctx &c, hid_t file, const std::string &name, const std::vector<hsize_t> &expect, std::vector<double> *v)
 {
+  if (!HasShape(c, file, name, expect)) return false;
   H5Id d;
   if (!OpenDataset(c, file, name, &d)) return false;
-  std::vector<hsize_t> dims;
-  if (!DatasetDims(c, d.get(), name, &dims)) return false;
-  if (dims != expect) return c.Fail("dataset " + name + " has shape " + ShapeString(dims) + ", expected " + ShapeString(expect) + " (corrupt file?)", false);
   hsize_t n = 1;
-  for (hsize_t x : dims) n *= x;
+  for (hsize_t x : expect) n *= x;
   v->assign(n, 0.0);
   if (n > 0 && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->data()) < 0) return c.Fail("cannot read dataset " + name);
   return true;

@@ -1,6 +1,7 @@
 // src/io/options_files.cpp: the -options_file chain checked before PETSc reads it (options_files.hpp).
 #include "rbcontact/options_files.hpp"
 #include <petscsys.h>
+#include <sys/stat.h>
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -243,6 +244,42 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
     return "";
   };
   double total = 0;
+  // What PETSc 3.18's PetscOptionsInsert reads before the command line: ~/.petscrc, ./.petscrc and ./petscrc (where they
+  // exist, unless the command line says -skip_petscrc), then the environment's PETSC_OPTIONS; an -options_file in any of
+  // them recursed in PETSc without a check here (a self-including .petscrc: a stack overflow, not a message).
+  // PETSC_OPTIONS_YAML and -options_file_yaml (YAML) are not followed here.
+  bool skip = false;
+  for (size_t i = 0; i < words.size(); ++i)
+    if (words[i] == "-skip_petscrc") {
+      const std::string v = i + 1 < words.size() ? words[i + 1] : "";
+      skip = !(v == "0" || v == "false" || v == "FALSE" || v == "no" || v == "NO" || v == "off");
+    }
+  std::vector<std::string> rc;
+  if (!skip) {
+    if (const char *home = std::getenv("HOME"); home && home[0]) rc.push_back(std::string(home) + "/.petscrc");
+    rc.push_back(".petscrc");
+    rc.push_back("petscrc");
+  }
+  for (const auto &file : rc) {
+    struct stat st;
+    if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue; // PETSc reads it only where it is a file
+    double            n = 0;
+    const std::string e = visit(file, 0, &n);
+    if (!e.empty()) return e + " (a file PETSc reads at every start; -skip_petscrc skips it)";
+    total += n;
+  }
+  if (const char *env = std::getenv("PETSC_OPTIONS")) {
+    std::istringstream       es(env);
+    std::vector<std::string> tok;
+    for (std::string t; es >> t;) tok.push_back(t);
+    for (size_t i = 0; i + 1 < tok.size(); ++i)
+      if (tok[i] == "-options_file") {
+        double            n = 0;
+        const std::string e = visit(tok[i + 1], 0, &n);
+        if (!e.empty()) return e + " (named in the environment's PETSC_OPTIONS)";
+        total += n;
+      }
+  }
   for (size_t i = 0; i + 1 < words.size(); ++i)
     if (words[i] == "-options_file") {
       double            n = 0;

@@ -599,6 +599,8 @@ PetscErrorCode SnapshotFile::RowsWithoutExtra(const std::string &name, std::vect
     if (has) {
       H5Id d(H5Dopen2((hid_t)file_, dn.c_str(), H5P_DEFAULT), H5Dclose);
       if (!(d.ok() || c.Fail("cannot open dataset " + dn)) || !DatasetDims(c, d.get(), dn, &dims) || (dims.size() != 2 && !c.Fail("dataset " + dn + " is not ntrain x len", false))) err = c.err;
+      // (a shape of 0 x 2^50 stores nothing, so it passed DatasetDims, and a row of 2^50 values was allocated)
+      else if (dims[0] != done_.size()) err = (c.Fail("dataset " + dn + " has shape " + ShapeString(dims) + ", expected ntrain (" + std::to_string(done_.size()) + ") x len: a corrupt file", false), c.err);
     }
     std::vector<double> row;
     for (size_t i = 0; err.empty() && i < done_.size(); ++i) {
@@ -772,6 +774,10 @@ bool ReadAllH5(Ctx &c, const std::string &path, SnapshotHeader *hOut, std::vecto
       }
     }
     const hsize_t np = h.paramNames.size();
+    // the row datasets' shapes before any row is sized from the header (a /snapshots/u of 0 rows stores nothing and
+    // passes DatasetDims whatever its header's ndofs: rows of ndofs values were allocated before the shape was seen)
+    const hsize_t nt = done.size();
+    ok = ok && HasShape(c, f.get(), "/snapshots/mu", {nt, np}) && HasShape(c, f.get(), "/snapshots/u", {nt, (hsize_t)h.ndofs}) && HasShape(c, f.get(), "/snapshots/lambda", {nt, (hsize_t)h.nmult});
     for (size_t i = 0; ok && i < done.size(); ++i) {
       if (!done[i]) continue;
       Snapshot  s;
@@ -958,6 +964,8 @@ bool ImportH5(Ctx &c, const std::string &file, const std::string &dset, bool tra
   std::vector<hsize_t> dims;
   if (!DatasetDims(c, d.get(), dset, &dims)) return false;
   if (dims.size() != 2) return c.Fail("dataset " + dset + " has shape " + ShapeString(dims) + "; a 2D matrix is expected (rows = dofs, columns = snapshots; -import_transpose for the transpose)", false);
+  // (a shape of 0 x 2^40 stores nothing, so it passed DatasetDims, and asked for 2^40 empty snapshot columns)
+  if (dims[0] == 0 || dims[1] == 0) return c.Fail("dataset " + dset + " has shape " + ShapeString(dims) + ": it holds no snapshots", false);
   std::vector<double> raw(dims[0] * dims[1]);
   if (!raw.empty() && H5Dread(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, raw.data()) < 0) return c.Fail("cannot read dataset " + dset);
   // raw is row-major dims[0] x dims[1].
@@ -995,11 +1003,20 @@ bool CheckPetscBinary(Ctx &c, const std::string &file, PetscInt *nz)
     m << "is neither a PETSc binary Mat file (no Mat class id " << MAT_FILE_CLASSID << " at its start) nor given as file.h5:/dataset";
     return c.Fail(m.str(), false);
   }
-  const long long M = hdr[1], N = hdr[2], NZ = hdr[3], I = sizeof(PetscInt), S = sizeof(PetscScalar);
-  const long long need = NZ == -1 ? 4 * I + M * N * S : 4 * I + M * I + NZ * (I + S);
-  if (M < 0 || N < 0 || NZ < -1 || size < need) {
+  // in long double: M * N * 8 of a corrupt dense header overflowed 64 bits (negative: passed the size check)
+  const long long   M = hdr[1], N = hdr[2], NZ = hdr[3], I = sizeof(PetscInt), S = sizeof(PetscScalar);
+  const long double need = NZ == -1 ? 4.0L * I + (long double)M * N * S : 4.0L * I + (long double)M * I + (long double)NZ * (I + S);
+  if (M < 0 || N < 0 || NZ < -1 || (long double)size < need) {
     std::ostringstream m;
-    m << "PETSc binary Mat header says " << M << " x " << N << " (nz " << NZ << ") but the file is truncated or corrupt (" << size << " bytes, need " << need << ")";
+    m << "PETSc binary Mat header says " << M << " x " << N << " (nz " << NZ << ") but the file is truncated or corrupt (" << size << " bytes, need " << (double)need << ")";
+    return c.Fail(m.str(), false);
+  }
+  // The import is dense (an AIJ file is converted, then copied into the snapshot columns: about 4 dense copies at
+  // once). A sparse file declaring 46340 x 46340 in 185 kB asked MatConvert for 17 GB; refused against the memory.
+  const long double dense = (long double)M * N * S, mem = (long double)sysconf(_SC_PHYS_PAGES) * (long double)sysconf(_SC_PAGE_SIZE);
+  if (NZ != -1 && mem > 0 && 4 * dense > mem) {
+    std::ostringstream m;
+    m << "PETSc binary Mat header says " << M << " x " << N << " (nz " << NZ << "): its import is dense, " << (double)dense << " bytes a copy (about 4 copies at once), more than this machine's memory (" << (double)mem << " bytes); a corrupt header, or a matrix too large to import";
     return c.Fail(m.str(), false);
   }
   *nz = (PetscInt)NZ;

@@ -457,31 +457,36 @@ static std::string Gmsh22TagClash(const std::string &msh, const std::string &opt
           groups[{d, t}] = (a != std::string::npos && b > a) ? name.substr(a + 1, b - a - 1) : name;
         }
       } else if (line.rfind("$Elements", 0) == 0) {
-        auto dimOf = [](int type) {
-          switch (type) {
-          case 15: return 0;
-          case 1: case 8: case 26: case 27: case 28: return 1;
-          case 2: case 3: case 9: case 10: case 16: case 20: case 21: case 22: case 23: case 24: case 25: return 2;
-          default: return 3;
-          }
+        auto dimOf = [](int type) { // the element types PETSc 3.18's reader knows (gmsh_check.cpp refuses the others)
+          if (type == 15) return 0;
+          if (type == 1 || type == 8 || (type >= 26 && type <= 28) || (type >= 62 && type <= 66)) return 1;
+          if ((type >= 2 && type <= 3) || (type >= 9 && type <= 10) || type == 16 || (type >= 20 && type <= 25) || (type >= 36 && type <= 51)) return 2;
+          return 3;
         };
         long n = 0;
         f >> n;
         std::getline(f, line);
         for (long e = 0; e < n && std::getline(f, line) && why.empty(); ++e) {
+          // every tag after the physical one is matched by the reader against the groups of the element's dimension:
+          // the entity tag, and in a partitioned file the partition count and the partition tags
           std::istringstream in(line);
-          int                id, type, ntags, phys = 0, ent = 0;
-          in >> id >> type >> ntags;
-          if (ntags >= 2) in >> phys >> ent;
-          if (ntags < 2 || ent == phys) continue;
-          const auto g = groups.find({dimOf(type), ent});
-          if (g != groups.end()) {
-            const auto own = groups.find({dimOf(type), phys});
+          int                id = 0, type = 0, ntags = 0, phys = 0;
+          in >> id >> type >> ntags >> phys;
+          for (int t = 1; t < ntags && why.empty(); ++t) {
+            int tag = 0;
+            if (!(in >> tag)) break;
+            if (tag == phys) continue;
+            const auto g = groups.find({dimOf(type), tag});
+            if (g == groups.end()) continue;
+            const auto         own = groups.find({dimOf(type), phys});
+            const std::string  ownName = own != groups.end() ? own->second : std::to_string(phys);
             std::ostringstream m;
-            m << "mesh '" << msh << "' (" << option << ") is in gmsh format 2.2 and its entity " << ent << " (of physical group '" << (own != groups.end() ? own->second : std::to_string(phys))
-              << "') has the tag of physical group '" << g->second << "': PETSc 3.18's reader would put those elements into '" << g->second
-              << "' too (a wrong mesh). " << (generated ? "Remove Mesh.MshFileVersion from the .geo (rbcontact meshes it in format 4.1)" : "Write it with gmsh -format msh41")
-              << " (or give the physical groups tags no entity uses)";
+            m << "mesh '" << msh << "' (" << option << ") is in gmsh format 2.2 and ";
+            if (t == 1) m << "its entity " << tag << " (of physical group '" << ownName << "') has the tag of physical group '" << g->second << "'";
+            else m << "its element " << id << " (of physical group '" << ownName << "') carries the tag " << tag << " of physical group '" << g->second << "' as its " << (t == 2 ? "partition count" : "partition tag") << " (a partitioned file)";
+            m << ": PETSc 3.18's reader would put those elements into '" << g->second << "' too (a wrong mesh). ";
+            if (t == 1) m << (generated ? "Remove Mesh.MshFileVersion from the .geo (rbcontact meshes it in format 4.1)" : "Write it with gmsh -format msh41") << " (or give the physical groups tags no entity uses)";
+            else m << "Write it without partitions (gmsh without -part" << (generated ? ", no Mesh.NbPartitions in the .geo" : "") << "): rbcontact partitions the mesh itself";
             why = m.str();
           }
         }
