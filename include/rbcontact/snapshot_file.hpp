@@ -28,6 +28,9 @@ struct SnapshotHeader {
   std::vector<std::vector<PetscReal>>  trainingPoints; // the full training set (ntrain x nparams)
   PetscInt                             ndofs = 0;      // length of u
   PetscInt                             nmult = 0;      // length of lambda (R)
+  // The extra arrays (name, length) every Write of this run carries: a new file creates their datasets with the others
+  // (no HDF5 metadata written by a Write). Not stored as such, not compared; a Write may still bring others.
+  std::vector<std::pair<std::string, PetscInt>> extras;
 };
 
 // Per-snapshot data (all arrays in canonical ordering, identical on any rank count).

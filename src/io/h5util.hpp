@@ -266,14 +266,14 @@ inline bool ReadStringAttr(Ctx &c, hid_t obj, const char *name, std::string *v)
   return true;
 }
 
-// Creates a dataset of its final shape, contiguous, allocated now; fill: the fill value (memory
-// type mtype), or nullptr for no fill (the space is allocated but never initialised: sparse).
-inline bool CreateDataset(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *fill, H5Id *out)
+// Creates a dataset of its final shape, contiguous, allocated now (late: at its first write); fill: the fill value
+// (memory type mtype), or nullptr for no fill (the space is allocated but never initialised: sparse).
+inline bool CreateDataset(Ctx &c, hid_t file, const std::string &name, hid_t ftype, const std::vector<hsize_t> &dims, hid_t mtype, const void *fill, H5Id *out, bool late = false)
 {
   H5Id sp(H5Screate_simple((int)dims.size(), dims.data(), nullptr), H5Sclose);
   if (!sp.ok()) return c.Fail("cannot create the dataspace of dataset " + name);
   H5Id dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
-  if (!dcpl.ok() || H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl.get(), H5D_ALLOC_TIME_EARLY) < 0) return c.Fail("cannot set the layout of dataset " + name);
+  if (!dcpl.ok() || H5Pset_layout(dcpl.get(), H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl.get(), late ? H5D_ALLOC_TIME_LATE : H5D_ALLOC_TIME_EARLY) < 0) return c.Fail("cannot set the layout of dataset " + name);
   if (fill) {
     if (H5Pset_fill_value(dcpl.get(), mtype, fill) < 0 || H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_IFSET) < 0) return c.Fail("cannot set the fill value of dataset " + name);
   } else if (H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER) < 0) return c.Fail("cannot set the fill time of dataset " + name);
@@ -438,8 +438,10 @@ public:
     return f;
   }
 
-  // Closes *file and writes its image to path (created or truncated), then fsync.
-  bool Save(Ctx &c, H5Id *file, const std::string &path)
+  // Closes *file and writes its image to path (created or truncated), then `reserve` more bytes of zeros after its
+  // end (the room the file will take when its late-allocated datasets are allocated: the disk's blocks taken now), then
+  // fsync.
+  bool Save(Ctx &c, H5Id *file, const std::string &path, unsigned long long reserve = 0)
   {
     const hid_t id = file->Release();
     if (H5Fclose(id) < 0 || !image_) return c.Fail("cannot close the file's image in memory");
@@ -454,12 +456,13 @@ public:
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
     if (fd < 0) return c.Fail(std::string("cannot create the file: ") + std::strerror(errno), false);
     // (zeros written, not a hole: the space is the disk's now, so a full disk is said here, not at a later row)
-    const std::vector<unsigned char> zeros(eof > size_ ? std::min<unsigned long long>(eof - size_, 1 << 20) : 0, 0);
+    const unsigned long long         end = eof + reserve;
+    const std::vector<unsigned char> zeros(end > size_ ? std::min<unsigned long long>(end - size_, 1 << 20) : 0, 0);
     int                              err = 0;
     unsigned long long               off = 0;
-    while (off < eof) {
-      const bool    mem = off < size_;
-      const size_t  len = mem ? (size_t)(std::min<unsigned long long>(eof, size_) - off) : (size_t)std::min<unsigned long long>(eof - off, zeros.size());
+    while (off < end) {
+      const bool    mem = off < size_ && off < eof;
+      const size_t  len = mem ? (size_t)(std::min<unsigned long long>(eof, size_) - off) : (size_t)std::min<unsigned long long>(end - off, zeros.size());
       const ssize_t w   = ::write(fd, mem ? u + off : zeros.data(), len);
       if (w < 0 && errno == EINTR) continue;
       if (w <= 0) {
@@ -470,7 +473,7 @@ public:
     }
     if (!err && ::fsync(fd) != 0) err = errno;
     if (::close(fd) != 0 && !err) err = errno;
-    if (err) return c.Fail("cannot write the file (" + std::to_string(eof) + " bytes): " + std::strerror(err), false);
+    if (err) return c.Fail("cannot write the file (" + std::to_string(end) + " bytes): " + std::strerror(err), false);
     return true;
   }
 

@@ -117,11 +117,13 @@ bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
   for (const auto &x : h.trainingPoints) pts.insert(pts.end(), x.begin(), x.end());
   if (!WriteWhole(c, f, "/train/points", H5T_IEEE_F64LE, {ntrain, np}, H5T_NATIVE_DOUBLE, pts.data())) return false;
 
-  // Per-snapshot datasets, final shape, allocated now.
+  // Per-snapshot datasets, final shape. The file is built in memory (MemoryFile), and HDF5's core driver extends its
+  // image to the whole allocated file at the close: so the large ones (u, lambda, the declared extras), whose rows are
+  // not written here, are allocated late, at the first write, which AllocateLarge does on disk before the file is
+  // renamed into place, in the zeros Save reserved for them (allocated here, a snapshot file of 1.4 GB took 1.4 GB of
+  // rank 0's memory at its creation: measured 2026-12-04).
   const long long   minus1 = -1;
   const signed char zero   = 0;
-  if (!CreateDataset(c, f, "/snapshots/u", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.ndofs}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
-  if (!CreateDataset(c, f, "/snapshots/lambda", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.nmult}, H5T_NATIVE_DOUBLE, nullptr, nullptr)) return false;
   if (!CreateDataset(c, f, "/snapshots/mu", H5T_IEEE_F64LE, {ntrain, np}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
   if (!CreateDataset(c, f, "/snapshots/kacanov_iterations", H5T_STD_I64LE, {ntrain}, H5T_NATIVE_LLONG, &minus1, nullptr)) return false;
   if (!CreateDataset(c, f, "/snapshots/kkt", H5T_IEEE_F64LE, {ntrain, 4}, H5T_NATIVE_DOUBLE, &kNaN, nullptr)) return false;
@@ -130,7 +132,29 @@ bool WriteHeaderAndLayout(Ctx &c, hid_t f, const SnapshotHeader &h)
   if (!CreateDataset(c, f, kPendingSet, H5T_STD_I8LE, {ntrain}, H5T_NATIVE_SCHAR, &zero, nullptr)) return false;
   H5Id g(H5Gcreate2(f, "/snapshots/extra", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   if (!g.ok()) return c.Fail("cannot create group /snapshots/extra");
+  if (!CreateDataset(c, f, "/snapshots/u", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.ndofs}, H5T_NATIVE_DOUBLE, nullptr, nullptr, true)) return false;
+  if (!CreateDataset(c, f, "/snapshots/lambda", H5T_IEEE_F64LE, {ntrain, (hsize_t)h.nmult}, H5T_NATIVE_DOUBLE, nullptr, nullptr, true)) return false;
+  // the extras the run declares (SnapshotHeader::extras): created now, so that no Write creates a dataset (metadata
+  // written while the disk may be full: HDF5 1.10.8 then crashes at its shutdown)
+  for (const auto &e : h.extras) {
+    if (e.first.empty() || e.first.find('/') != std::string::npos || e.first == "." || e.first == ".." || e.second < 0) return c.Fail("declared extra array '" + e.first + "' is not a valid dataset name and length", false);
+    if (!CreateDataset(c, f, "/snapshots/extra/" + e.first, H5T_IEEE_F64LE, {ntrain, (hsize_t)e.second}, H5T_NATIVE_DOUBLE, nullptr, nullptr, true)) return false;
+  }
+  if (!g.ok()) return c.Fail("cannot create group /snapshots/extra");
   return true;
+}
+
+// The datasets WriteHeaderAndLayout allocates late, and their bytes.
+std::vector<std::string> LargeDatasets(const SnapshotHeader &h, unsigned long long *bytes)
+{
+  const unsigned long long nt = h.trainingPoints.size();
+  std::vector<std::string> names = {"/snapshots/u", "/snapshots/lambda"};
+  *bytes                         = 8 * nt * ((unsigned long long)h.ndofs + (unsigned long long)h.nmult);
+  for (const auto &e : h.extras) {
+    names.push_back("/snapshots/extra/" + e.first);
+    *bytes += 8 * nt * (unsigned long long)e.second;
+  }
+  return names;
 }
 
 // Opens an existing file and checks that it is an rbcontact snapshot file.
@@ -286,6 +310,27 @@ bool CloseFile(Ctx &c, H5Id *file)
   return true;
 }
 
+// Allocates the late datasets of a new file (its rows: zeros written to the first, which allocates the whole
+// contiguous dataset in the zeros Save reserved after the file's end), then flush + fsync: from here on a Write
+// changes raw data only.
+bool AllocateLarge(Ctx &c, const std::string &path, const SnapshotHeader &h)
+{
+  unsigned long long             bytes = 0;
+  const std::vector<std::string> names = LargeDatasets(h, &bytes);
+  H5Id                           f(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+  if (!f.ok()) return c.Fail("cannot be reopened to allocate its rows");
+  for (const auto &n : names) {
+    H5Id                 d;
+    std::vector<hsize_t> dims;
+    if (!OpenDataset(c, f.get(), n, &d) || !DatasetDims(c, d.get(), n, &dims)) return false;
+    if (dims[0] == 0 || dims[1] == 0) continue;
+    const std::vector<double> zeros((size_t)dims[1], 0.0);
+    d.Reset();
+    if (!RowIO(c, f.get(), n, H5T_NATIVE_DOUBLE, 0, dims[1], const_cast<double *>(zeros.data()), true)) return false;
+  }
+  return FlushSync(c, f.get()) && CloseFile(c, &f);
+}
+
 std::string Hex(unsigned long long v)
 {
   char b[32];
@@ -371,7 +416,10 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
     MemoryFile mem;
     H5Id       f(mem.Create(tmp), H5Fclose);
     bool       ok = f.ok() || ct.Fail("cannot create the file");
-    ok            = ok && WriteHeaderAndLayout(ct, f.get(), h) && mem.Save(ct, &f, tmp);
+    unsigned long long large = 0;
+    (void)LargeDatasets(h, &large);
+    // (1 MB beyond what the rows take: HDF5's own allocations there; its close truncates the file to what it uses)
+    ok = ok && WriteHeaderAndLayout(ct, f.get(), h) && mem.Save(ct, &f, tmp, large + (1ull << 20)) && AllocateLarge(ct, tmp, h);
     if (ok && std::rename(tmp.c_str(), target.c_str()) != 0) ok = ct.Fail(std::string("cannot rename '") + tmp + "' to '" + target + "': " + std::strerror(errno), false);
     if (!ok) {
       f.Reset();

@@ -305,6 +305,11 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     h.trainingPoints = train.points;
     h.ndofs          = ndofs;
     h.nmult          = R;
+    if (scene.contact) h.extras.emplace_back("contact_gap", R); // (the packing below)
+    if (s.sensitivities) {
+      h.extras.emplace_back("sensitivity_u", np * ndofs);
+      h.extras.emplace_back("sensitivity_lambda", np * R);
+    }
     {
       char *all = NULL;
       PetscCall(PetscOptionsGetAll(NULL, &all));
