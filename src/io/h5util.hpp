@@ -457,7 +457,8 @@ public:
     if (fd < 0) return c.Fail(std::string("cannot create the file: ") + std::strerror(errno), false);
     // (zeros written, not a hole: the space is the disk's now, so a full disk is said here, not at a later row)
     const unsigned long long         end = eof + reserve;
-    const std::vector<unsigned char> zeros(end > size_ ? std::min<unsigned long long>(end - size_, 1 << 20) : 0, 0);
+    const unsigned long long         inMem = std::min<unsigned long long>(eof, size_);
+    const std::vector<unsigned char> zeros(end > inMem ? std::min<unsigned long long>(end - inMem, 1 << 20) : 0, 0);
     int                              err = 0;
     unsigned long long               off = 0;
     while (off < end) {

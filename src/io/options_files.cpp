@@ -1,7 +1,9 @@
 // src/io/options_files.cpp: the -options_file chain checked before PETSc reads it (options_files.hpp).
 #include "rbcontact/options_files.hpp"
 #include <petscsys.h>
+#include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -252,7 +254,7 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
   for (size_t i = 0; i < words.size(); ++i)
     if (words[i] == "-skip_petscrc") {
       const std::string v = i + 1 < words.size() ? words[i + 1] : "";
-      skip = !(v == "0" || v == "false" || v == "FALSE" || v == "no" || v == "NO" || v == "off");
+      skip = !(!strcasecmp(v.c_str(), "0") || !strcasecmp(v.c_str(), "false") || !strcasecmp(v.c_str(), "no") || !strcasecmp(v.c_str(), "off")); // (PETSc's case-insensitive bool)
     }
   std::vector<std::string> rc;
   if (!skip) {
@@ -262,12 +264,17 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
   }
   for (const auto &file : rc) {
     struct stat st;
-    if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue; // PETSc reads it only where it is a file
+    // PETSc reads it where it is a readable file and skips it silently otherwise
+    if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || ::access(file.c_str(), R_OK) != 0) continue;
     double            n = 0;
     const std::string e = visit(file, 0, &n);
     if (!e.empty()) return e + " (a file PETSc reads at every start; -skip_petscrc skips it)";
     total += n;
   }
+  const auto tooMany = [&](const std::string &where) {
+    return "the options files " + where + " make PETSc read options files more than " + std::to_string((int)maxReads) + " times: include each file once";
+  };
+  if (total > maxReads) return tooMany("of ~/.petscrc, ./.petscrc and ./petscrc");
   if (const char *env = std::getenv("PETSC_OPTIONS")) {
     std::istringstream       es(env);
     std::vector<std::string> tok;
@@ -278,6 +285,7 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
         const std::string e = visit(tok[i + 1], 0, &n);
         if (!e.empty()) return e + " (named in the environment's PETSC_OPTIONS)";
         total += n;
+        if (total > maxReads) return tooMany("named in the environment's PETSC_OPTIONS");
       }
   }
   for (size_t i = 0; i + 1 < words.size(); ++i)

@@ -466,19 +466,26 @@ static std::string Gmsh22TagClash(const std::string &msh, const std::string &opt
         long n = 0;
         f >> n;
         std::getline(f, line);
-        for (long e = 0; e < n && std::getline(f, line) && why.empty(); ++e) {
-          // every tag after the physical one is matched by the reader against the groups of the element's dimension:
-          // the entity tag, and in a partitioned file the partition count and the partition tags
+        // PETSc 3.18.5's reader matches every tag (at most 16) of the cells and of the facets (the mesh's dimension and
+        // the one below) against the groups of their dimension: the entity tag, and in a partitioned file the partition
+        // count and the partition tags; points and, in 3D, curves are labelled by their physical tag alone. The mesh's
+        // dimension is known at the end: the first clash of each dimension is kept until then.
+        std::map<int, std::string> clash; // element dimension -> message
+        int                        top = 0;
+        for (long e = 0; e < n && std::getline(f, line); ++e) {
           std::istringstream in(line);
           int                id = 0, type = 0, ntags = 0, phys = 0;
           in >> id >> type >> ntags >> phys;
-          for (int t = 1; t < ntags && why.empty(); ++t) {
+          const int dim = dimOf(type);
+          top           = std::max(top, dim);
+          if (clash.count(dim)) continue;
+          for (int t = 1; t < std::min(ntags, 16); ++t) {
             int tag = 0;
             if (!(in >> tag)) break;
             if (tag == phys) continue;
-            const auto g = groups.find({dimOf(type), tag});
+            const auto g = groups.find({dim, tag});
             if (g == groups.end()) continue;
-            const auto         own = groups.find({dimOf(type), phys});
+            const auto         own     = groups.find({dim, phys});
             const std::string  ownName = own != groups.end() ? own->second : std::to_string(phys);
             std::ostringstream m;
             m << "mesh '" << msh << "' (" << option << ") is in gmsh format 2.2 and ";
@@ -487,9 +494,12 @@ static std::string Gmsh22TagClash(const std::string &msh, const std::string &opt
             m << ": PETSc 3.18's reader would put those elements into '" << g->second << "' too (a wrong mesh). ";
             if (t == 1) m << (generated ? "Remove Mesh.MshFileVersion from the .geo (rbcontact meshes it in format 4.1)" : "Write it with gmsh -format msh41") << " (or give the physical groups tags no entity uses)";
             else m << "Write it without partitions (gmsh without -part" << (generated ? ", no Mesh.NbPartitions in the .geo" : "") << "): rbcontact partitions the mesh itself";
-            why = m.str();
+            clash[dim] = m.str();
+            break;
           }
         }
+        for (int d : {top, top - 1})
+          if (why.empty() && d > 0 && clash.count(d)) why = clash[d];
         break;
       }
     }

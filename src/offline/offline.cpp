@@ -325,6 +325,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
       PetscCall(SnapshotFile::DoneCount(world, snapPath, &ndone, &nold));
       PetscCheck(ndone <= 0, world, PETSC_ERR_USER_INPUT, "Snapshot file '%s' exists and holds %" PetscInt_FMT " finished snapshots (of %" PetscInt_FMT "): resume it with -snapshots_restart (it is checked to belong to this problem first), or replace it with -snapshots_restart 0", snapPath, ndone, nold);
     }
+    // (before Open, which may replace a file)
+    PetscCheck(!s.sensitivities || scene.contact, world, PETSC_ERR_SUP, "-snapshots_sensitivities: the derivatives are those of a contact solution (-contact_slave, -contact_master)");
     PetscCall(file.Open(world, snapPath, h, restart));
     PetscInt                 imported = 0;
     std::vector<std::string> extras; // what this run writes with every snapshot (the packing below)
@@ -357,7 +359,6 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
 
     // Packed snapshot: idx, its, seconds, kkt[4], mu[np], u[ndofs], lambda[R], gap[R], and with
     // -snapshots_sensitivities the scaled derivatives (mu_i range) du/dmu_i [np*ndofs], dlambda/dmu_i [np*R]
-    PetscCheck(!s.sensitivities || scene.contact, world, PETSC_ERR_SUP, "-snapshots_sensitivities: the derivatives are those of a contact solution (-contact_slave, -contact_master)");
     const bool             sensOn = s.sensitivities;
     const size_t           L0 = 7 + np + ndofs + 2 * R, L = L0 + (sensOn ? (size_t)np * (ndofs + R) : 0);
     PetscLogDouble         sensSeconds = 0;
