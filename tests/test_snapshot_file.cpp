@@ -522,27 +522,25 @@ int main(int argc, char **argv)
     hx.extras         = {{"gap", 3}, {"active", 2}};
     SnapshotFile f;
     PetscCall(f.Open(PETSC_COMM_WORLD, dir + "/declared.h5", hx, false));
-    if (rank == 0) { // before any Write: there, allocated (the file is open for writing: HDF5's SWMR-less read is fine)
+    // the bytes stored for dataset `name` of declared.h5 (rank 0; 0 if it is not there)
+    auto stored = [&](const char *name) {
       hid_t   fid = H5Fopen((dir + "/declared.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-      hid_t   d   = fid >= 0 ? H5Dopen2(fid, "/snapshots/extra/active", H5P_DEFAULT) : -1;
+      hid_t   d   = fid >= 0 ? H5Dopen2(fid, name, H5P_DEFAULT) : -1;
       hsize_t st  = d >= 0 ? H5Dget_storage_size(d) : 0;
       if (d >= 0) H5Dclose(d);
       if (fid >= 0) H5Fclose(fid);
-      Check(st == 5 * 2 * 8, "declared extra /snapshots/extra/active there and allocated before the first Write (" + std::to_string((unsigned long long)st) + " bytes, 5 x 2 doubles)");
+      return (unsigned long long)st;
+    };
+    if (rank == 0) { // before any Write: there, allocated
+      const unsigned long long st = stored("/snapshots/extra/active");
+      Check(st == 5 * 2 * 8, "declared extra /snapshots/extra/active there and allocated before the first Write (" + std::to_string(st) + " bytes, 5 x 2 doubles)");
     }
     PetscCall(f.Write(MakeSnapshot(hx, 1)));
     PetscCall(f.Close());
     std::vector<Snapshot> snaps;
     PetscCall(SnapshotFile::ReadAll(dir + "/declared.h5", &snaps));
     Check(snaps.size() == 1 && SameSnapshot(snaps[0], MakeSnapshot(hx, 1)), "declared extras: created with the file, the Write's values read back");
-    if (rank == 0) {
-      hid_t   fid = H5Fopen((dir + "/declared.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-      hid_t   d   = fid >= 0 ? H5Dopen2(fid, "/snapshots/extra/gap", H5P_DEFAULT) : -1;
-      hsize_t st  = d >= 0 ? H5Dget_storage_size(d) : 0;
-      if (d >= 0) H5Dclose(d);
-      if (fid >= 0) H5Fclose(fid);
-      Check(st == 5 * 3 * 8, "declared extra /snapshots/extra/gap allocated (" + std::to_string((unsigned long long)st) + " bytes, 5 x 3 doubles)");
-    }
+    if (rank == 0) Check(stored("/snapshots/extra/gap") == 5 * 3 * 8, "declared extra /snapshots/extra/gap allocated (5 x 3 doubles)");
     hx.extras = {{"a/b", 3}};
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
     code = f.Open(PETSC_COMM_WORLD, dir + "/badextra.h5", hx, false);
