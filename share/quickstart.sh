@@ -35,6 +35,8 @@ if [ "$(id -u)" -eq 0 ]; then
   export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 fi
 export OMPI_MCA_rmaps_base_oversubscribe="${OMPI_MCA_rmaps_base_oversubscribe:-1}"
+# (the PML Open MPI selects here anyway; named, MPI_Init skips probing libfabric: half of every start, docs/online.md)
+export OMPI_MCA_pml="${OMPI_MCA_pml:-ob1}"
 MPIRUN=(mpirun -n "$NP")
 
 REPORTS=()  # JSON reports written by the main job (printed at the end)
