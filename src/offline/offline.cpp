@@ -305,7 +305,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     h.trainingPoints = train.points;
     h.ndofs          = ndofs;
     h.nmult          = R;
-    if (scene.contact) h.extras.emplace_back("contact_gap", R); // (the packing below)
+    // the extras every snapshot of this run carries (the packing below), created with a new file
+    if (scene.contact) h.extras.emplace_back("contact_gap", R);
     if (s.sensitivities) {
       h.extras.emplace_back("sensitivity_u", np * ndofs);
       h.extras.emplace_back("sensitivity_lambda", np * R);
@@ -329,9 +330,8 @@ PetscErrorCode RunOffline(MPI_Comm world, const SceneSpec &scene, const OfflineS
     PetscCheck(!s.sensitivities || scene.contact, world, PETSC_ERR_SUP, "-snapshots_sensitivities: the derivatives are those of a contact solution (-contact_slave, -contact_master)");
     PetscCall(file.Open(world, snapPath, h, restart));
     PetscInt                 imported = 0;
-    std::vector<std::string> extras; // what this run writes with every snapshot (the packing below)
-    if (scene.contact) extras.push_back("contact_gap");
-    if (s.sensitivities) extras.insert(extras.end(), {"sensitivity_u", "sensitivity_lambda"});
+    std::vector<std::string> extras; // what this run writes with every snapshot (the packing below: h.extras)
+    for (const auto &e : h.extras) extras.push_back(e.first);
     for (const auto &from : s.from) { // before the done list: the imported snapshots are not solved again
       PetscInt n = 0, outside = 0;
       PetscCall(file.Import(from, extras, &n, &outside));
