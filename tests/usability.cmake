@@ -1,12 +1,12 @@
 # tests/usability.cmake -- what a PETSc user meets driving rbcontact from outside: provenance in every
 # report and HDF5 file, the report of a failed run, -help, the boundary options renamed out of PETSc's
-# -bc_ namespace, the README's iterative solver on a contact scene (tests/usability_checks.py), the
+# -bc_ namespace, the temporary files a killed job left, the README's iterative solver on a contact scene (tests/usability_checks.py), the
 # installation (tests/install_check.sh), the "your own scene" tutorial with the installed package
 # (tests/tutorial_check.sh, docs/tutorial.md), Makefile.petsc (tests/makefile_petsc_check.sh).
 find_program(RBC_PYTHON3_U NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
 set(RBC_UC ${RBC_PYTHON3_U} ${CMAKE_CURRENT_SOURCE_DIR}/usability_checks.py)
 foreach(np 1 2)
-  foreach(what provenance failure rename paraview)
+  foreach(what provenance failure rename paraview stale)
     add_test(NAME usability_${what}_np${np} COMMAND ${RBC_UC} ${what} --exe $<TARGET_FILE:rbcontact_exe> --np ${np} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(usability_${what}_np${np} PROPERTIES ENVIRONMENT "${RBC_MPI_ENV}" TIMEOUT 300 PROCESSORS ${np} LABELS usability)
   endforeach()

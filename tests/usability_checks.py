@@ -16,6 +16,9 @@ Subcommands (exit 0 = pass; a failure prints what was seen):
               the number type / precision the .xmf says (the FOM output, the reconstructed ROM fields, the
               offline basis view); the contact grid's points are the slave vertices; the basis view's POD
               modes, supremizers and dual vectors are those of the basis file (the same norms and entries)
+  stale       the temporary file of an output a killed job left (<target>.tmp.<pid>, its process gone) is
+              named in a warning with its size before the work, and never removed; one of a process that
+              still runs is not named; the output is written as usual
 """
 import argparse
 import atexit
@@ -247,6 +250,31 @@ def rename(args):
           "both spellings: refused, naming both (exit %d)" % p.returncode)
 
 
+def stale(args):
+    # what a job killed while writing leaves beside its output: <target>.tmp.<pid>, never reused (the next job's pid
+    # differs); a snapshot file's is as large as the file. The dead pid: a process run here, killed and reaped.
+    d = workdir()
+    k = subprocess.Popen(["sleep", "60"])
+    k.kill()
+    k.wait()
+    dead, live = k.pid, os.getpid()
+    rep, out = d + "/fom.json", d + "/u.h5"
+    planted = {rep + ".tmp.%d" % dead: 3 << 20, out + ".tmp.%d" % dead: 1 << 10, rep + ".tmp.%d" % live: 10}
+    for path, size in planted.items():
+        with open(path, "wb") as f:
+            f.write(b"\0" * size)
+    p = run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", rep, "-fom_output", out])
+    warned = [l for l in p.stdout.splitlines() if "is a temporary file of this output left by a job that no longer runs" in l]
+    check(len(warned) == 2, "two warnings, one per stale temporary file (%d: %s)" % (len(warned), warned))
+    check(any("-report %s: '%s.tmp.%d' (3.0 MB)" % (rep, rep, dead) in l for l in warned), "-report: the dead job's file named with its size")
+    check(any("-fom_output %s: '%s.tmp.%d' (0.0 MB)" % (out, out, dead) in l for l in warned), "-fom_output: the dead job's file named")
+    check(not any(".tmp.%d" % live in l for l in warned), "the file of a process that runs (pid %d) is not named" % live)
+    check(all(os.path.getsize(x) == n for x, n in planted.items()), "every planted file is still there, untouched (named, never removed)")
+    check(load(rep).get("converged") is True and os.path.exists(out), "the run wrote its report and its output as usual")
+    left = sorted(x for x in os.listdir(d) if ".tmp." in x and os.path.join(d, x) not in planted)
+    check(not left, "the run left no temporary file of its own (%s)" % left)
+
+
 def run_force(args, d, extra):
     run(args, args.np, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", d + "/rf.json"] + extra)
     return load(d + "/rf.json")["contact_force"]
@@ -335,13 +363,13 @@ def paraview(args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg", "paraview"])
+    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg", "paraview", "stale"])
     ap.add_argument("--exe", default=os.path.join(ROOT, "build/bin/rbcontact"))
     ap.add_argument("--np", type=int, default=1)
     args = ap.parse_args()
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg, "paraview": paraview}[args.what](args)
+    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg, "paraview": paraview, "stale": stale}[args.what](args)
     if FAILED:
         print("%d check(s) failed" % len(FAILED))
         return 1

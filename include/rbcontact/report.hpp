@@ -73,13 +73,23 @@ std::string OutputTarget(const std::string &path);
 // Checks, before any work, that path (given with option; empty: nothing to check) can be written: its
 // directory exists and is writable, path is not a directory, nor an existing device, FIFO or socket (the
 // rename of the temporary file would replace it: -report /dev/null as root), and the temporary file
-// (OutputTarget(path) + ".tmp.<pid>") can be created there (a name too long, /proc). Collective (rank 0 looks).
+// (TemporaryPath(path)) can be created there (a name too long, /proc). Warns (rank 0) about the temporary files of
+// path that a killed job left (StaleTemporaries): the next write does not reuse them and they may be large.
+// Collective (rank 0 looks).
 PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option);
 
-// Checks, before any work, that the outputs (option, path) name distinct files and none of them names an
-// input (option, path): -report equal to -rom, -rom_reconstruct onto the ROM it reads. Empty paths are
-// skipped; files compare by device and inode when they exist, else by their resolved directory and name.
-// Collective (rank 0 looks).
+// The temporary file an output named path is written to before it is renamed onto OutputTarget(path):
+// OutputTarget(path) + ".tmp.<pid>", pid this process's (or, for a collective writer, rank 0's).
+std::string TemporaryPath(const std::string &path, long pid);
+std::string TemporaryPath(const std::string &path);
+
+// The temporary files of path (TemporaryPath(path, pid) for any pid) whose process no longer runs on this host:
+// what a job killed during the write left (a snapshot file's is as large as the file). Files of a process that
+// still runs, or that this process may not signal, are not listed; a job on another host writing the same output
+// at the same time would be (two jobs writing one file is the user's mistake either way): they are named, never
+// removed.
+std::vector<std::string> StaleTemporaries(const std::string &path);
+
 // The report of a failed run: {"stage", "converged": false, "error", "error_code"[, "provenance"]} written to path by the
 // calling rank alone (temporary file + rename). Never onto a device, a path the run refused (ReportPathRefused), a
 // report the stage wrote itself (FailureReported) or an HDF5 file (a ROM or snapshot file named by mistake).
@@ -98,6 +108,10 @@ bool ReportPathRefused();
 // Python module: a report refused or written by one call kept every later failure from replacing its -report).
 void ResetReportMarks();
 
+// Checks, before any work, that the outputs (option, path) name distinct files and none of them names an
+// input (option, path): -report equal to -rom, -rom_reconstruct onto the ROM it reads. Empty paths are
+// skipped; files compare by device and inode when they exist, else by their resolved directory and name.
+// Collective (rank 0 looks).
 PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std::string, std::string>> &outputs, const std::vector<std::pair<std::string, std::string>> &inputs);
 
 // The report of one stage run: filled by the stage, written by Write() if -report was given, with the

@@ -89,7 +89,7 @@ PetscErrorCode ElasticFOM::WriteOutput(const std::string &h5file, const std::vec
   {
     long pid = (long)getpid();
     PetscCallMPI(MPI_Bcast(&pid, 1, MPI_LONG, 0, comm));
-    tmp = OutputTarget(h5file) + ".tmp." + std::to_string(pid);
+    tmp = TemporaryPath(h5file, pid);
   }
   PetscCall(elas.VonMises(u, &vm));
   // The mesh is the reference one: write it in the physical configuration at mu (x = h_b(mu)(xr) on

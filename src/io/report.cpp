@@ -2,13 +2,16 @@
 #include "rbcontact/report.hpp"
 #include "rbcontact/options_files.hpp"
 #include "rbcontact/provenance.hpp"
+#include <algorithm>
 #include <cmath>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <fstream>
 #include <sstream>
 #include <sys/stat.h>
@@ -182,7 +185,7 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+    const std::string target = OutputTarget(path), tmp = TemporaryPath(path);
     errno = 0;
     std::ofstream f(tmp);
     if (!f) ok = -(errno ? errno : EIO);
@@ -200,6 +203,18 @@ PetscErrorCode WriteFileAtomic(MPI_Comm comm, const std::string &path, const std
   PetscFunctionReturn(0);
 }
 
+// The directory of path ("." without a slash, "/" for a file in the root) and its last component.
+static std::string DirOf(const std::string &path)
+{
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+}
+static std::string NameOf(const std::string &path)
+{
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
 PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const char *option)
 {
   PetscMPIInt rank;
@@ -209,8 +224,7 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
   if (path.empty()) PetscFunctionReturn(0);
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    const size_t      slash = path.find_last_of('/');
-    const std::string dir   = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+    const std::string dir = DirOf(path);
     struct stat       st;
     if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) why = "the directory '" + dir + "' does not exist";
     else if (access(dir.c_str(), W_OK | X_OK) != 0) why = "the directory '" + dir + "' is not writable";
@@ -219,7 +233,7 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
       why = "it is a device, FIFO or socket, not a regular file: outputs are written to a temporary file renamed onto their name, which would replace it (leave the option out to skip this output)";
     else if (stat(path.c_str(), &st) == 0 && access(path.c_str(), W_OK) != 0) why = "the file exists and is not writable";
     else { // the temporary file the writers create (the longest name they use), created and removed
-      const std::string tmp = OutputTarget(path) + ".tmp." + std::to_string((long)getpid());
+      const std::string tmp = TemporaryPath(path);
       const int         fd  = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
       if (fd < 0 && errno != EEXIST) why = "cannot create the temporary file '" + tmp + "': " + std::strerror(errno);
       else if (fd >= 0) {
@@ -231,7 +245,40 @@ PetscErrorCode CheckOutputPath(MPI_Comm comm, const std::string &path, const cha
   PetscCall(BcastString(comm, &why));
   if (!why.empty() && std::string(option) == "-report") reportRefused = true;
   PetscCheck(why.empty(), comm, PETSC_ERR_FILE_OPEN, "%s %s: cannot write there: %s (checked before any work; nothing was computed or written)", option, path.c_str(), why.c_str());
+  if (rank == 0)
+    for (const auto &t : StaleTemporaries(path)) {
+      struct stat st;
+      const double mb = stat(t.c_str(), &st) == 0 ? (double)st.st_size / 1048576.0 : 0.0;
+      PetscCall(PetscPrintf(PETSC_COMM_SELF, "rbcontact: warning: %s %s: '%s' (%.1f MB) is a temporary file of this output left by a job that no longer runs (killed while writing); it is not reused: remove it\n", option, path.c_str(), t.c_str(), mb));
+    }
   PetscFunctionReturn(0);
+}
+
+std::string TemporaryPath(const std::string &path, long pid) { return OutputTarget(path) + ".tmp." + std::to_string(pid); }
+
+std::string TemporaryPath(const std::string &path) { return TemporaryPath(path, (long)getpid()); }
+
+std::vector<std::string> StaleTemporaries(const std::string &path)
+{
+  std::vector<std::string> stale;
+  const std::string        target = OutputTarget(path);
+  const std::string        dir = DirOf(target), prefix = NameOf(target) + ".tmp.";
+  DIR                     *d   = opendir(dir.c_str());
+  if (!d) return stale;
+  while (const struct dirent *e = readdir(d)) {
+    const std::string name = e->d_name;
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos || digits[0] == '0') continue; // not one of ours
+    const long pid = std::strtol(digits.c_str(), nullptr, 10);
+    if (pid == (long)getpid() || kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue; // its process runs (or may not be signalled)
+    const std::string full = target.substr(0, target.size() - NameOf(target).size()) + name; // beside the target
+    struct stat       st;
+    if (lstat(full.c_str(), &st) == 0 && S_ISREG(st.st_mode)) stale.push_back(full);
+  }
+  closedir(d);
+  std::sort(stale.begin(), stale.end());
+  return stale;
 }
 
 std::string OutputTarget(const std::string &path)
@@ -256,8 +303,7 @@ static std::string FileKey(const std::string &path)
   struct stat st;
   if (stat(path.c_str(), &st) == 0) return "inode " + std::to_string((unsigned long long)st.st_dev) + ":" + std::to_string((unsigned long long)st.st_ino);
   const std::string target = OutputTarget(path);
-  const size_t      slash  = target.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : target.substr(0, slash)), name = slash == std::string::npos ? target : target.substr(slash + 1);
+  const std::string dir = DirOf(target), name = NameOf(target);
   char buf[PATH_MAX];
   return std::string("path ") + (realpath(dir.c_str(), buf) ? buf : dir.c_str()) + "/" + name;
 }
@@ -302,7 +348,7 @@ void WriteFailureReport(const char *path, const std::string &stage, const std::s
   r["error"]       = error;
   r["error_code"]  = code;
   if (provenance) r["provenance"] = ProvenanceJson(LocalProvenance());
-  const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+  const std::string target = OutputTarget(path), tmp = TemporaryPath(path);
   struct stat       st;
   if (stat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) return; // a directory or device (refused by CheckOutputPath): never replaced
   if (ReportPathRefused()) return;                                 // the path the run refused (an input, another output)

@@ -48,7 +48,7 @@ PetscErrorCode RomWriter::Write(MPI_Comm comm, const std::string &path) const
   if (rank == 0) {
     H5Quiet           quiet;
     Ctx               c{"ROM file '" + path + "'", std::string()};
-    const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+    const std::string target = OutputTarget(path), tmp = TemporaryPath(path);
     bool              ok  = true;
     {
       MemoryFile mem;

@@ -413,7 +413,7 @@ bool OpenOnRoot(Ctx &c, const std::string &path, const SnapshotHeader &h, bool r
     }
     return ReadDone(c, file->get(), h.trainingPoints.size(), done) && ReadPending(c, file->get(), h.trainingPoints.size(), pending);
   }
-  const std::string target = OutputTarget(path), tmp = target + ".tmp." + std::to_string((long)getpid());
+  const std::string target = OutputTarget(path), tmp = TemporaryPath(path);
   Ctx               ct{"Snapshot file '" + path + "' (being created as '" + tmp + "')", std::string()};
   if (!CheckNotLocked(c, target)) return false;
   {
