@@ -679,6 +679,15 @@ def solver_input(args):
     before = open(opts).read()
     fails(base + ["-options_file", opts, "-report", opts], ["the output -report", "is the input -options_file"], "-report onto the run's options file")
     check(open(opts).read() == before, "... the options file unchanged (it held the report)")
+    # a YAML options file, named by an options file the run reads (overwritten by the report, exit 0, until 2026-12-04)
+    yml, inc = os.path.join(out, "in.yaml"), os.path.join(out, "yaml.opts")
+    with open(yml, "w") as f:
+        f.write("kacanov_max_it: 30\n")
+    with open(inc, "w") as f:
+        f.write("-options_file runs/ring_on_block.opts\n-options_file_yaml %s\n" % yml)
+    fails(base + ["-options_file", inc, "-report", yml], ["the output -report", "is the input -options_file_yaml"], "-report onto a YAML options file an options file names")
+    fails(ring + ["-options_file_yaml", yml, "-fom_output", yml], ["the output -fom_output", "is the input -options_file_yaml"], "-fom_output onto the command line's YAML options file")
+    check(open(yml).read() == "kacanov_max_it: 30\n", "... the YAML file unchanged")
     fails(base + ["-options_file", opts, "-fem_degree"], ["option -fem_degree is given without a value"], "a trailing -fem_degree (cancelled the file's -fem_degree 2)")
     fails(ring + ["-kacanov_max_it"], ["option -kacanov_max_it is given without a value"], "-kacanov_max_it without a value")
     fails(ring + ["-fom_kkt_tol", "inf"], ["-fom_kkt_tol inf", "must be a finite number > 0"], "-fom_kkt_tol inf")

@@ -44,9 +44,11 @@ std::string OptionsHoldingValue(const char *mess);
 // refused, naming the option. Collective on comm.
 PetscErrorCode CheckListEntries(MPI_Comm comm);
 
-// The options files the last CheckOptionsFiles visited (the whole -options_file chain, as named): inputs of the run,
-// which no output may replace (CheckDistinctFiles; `fom -report in.opts -options_file in.opts` overwrote it, exit 0).
-const std::vector<std::string> &OptionsFilesRead();
+// The options files the last CheckOptionsFiles visited (the whole -options_file chain, as named, and the
+// -options_file_yaml files named on the way, not parsed): inputs of the run, which no output may replace
+// (CheckDistinctFiles; `fom -report in.opts -options_file in.opts` overwrote it, exit 0; so did
+// `-options_file_yaml a.yaml -report a.yaml` until 2026-12-04).
+const std::vector<std::pair<std::string, std::string>> &OptionsFilesRead(); // (option, file)
 
 // Each of these options, where it is given, has a value: PETSc's readers keep the default for an option given without
 // one (-rom_N at the end of a command line), without a word. Collective on comm (the options are the same on every rank).

@@ -188,9 +188,9 @@ PetscErrorCode UnusedOptions(const std::string &stage, std::vector<std::string> 
   PetscFunctionReturn(0);
 }
 
-static std::vector<std::string> optionsFilesRead; // of the last CheckOptionsFiles
+static std::vector<std::pair<std::string, std::string>> optionsFilesRead; // of the last CheckOptionsFiles: (option, file)
 
-const std::vector<std::string> &OptionsFilesRead() { return optionsFilesRead; }
+const std::vector<std::pair<std::string, std::string>> &OptionsFilesRead() { return optionsFilesRead; }
 
 std::string CheckOptionsFiles(const std::vector<std::string> &words)
 {
@@ -198,6 +198,12 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
   std::map<std::string, double>                                 reads; // by resolved path: the files PETSc reads for it (itself and its -options_file's)
   const double                                                  maxReads = 256;
   optionsFilesRead.clear();
+  // a YAML options file (-options_file_yaml F, PETSc follows it from the command line, PETSC_OPTIONS and options files):
+  // an input of the run, not parsed here (its own -options_file entries are not followed)
+  const auto yaml = [&](const std::string &file) {
+    const std::pair<std::string, std::string> f("-options_file_yaml", file);
+    if (std::find(optionsFilesRead.begin(), optionsFilesRead.end(), f) == optionsFilesRead.end()) optionsFilesRead.push_back(f);
+  };
   // *n: the files PETSc reads when it inserts this one. A file included several times is read as often (3 -options_file
   // lines naming one file, nested 15 deep: 3^15 reads, a hang in this check and in PETSc); each file is parsed here once.
   std::function<std::string(const std::string &, int, double *)> visit = [&](const std::string &file, int depth, double *n) -> std::string {
@@ -218,7 +224,7 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
     if (!in) return "options file " + file + " (-options_file): cannot be read";
     chain.push_back(canon);
     shown.push_back(file);
-    if (std::find(optionsFilesRead.begin(), optionsFilesRead.end(), file) == optionsFilesRead.end()) optionsFilesRead.push_back(file);
+    if (const std::pair<std::string, std::string> f("-options_file", file); std::find(optionsFilesRead.begin(), optionsFilesRead.end(), f) == optionsFilesRead.end()) optionsFilesRead.push_back(f);
     *n = 1;
     for (std::string line; std::getline(in, line);) {
       const size_t hash = line.find('#');
@@ -227,7 +233,8 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
       std::vector<std::string> tok;
       for (std::string t; ls >> t;) tok.push_back(t);
       for (size_t k = 0; k + 1 < tok.size(); ++k)
-        if (tok[k] == "-options_file") {
+        if (tok[k] == "-options_file_yaml") yaml(tok[k + 1]);
+        else if (tok[k] == "-options_file") {
           double            m = 0;
           const std::string e = visit(tok[k + 1], depth + 1, &m);
           if (!e.empty()) return e;
@@ -249,7 +256,8 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
   // What PETSc 3.18's PetscOptionsInsert reads before the command line: ~/.petscrc, ./.petscrc and ./petscrc (where they
   // exist, unless the command line says -skip_petscrc), then the environment's PETSC_OPTIONS; an -options_file in any of
   // them recursed in PETSc without a check here (a self-including .petscrc: a stack overflow, not a message).
-  // PETSC_OPTIONS_YAML and -options_file_yaml (YAML) are not followed here.
+  // PETSC_OPTIONS_YAML (a YAML string) and the contents of -options_file_yaml files are not followed here: a YAML file
+  // is only listed among the inputs (OptionsFilesRead).
   bool skip = false;
   for (size_t i = 0; i < words.size(); ++i)
     if (words[i] == "-skip_petscrc") {
@@ -280,7 +288,8 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
     std::vector<std::string> tok;
     for (std::string t; es >> t;) tok.push_back(t);
     for (size_t i = 0; i + 1 < tok.size(); ++i)
-      if (tok[i] == "-options_file") {
+      if (tok[i] == "-options_file_yaml") yaml(tok[i + 1]);
+      else if (tok[i] == "-options_file") {
         double            n = 0;
         const std::string e = visit(tok[i + 1], 0, &n);
         if (!e.empty()) return e + " (named in the environment's PETSC_OPTIONS)";
@@ -289,7 +298,8 @@ std::string CheckOptionsFiles(const std::vector<std::string> &words)
       }
   }
   for (size_t i = 0; i + 1 < words.size(); ++i)
-    if (words[i] == "-options_file") {
+    if (words[i] == "-options_file_yaml") yaml(words[i + 1]);
+    else if (words[i] == "-options_file") {
       double            n = 0;
       const std::string e = visit(words[i + 1], 0, &n);
       if (!e.empty()) return e;

@@ -318,7 +318,7 @@ PetscErrorCode CheckDistinctFiles(MPI_Comm comm, const std::vector<std::pair<std
   if (rank == 0) {
     std::vector<std::string>                         ko, ki;
     std::vector<std::pair<std::string, std::string>> inputs = inputsGiven; // and every options file of the run
-    for (const auto &f : OptionsFilesRead()) inputs.emplace_back("-options_file", f);
+    for (const auto &f : OptionsFilesRead()) inputs.push_back(f);
     for (const auto &o : outputs) ko.push_back(o.second.empty() ? std::string() : FileKey(o.second));
     for (const auto &i : inputs) ki.push_back(i.second.empty() ? std::string() : FileKey(i.second));
     for (size_t a = 0; a < outputs.size() && why.empty(); ++a) {
