@@ -244,7 +244,7 @@ PetscErrorCode ReducedParametrization::CheckBox(MPI_Comm comm, const std::vector
   if (mu.size() != params.size()) {
     std::string names;
     for (const auto &p : params) names += (names.empty() ? "" : ", ") + p.name;
-    SETERRQ(comm, PETSC_ERR_ARG_SIZ, "%s: %zu values given, the model has %zu parameters (%s, in this order)", what.c_str(), mu.size(), params.size(), names.c_str());
+    SETERRQ(comm, PETSC_ERR_ARG_SIZ, "%s: %zu value%s given, the model has %zu parameter%s (%s, in this order)", what.c_str(), mu.size(), mu.size() == 1 ? "" : "s", params.size(), params.size() == 1 ? "" : "s", names.c_str());
   }
   for (size_t i = 0; i < mu.size(); ++i) {
     PetscCheck(std::isfinite(mu[i]), comm, PETSC_ERR_ARG_OUTOFRANGE, "%s: parameter '%s' is not a finite number", what.c_str(), params[i].name.c_str());
