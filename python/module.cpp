@@ -95,7 +95,7 @@ void Warn(PyObject *category, const std::string &message)
   if (PyErr_WarnEx(category, message.c_str(), 1) < 0) throw py::error_already_set(); // warnings turned into errors
 }
 
-bool initializedHere = false, exiting = false;
+bool initializedHere = false, exiting = false, mpiBeganHere = false; // (mpiBeganHere: MPI started by Initialize, finalized by Finalize)
 int  liveModels      = 0; // PETSc is finalized at exit once no ReducedModel (which may hold PETSc objects) is alive
 std::vector<std::string> initOptions;              // initialize()'s, checked after the first model read them
 bool                     initOptionsChecked = false;
@@ -156,8 +156,21 @@ void Initialize(const std::vector<std::string> &options)
     return;
   }
   CheckWords(options, "rbcontact.initialize");
+  // MPI first (unless mpi4py or another library started it), for the check of the options files where PETSc reads them:
+  // on rank 0, one answer for every rank (checked on each rank, a file only rank 0 could see raised on the other ranks
+  // while rank 0 started PETSc: a hang under mpirun)
   {
-    const std::string bad = rbc::CheckOptionsFiles(options);
+    int up = 0, down = 0, provided = 0;
+    MPI_Initialized(&up);
+    MPI_Finalized(&down);
+    if (down) throw std::runtime_error("rbcontact: MPI was finalized; PETSc cannot be started again in this process");
+    if (!up) {
+      if (MPI_Init_thread(nullptr, nullptr, PETSC_MPI_THREAD_REQUIRED, &provided) != MPI_SUCCESS) throw std::runtime_error("rbcontact: MPI_Init_thread failed");
+      mpiBeganHere = true;
+    }
+  }
+  {
+    const std::string bad = rbc::CheckOptionsFilesOnRankZero(MPI_COMM_WORLD, options);
     if (!bad.empty()) throw std::runtime_error("rbcontact.initialize: " + bad);
   }
   // MPI and PETSc keep argv: it lives as long as the process, and ends with a null pointer (MPI_Init reads it)
@@ -195,6 +208,10 @@ void Finalize()
 {
   if (initializedHere && PetscInitializeCalled && !PetscFinalizeCalled) (void)SlepcFinalize();
   initializedHere = false;
+  int down = 0;
+  MPI_Finalized(&down);
+  if (mpiBeganHere && !down) MPI_Finalize(); // (PETSc leaves MPI to whoever started it)
+  mpiBeganHere = false;
 }
 
 // At interpreter exit: finalize now, or when the last model goes.
@@ -398,7 +415,7 @@ std::string RunStageLocked(const std::string &stage, const std::vector<std::stri
     long long code = PETSC_ERR_USER_INPUT;
     try {
       CheckWords(options, "rbcontact." + stage);
-      const std::string bad = rbc::CheckOptionsFiles(options);
+      const std::string bad = rbc::CheckOptionsFilesOnRankZero(PETSC_COMM_WORLD, options);
       code                  = PETSC_ERR_FILE_OPEN;
       if (!bad.empty()) throw std::runtime_error("rbcontact." + stage + ": " + bad);
       scope = std::make_unique<ScopedOptions>(options);

@@ -16,6 +16,9 @@ Subcommands (exit 0 = pass; a failure prints what was seen):
               the number type / precision the .xmf says (the FOM output, the reconstructed ROM fields, the
               offline basis view); the contact grid's points are the slave vertices; the basis view's POD
               modes, supremizers and dual vectors are those of the basis file (the same norms and entries)
+  rank_files  an options file that only rank 0 can see (node-local, here: another working directory per rank)
+              is read by PETSc on rank 0 as usual (the check on every rank stopped rank 1 and hung the run);
+              one that rank 0 cannot see is refused on every rank, with the report, no hang
   stale       the temporary file of an output a killed job left (<target>.tmp.<pid>, its process gone) is
               named in a warning with its size before the work, and never removed; one of a process that
               still runs is not named; the output is written as usual
@@ -250,6 +253,41 @@ def rename(args):
           "both spellings: refused, naming both (exit %d)" % p.returncode)
 
 
+def rank_files(args):
+    # mpirun's MPMD form gives each rank its own working directory: runs/ring_on_block.opts exists for the rank started in
+    # the source tree only
+    d = workdir()
+    exe = os.path.abspath(args.exe)
+
+    def mpmd(first_here, rep):
+        here = ["-n", "1", "--wdir", ROOT, exe, "fom", "-options_file", "runs/ring_on_block.opts", "-report", rep]
+        away = ["-n", "1", "--wdir", d, exe, "fom", "-options_file", "runs/ring_on_block.opts", "-report", rep]
+        c = ["mpirun"] + (here + [":"] + away if first_here else away + [":"] + here)
+        t0 = time.time()
+        try:
+            p = subprocess.run(c, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", stdin=subprocess.DEVNULL, timeout=120)
+        except subprocess.TimeoutExpired:
+            subprocess.run(["pkill", "-f", exe + " fom"])
+            check(False, "rank 0 %s the options file: the run hung (killed after 120 s)" % ("sees" if first_here else "does not see"))
+            return None, 0
+        return p, time.time() - t0
+
+    ref = d + "/ref.json"
+    run(args, 2, ["fom", "-options_file", "runs/ring_on_block.opts", "-report", ref])
+    p, t = mpmd(True, d + "/a.json")
+    if p is not None:
+        r = load(d + "/a.json") if os.path.exists(d + "/a.json") else {}
+        check(p.returncode == 0 and r.get("converged") is True and r.get("nranks") == 2, "only rank 0 sees the options file: the run works on 2 ranks (exit %d, %.1f s)" % (p.returncode, t))
+        e0 = load(ref)["energy"]
+        check(abs(r.get("energy", 0) - e0) <= 1e-10 * abs(e0), "... the energy of the ordinary run (%.12g / %.12g)" % (r.get("energy", float("nan")), e0))
+    p, t = mpmd(False, d + "/b.json")
+    if p is not None:
+        r = load(d + "/b.json") if os.path.exists(d + "/b.json") else {}
+        check(p.returncode != 0 and "options file runs/ring_on_block.opts (-options_file): No such file or directory" in p.stdout and t < 60,
+              "rank 0 does not see the options file: refused on every rank, naming it (exit %d, %.1f s)" % (p.returncode, t))
+        check(r.get("converged") is False and "No such file" in r.get("error", ""), "... the failure report written (%s)" % r.get("error"))
+
+
 def stale(args):
     # what a job killed while writing leaves beside its output: <target>.tmp.<pid>, never reused (the next job's pid
     # differs); a snapshot file's is as large as the file. The dead pid: a process run here, killed and reaped.
@@ -363,13 +401,13 @@ def paraview(args):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg", "paraview", "stale"])
+    ap.add_argument("what", choices=["provenance", "failure", "help", "rename", "gamg", "paraview", "stale", "rank_files"])
     ap.add_argument("--exe", default=os.path.join(ROOT, "build/bin/rbcontact"))
     ap.add_argument("--np", type=int, default=1)
     args = ap.parse_args()
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
     os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg, "paraview": paraview, "stale": stale}[args.what](args)
+    {"provenance": provenance, "failure": failure, "help": help_, "rename": rename, "gamg": gamg, "paraview": paraview, "stale": stale, "rank_files": rank_files}[args.what](args)
     if FAILED:
         print("%d check(s) failed" % len(FAILED))
         return 1

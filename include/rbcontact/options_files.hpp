@@ -17,6 +17,12 @@ namespace rbc {
 // well, else the message ("options file a.opts includes itself through -options_file (a.opts -> b.opts -> a.opts)").
 std::string CheckOptionsFiles(const std::vector<std::string> &words);
 
+// CheckOptionsFiles where PETSc reads the files (rank 0 of comm reads every options file, ~/.petscrc and PETSC_OPTIONS,
+// and broadcasts them), its answer on every rank; MPI started, PETSc not needed (plain MPI calls). Checked on every rank,
+// a file rank 0 reads but another rank cannot see (a node-local path) stopped that rank alone while rank 0 went on into
+// PETSc's start: the run hung. OptionsFilesRead is then rank 0's. Collective.
+std::string CheckOptionsFilesOnRankZero(MPI_Comm comm, const std::vector<std::string> &words);
+
 // A word of a command line that names an option (-rom, -rom_N), not a value (-1, -.5).
 bool IsOptionName(const std::string &word);
 

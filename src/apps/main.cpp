@@ -146,6 +146,8 @@ static PetscErrorCode TestFailRank(bool *doThrow)
   PetscFunctionReturn(0);
 }
 
+static int RunStage(int argc, char **argv, const std::string &stage);
+
 int main(int argc, char **argv)
 {
   if (argc == 2 && (!std::strcmp(argv[1], "--version") || !std::strcmp(argv[1], "-version") || !std::strcmp(argv[1], "version"))) {
@@ -165,19 +167,28 @@ int main(int argc, char **argv)
   for (int i = 1; i < argc - 1; ++i) argv[i] = argv[i + 1];
   --argc;
 
-  {
-    const std::string bad = rbc::CheckOptionsFiles(std::vector<std::string>(argv + 1, argv + argc));
-    if (!bad.empty()) { // PETSc is not initialized: MPI only, for the rank and a clean exit under mpirun
-      int rank = 0;
-      MPI_Init(&argc, &argv);
-      MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-      std::fprintf(stderr, "[%d] rbcontact error: %s\n", rank, bad.c_str());
-      for (int i = 1; rank == 0 && i + 1 < argc; ++i)
-        if (!std::strcmp(argv[i], "-report") && argv[i + 1][0]) rbc::WriteFailureReport(argv[i + 1], stage, bad, (long long)PETSC_ERR_FILE_OPEN, false);
-      MPI_Finalize();
-      return (int)PETSC_ERR_FILE_OPEN;
-    }
+  // MPI before PETSc, which then leaves MPI_Finalize to this function: the options files are checked before PETSc reads
+  // them (a self-including file overflowed its stack) and where it reads them, on rank 0, with one answer for every rank
+  // (checked on each rank, a file that only rank 0 could see stopped the other ranks while rank 0 started PETSc: a hang)
+  int provided = 0, rank = 0;
+  MPI_Init_thread(&argc, &argv, PETSC_MPI_THREAD_REQUIRED, &provided);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const std::string bad = rbc::CheckOptionsFilesOnRankZero(MPI_COMM_WORLD, std::vector<std::string>(argv + 1, argv + argc));
+  if (!bad.empty()) { // PETSc is not initialized
+    if (rank == 0) std::fprintf(stderr, "[0] rbcontact error: %s\n", bad.c_str());
+    for (int i = 1; rank == 0 && i + 1 < argc; ++i)
+      if (!std::strcmp(argv[i], "-report") && argv[i + 1][0]) rbc::WriteFailureReport(argv[i + 1], stage, bad, (long long)PETSC_ERR_FILE_OPEN, false);
+    MPI_Finalize();
+    return (int)PETSC_ERR_FILE_OPEN;
   }
+  const int code = RunStage(argc, argv, stage);
+  MPI_Finalize();
+  return code;
+}
+
+// The stage under PETSc, MPI started (main).
+static int RunStage(int argc, char **argv, const std::string &stage)
+{
   const std::vector<std::string> given(argv + 1, argv + argc); // the options given on the command line (WarnUnusedOptions)
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(OneBlasThreadPerRank());

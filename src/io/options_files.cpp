@@ -192,6 +192,19 @@ static std::vector<std::pair<std::string, std::string>> optionsFilesRead; // of 
 
 const std::vector<std::pair<std::string, std::string>> &OptionsFilesRead() { return optionsFilesRead; }
 
+std::string CheckOptionsFilesOnRankZero(MPI_Comm comm, const std::vector<std::string> &words)
+{
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::string bad = rank == 0 ? CheckOptionsFiles(words) : std::string();
+  if (rank != 0) optionsFilesRead.clear();
+  unsigned long long n = bad.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  bad.resize(n);
+  if (n) MPI_Bcast(&bad[0], (int)n, MPI_CHAR, 0, comm);
+  return bad;
+}
+
 std::string CheckOptionsFiles(const std::vector<std::string> &words)
 {
   std::vector<std::string>                                      chain, shown;
