@@ -286,6 +286,24 @@ def rank_files(args):
         check(p.returncode != 0 and "options file runs/ring_on_block.opts (-options_file): No such file or directory" in p.stdout and t < 60,
               "rank 0 does not see the options file: refused on every rank, naming it (exit %d, %.1f s)" % (p.returncode, t))
         check(r.get("converged") is False and "No such file" in r.get("error", ""), "... the failure report written (%s)" % r.get("error"))
+    # the Python module (built beside the executable): rbcontact.initialize with an options file rank 1 cannot see
+    pydir = os.path.join(os.path.dirname(os.path.dirname(exe)), "python")
+    rom = d + "/rom.h5"
+    if os.path.isdir(os.path.join(pydir, "rbcontact")):
+        run(args, 1, ["offline", "-options_file", "runs/ring_on_block.opts", "-train_size", "5", "-rom", rom])
+        script = d + "/init.py"
+        with open(script, "w") as f:
+            f.write("import sys\nsys.path.insert(0, %r)\nimport rbcontact\nrbcontact.initialize(['-options_file', 'runs/ring_on_block.opts'])\n"
+                    "print('force %%.15g' %% rbcontact.ReducedModel(%r).solve([1.02]).contact_force)\n" % (pydir, rom))
+        py = ["-n", "1", "--wdir", ROOT, "/usr/bin/python3", script]
+        c = ["mpirun"] + py + [":"] + py[:2] + ["--wdir", d] + py[4:]
+        try:
+            p = subprocess.run(c, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", stdin=subprocess.DEVNULL, timeout=120)
+            forces = re.findall(r"^force (\S+)", p.stdout, re.M)
+            check(p.returncode == 0 and len(forces) == 2 and forces[0] == forces[1], "Python: rbcontact.initialize with an options file only rank 0 sees works on 2 ranks (exit %d, %s)" % (p.returncode, forces))
+        except subprocess.TimeoutExpired:
+            subprocess.run(["pkill", "-f", script])
+            check(False, "Python: rbcontact.initialize with an options file only rank 0 sees: hung (killed after 120 s)")
 
 
 def stale(args):
